@@ -1,0 +1,56 @@
+//! # nesy-cli
+//!
+//! Command-line front end of nesy. The binary is a thin shell over this library so that
+//! integration tests can drive the same code paths.
+//!
+//! Exit codes follow one convention across subcommands: 0 success, 1 a negative verdict
+//! (invalid plan, failed episode), 2 bad input or usage.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+pub mod commands;
+
+/// Turn a demonstration recorded in one setting into a verified robot program for another.
+#[derive(Debug, Parser)]
+#[command(name = "nesy", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands. Each lives in its own module under [`commands`].
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Verify a plan against a PDDL domain and problem, like VAL.
+    Verify(commands::verify::VerifyArgs),
+}
+
+/// Exit code for bad input or usage errors.
+pub const EXIT_BAD_INPUT: u8 = 2;
+
+/// Parses the command line, sets up logging from `RUST_LOG`, and runs the subcommand.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    tracing_subscriber::fmt()
+        .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
+        .with_writer(std::io::stderr)
+        .init();
+    run(cli)
+}
+
+/// Runs a parsed command line and maps errors to exit code 2 with their full context.
+pub fn run(cli: Cli) -> ExitCode {
+    let result = match cli.command {
+        Command::Verify(args) => commands::verify::run(args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::from(EXIT_BAD_INPUT)
+        }
+    }
+}

@@ -1,0 +1,226 @@
+//! Symbolic states: finite sets of ground atoms under the closed-world assumption.
+
+use std::fmt;
+
+use crate::atom::Atom;
+use crate::symbol::Symbol;
+
+/// A set of ground atoms; anything absent is false (closed world).
+///
+/// Stored as a sorted, de-duplicated vector: membership is a binary search, cloning is a
+/// single allocation, and iteration order is deterministic within a process.
+#[derive(Clone, Default, PartialEq, Eq, Hash)]
+pub struct State {
+    atoms: Vec<Atom>,
+}
+
+impl State {
+    /// The empty state.
+    pub fn new() -> Self {
+        State::default()
+    }
+
+    /// Builds a state from atoms; duplicates collapse.
+    pub fn from_atoms(atoms: impl IntoIterator<Item = Atom>) -> Self {
+        let mut atoms: Vec<Atom> = atoms.into_iter().collect();
+        atoms.sort_unstable();
+        atoms.dedup();
+        State { atoms }
+    }
+
+    /// True if `atom` holds.
+    pub fn contains(&self, atom: &Atom) -> bool {
+        self.atoms.binary_search(atom).is_ok()
+    }
+
+    /// Adds `atom`; returns false if it was already present.
+    pub fn insert(&mut self, atom: Atom) -> bool {
+        match self.atoms.binary_search(&atom) {
+            Ok(_) => false,
+            Err(i) => {
+                self.atoms.insert(i, atom);
+                true
+            }
+        }
+    }
+
+    /// Removes `atom`; returns false if it was absent.
+    pub fn remove(&mut self, atom: &Atom) -> bool {
+        match self.atoms.binary_search(atom) {
+            Ok(i) => {
+                self.atoms.remove(i);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// Number of atoms.
+    pub fn len(&self) -> usize {
+        self.atoms.len()
+    }
+
+    /// True if no atom holds.
+    pub fn is_empty(&self) -> bool {
+        self.atoms.is_empty()
+    }
+
+    /// Atoms in storage order (by interned id).
+    pub fn iter(&self) -> std::slice::Iter<'_, Atom> {
+        self.atoms.iter()
+    }
+
+    /// Atoms sorted by their printed text, the order used in every human-facing output.
+    pub fn sorted_by_text(&self) -> Vec<&Atom> {
+        let mut v: Vec<&Atom> = self.atoms.iter().collect();
+        v.sort_by_cached_key(|a| a.to_string());
+        v
+    }
+
+    /// True if every atom of `other` also holds here.
+    pub fn is_superset(&self, other: &State) -> bool {
+        other.atoms.iter().all(|a| self.contains(a))
+    }
+
+    /// Every object constant mentioned by some atom, in id order.
+    pub fn objects(&self) -> Vec<Symbol> {
+        let mut objs: Vec<Symbol> = self.atoms.iter().flat_map(|a| a.args().iter().copied()).collect();
+        objs.sort_unstable();
+        objs.dedup();
+        objs
+    }
+
+    /// What changed from `self` to `next`.
+    pub fn diff(&self, next: &State) -> StateDiff {
+        StateDiff {
+            added: next.atoms.iter().filter(|a| !self.contains(a)).cloned().collect(),
+            removed: self.atoms.iter().filter(|a| !next.contains(a)).cloned().collect(),
+        }
+    }
+}
+
+impl FromIterator<Atom> for State {
+    fn from_iter<I: IntoIterator<Item = Atom>>(iter: I) -> Self {
+        State::from_atoms(iter)
+    }
+}
+
+impl<'a> IntoIterator for &'a State {
+    type Item = &'a Atom;
+    type IntoIter = std::slice::Iter<'a, Atom>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.atoms.iter()
+    }
+}
+
+/// Prints the paper's state list: one `- (Atom ...)` line per atom, sorted by text, or
+/// `None` for the empty state.
+impl fmt::Display for State {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.atoms.is_empty() {
+            return f.write_str("None");
+        }
+        for (i, atom) in self.sorted_by_text().into_iter().enumerate() {
+            if i > 0 {
+                f.write_str("\n")?;
+            }
+            write!(f, "- {atom}")?;
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Debug for State {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_set().entries(self.sorted_by_text()).finish()
+    }
+}
+
+/// Serialised as a JSON array of atom strings sorted by text, e.g. `["(GripperOpen)"]`.
+impl serde::Serialize for State {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(self.sorted_by_text())
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for State {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let atoms = Vec::<Atom>::deserialize(deserializer)?;
+        Ok(State::from_atoms(atoms))
+    }
+}
+
+/// The change between two states: atoms that became true and atoms that became false.
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct StateDiff {
+    /// Atoms true after but not before.
+    pub added: Vec<Atom>,
+    /// Atoms true before but not after.
+    pub removed: Vec<Atom>,
+}
+
+impl StateDiff {
+    /// True if nothing changed.
+    pub fn is_empty(&self) -> bool {
+        self.added.is_empty() && self.removed.is_empty()
+    }
+}
+
+/// Prints the authors' diff form: `(+) (Atom)` lines, then `(-) (Atom)` lines, each
+/// group sorted by text; `None` when nothing changed.
+impl fmt::Display for StateDiff {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.is_empty() {
+            return f.write_str("None");
+        }
+        let mut lines: Vec<String> = Vec::new();
+        let mut added: Vec<String> = self.added.iter().map(|a| a.to_string()).collect();
+        let mut removed: Vec<String> = self.removed.iter().map(|a| a.to_string()).collect();
+        added.sort();
+        removed.sort();
+        lines.extend(added.into_iter().map(|a| format!("(+) {a}")));
+        lines.extend(removed.into_iter().map(|a| format!("(-) {a}")));
+        f.write_str(&lines.join("\n"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn atom(s: &str) -> Atom {
+        s.parse().unwrap()
+    }
+
+    #[test]
+    fn set_semantics() {
+        let mut s = State::from_atoms([atom("(GripperOpen)"), atom("(OnTopOf a b)"), atom("(GripperOpen)")]);
+        assert_eq!(s.len(), 2);
+        assert!(s.contains(&atom("(OnTopOf a b)")));
+        assert!(!s.insert(atom("(GripperOpen)")));
+        assert!(s.remove(&atom("(GripperOpen)")));
+        assert!(!s.contains(&atom("(GripperOpen)")));
+        assert!(!s.remove(&atom("(GripperOpen)")));
+    }
+
+    #[test]
+    fn prints_paper_format_sorted() {
+        let s = State::from_atoms([atom("(OnTopOf b floor)"), atom("(Closed hinge_lid)"), atom("(GripperOpen)")]);
+        assert_eq!(s.to_string(), "- (Closed hinge_lid)\n- (GripperOpen)\n- (OnTopOf b floor)");
+        assert_eq!(State::new().to_string(), "None");
+    }
+
+    #[test]
+    fn diff_and_json() {
+        let a = State::from_atoms([atom("(GripperOpen)"), atom("(GripperSurrounding x)")]);
+        let b = State::from_atoms([atom("(GripperClosed)"), atom("(GripperHolding x)")]);
+        let d = a.diff(&b);
+        assert_eq!(
+            d.to_string(),
+            "(+) (GripperClosed)\n(+) (GripperHolding x)\n(-) (GripperOpen)\n(-) (GripperSurrounding x)"
+        );
+        let json = serde_json::to_string(&a).unwrap();
+        assert_eq!(json, r#"["(GripperOpen)","(GripperSurrounding x)"]"#);
+        assert_eq!(serde_json::from_str::<State>(&json).unwrap(), a);
+    }
+}

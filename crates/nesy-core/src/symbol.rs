@@ -1,0 +1,93 @@
+//! Interned symbols: object, predicate, type and action names.
+//!
+//! Every name is interned once in a process-wide table, so symbols are `Copy`, compare
+//! and hash as a `u32`, and resolve back to a `&'static str` without locking.
+
+use std::fmt;
+use std::sync::LazyLock;
+
+use lasso::{Spur, ThreadedRodeo};
+
+static INTERNER: LazyLock<ThreadedRodeo> = LazyLock::new(ThreadedRodeo::new);
+
+/// An interned name.
+///
+/// `Ord` follows interning order, which is cheap and deterministic within a process but
+/// not alphabetical; use [`Symbol::as_str`] when a human-facing order is needed.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Symbol(Spur);
+
+impl Symbol {
+    /// Interns `name` (or finds it if it was interned before).
+    pub fn new(name: &str) -> Self {
+        Symbol(INTERNER.get_or_intern(name))
+    }
+
+    /// Returns the symbol for `name` only if it has been interned already.
+    pub fn lookup(name: &str) -> Option<Self> {
+        INTERNER.get(name).map(Symbol)
+    }
+
+    /// The interned text.
+    pub fn as_str(self) -> &'static str {
+        // The interner is a never-dropped static, so its strings live for the whole
+        // process; `resolve` ties them to the borrow of the static, which is 'static.
+        let rodeo: &'static ThreadedRodeo = &INTERNER;
+        rodeo.resolve(&self.0)
+    }
+}
+
+impl fmt::Display for Symbol {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl fmt::Debug for Symbol {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{:?}", self.as_str())
+    }
+}
+
+impl From<&str> for Symbol {
+    fn from(name: &str) -> Self {
+        Symbol::new(name)
+    }
+}
+
+impl serde::Serialize for Symbol {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.as_str())
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Symbol {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let name = <std::borrow::Cow<'de, str>>::deserialize(deserializer)?;
+        Ok(Symbol::new(&name))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interning_is_idempotent_and_resolves() {
+        let a = Symbol::new("red_cube");
+        let b = Symbol::new("red_cube");
+        assert_eq!(a, b);
+        assert_eq!(a.as_str(), "red_cube");
+        assert_ne!(a, Symbol::new("red_cube2"));
+        assert_eq!(Symbol::lookup("red_cube"), Some(a));
+    }
+
+    #[test]
+    fn serde_round_trip() {
+        let s = Symbol::new("hinge_lid");
+        let json = serde_json::to_string(&s).unwrap();
+        assert_eq!(json, "\"hinge_lid\"");
+        let back: Symbol = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, s);
+    }
+}
