@@ -6,9 +6,9 @@
 //!
 //! This crate is pure: no IO, no async runtime, no physics.
 
-pub mod symbol;
 pub mod atom;
 pub mod state;
+pub mod symbol;
 
 pub use atom::Atom;
 pub use state::State;

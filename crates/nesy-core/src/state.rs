@@ -194,7 +194,11 @@ mod tests {
 
     #[test]
     fn set_semantics() {
-        let mut s = State::from_atoms([atom("(GripperOpen)"), atom("(OnTopOf a b)"), atom("(GripperOpen)")]);
+        let mut s = State::from_atoms([
+            atom("(GripperOpen)"),
+            atom("(OnTopOf a b)"),
+            atom("(GripperOpen)"),
+        ]);
         assert_eq!(s.len(), 2);
         assert!(s.contains(&atom("(OnTopOf a b)")));
         assert!(!s.insert(atom("(GripperOpen)")));
@@ -205,8 +209,15 @@ mod tests {
 
     #[test]
     fn prints_paper_format_sorted() {
-        let s = State::from_atoms([atom("(OnTopOf b floor)"), atom("(Closed hinge_lid)"), atom("(GripperOpen)")]);
-        assert_eq!(s.to_string(), "- (Closed hinge_lid)\n- (GripperOpen)\n- (OnTopOf b floor)");
+        let s = State::from_atoms([
+            atom("(OnTopOf b floor)"),
+            atom("(Closed hinge_lid)"),
+            atom("(GripperOpen)"),
+        ]);
+        assert_eq!(
+            s.to_string(),
+            "- (Closed hinge_lid)\n- (GripperOpen)\n- (OnTopOf b floor)"
+        );
         assert_eq!(State::new().to_string(), "None");
     }
 

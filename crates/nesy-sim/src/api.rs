@@ -99,22 +99,51 @@ impl Direction {
 #[serde(tag = "call", rename_all = "snake_case")]
 #[allow(missing_docs)] // variant fields are the API's own parameter names
 pub enum ApiCall {
-    IsObjVisible { obj_name: String },
+    IsObjVisible {
+        obj_name: String,
+    },
     GetObjNames,
-    GetObjPos { obj_name: String },
-    GetObjBbox { obj_name: String },
-    GetObjSize { obj_name: String },
+    GetObjPos {
+        obj_name: String,
+    },
+    GetObjBbox {
+        obj_name: String,
+    },
+    GetObjSize {
+        obj_name: String,
+    },
     GripperIsOpen,
-    ObjInGripper { obj_name: String },
-    GetEmptyFloorXy { obj_name: String },
-    MoveGripperTo { obj_name: String, pointing_to: Direction, depth: f64 },
-    MoveToPosition { pos: [f64; 3], pointing_to: Direction, lift_clearance: f64, angle: f64 },
-    MoveParallel { move_dir: Direction, offset: f64, pointing_to: Direction },
-    GraspHandle { handle_name: String },
+    ObjInGripper {
+        obj_name: String,
+    },
+    GetEmptyFloorXy {
+        obj_name: String,
+    },
+    MoveGripperTo {
+        obj_name: String,
+        pointing_to: Direction,
+        depth: f64,
+    },
+    MoveToPosition {
+        pos: [f64; 3],
+        pointing_to: Direction,
+        lift_clearance: f64,
+        angle: f64,
+    },
+    MoveParallel {
+        move_dir: Direction,
+        offset: f64,
+        pointing_to: Direction,
+    },
+    GraspHandle {
+        handle_name: String,
+    },
     ReleaseHandle,
     OpenGripper,
     CloseGripper,
-    AttachVacuumHandle { handle_name: String },
+    AttachVacuumHandle {
+        handle_name: String,
+    },
     DetachVacuumHandle,
     ActivateVacuum,
     DeactivateVacuum,
@@ -298,7 +327,8 @@ pub trait RobotApi {
     fn get_empty_floor_xy(&mut self, obj_name: &str) -> Result<[f64; 2], ApiError>;
 
     /// Moves the tool to the object: `depth` below its top surface when pointing down.
-    fn move_gripper_to(&mut self, obj_name: &str, pointing_to: Direction, depth: f64) -> Result<(), ApiError>;
+    fn move_gripper_to(&mut self, obj_name: &str, pointing_to: Direction, depth: f64)
+    -> Result<(), ApiError>;
     /// Moves the tool tip to `pos` with a lift/approach clearance; `angle` is the yaw
     /// about the approach axis.
     fn move_to_position(
@@ -310,7 +340,12 @@ pub trait RobotApi {
     ) -> Result<(), ApiError>;
     /// Translates the tool by `offset` metres in `move_dir` (left/right/front/back/up),
     /// keeping its orientation.
-    fn move_parallel(&mut self, move_dir: Direction, offset: f64, pointing_to: Direction) -> Result<(), ApiError>;
+    fn move_parallel(
+        &mut self,
+        move_dir: Direction,
+        offset: f64,
+        pointing_to: Direction,
+    ) -> Result<(), ApiError>;
     /// Grasps a handle within reach (finger robot).
     fn grasp_handle(&mut self, handle_name: &str) -> Result<(), ApiError>;
     /// Releases the grasped handle and opens the gripper (finger robot).
@@ -337,7 +372,11 @@ mod tests {
     fn trace_entry_json_shape() {
         let e = TraceEntry {
             index: 3,
-            call: ApiCall::MoveGripperTo { obj_name: "red_cube".into(), pointing_to: Direction::Down, depth: 0.015 },
+            call: ApiCall::MoveGripperTo {
+                obj_name: "red_cube".into(),
+                pointing_to: Direction::Down,
+                depth: 0.015,
+            },
             result: Ok(ApiValue::None),
             sim_time: 1.25,
         };
@@ -358,7 +397,10 @@ mod tests {
             sim_time: 1.25,
         };
         let text = refused.result.as_ref().unwrap_err().to_string();
-        assert_eq!(text, "close_gripper() is not available on the vacuum robot; use activate_vacuum() instead");
+        assert_eq!(
+            text,
+            "close_gripper() is not available on the vacuum robot; use activate_vacuum() instead"
+        );
         let back: TraceEntry = serde_json::from_str(&serde_json::to_string(&refused).unwrap()).unwrap();
         assert_eq!(back, refused);
     }
