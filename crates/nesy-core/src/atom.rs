@@ -1,8 +1,17 @@
 //! Ground atoms such as `(OnTopOf red_cube floor)` or `(GripperOpen)`.
+//!
+//! Atoms are hash-consed: every distinct `(predicate, arguments)` pair is stored once in a
+//! process-wide table and an [`Atom`] is a pointer to that entry. Atoms are therefore
+//! `Copy`, eight bytes wide, compare and hash by a dense id, and a [`crate::State`] of
+//! two hundred atoms clones with one `memcpy`. The table only grows; its size is bounded by
+//! the number of distinct atoms a process ever builds.
 
 use std::fmt;
+use std::hash::{Hash, Hasher};
 use std::str::FromStr;
+use std::sync::{LazyLock, RwLock};
 
+use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
 use crate::symbol::Symbol;
@@ -11,58 +20,110 @@ use crate::symbol::Symbol;
 /// paper has arity ≤ 2); longer PDDL predicates spill to the heap.
 pub type Args = SmallVec<[Symbol; 3]>;
 
-/// A ground atom: a predicate applied to object constants.
-///
-/// `Ord` is by interned id (fast, deterministic within a process); printing code sorts
-/// by text where humans read the result.
-#[derive(Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Atom {
+/// The interned data behind an atom.
+#[derive(Debug)]
+struct AtomData {
+    id: u32,
     pred: Symbol,
     args: Args,
 }
 
+type AtomKey = (Symbol, Args);
+
+static ATOMS: LazyLock<RwLock<FxHashMap<AtomKey, &'static AtomData>>> =
+    LazyLock::new(|| RwLock::new(FxHashMap::default()));
+
+fn intern(pred: Symbol, args: Args) -> &'static AtomData {
+    let key = (pred, args);
+    if let Some(found) = ATOMS.read().unwrap_or_else(|e| e.into_inner()).get(&key) {
+        return found;
+    }
+    let mut table = ATOMS.write().unwrap_or_else(|e| e.into_inner());
+    if let Some(found) = table.get(&key) {
+        return found;
+    }
+    let id = u32::try_from(table.len()).expect("more than 2^32 distinct atoms");
+    // Leaked on purpose: the table lives for the whole process and hands out `'static`
+    // references, which is what makes `Atom` a plain pointer.
+    let data: &'static AtomData = Box::leak(Box::new(AtomData { id, pred: key.0, args: key.1.clone() }));
+    table.insert(key, data);
+    data
+}
+
+/// A ground atom: a predicate applied to object constants.
+///
+/// `Ord` is by interned id (fast, deterministic for a given interning order); printing code
+/// sorts by text where humans read the result.
+#[derive(Clone, Copy)]
+pub struct Atom(&'static AtomData);
+
 impl Atom {
     /// Builds an atom from a predicate name and argument names, interning them.
     pub fn new(pred: &str, args: &[&str]) -> Self {
-        Atom {
-            pred: Symbol::new(pred),
-            args: args.iter().map(|a| Symbol::new(a)).collect(),
-        }
+        Atom(intern(Symbol::new(pred), args.iter().map(|a| Symbol::new(a)).collect()))
     }
 
     /// Builds an atom from already interned symbols.
     pub fn from_symbols(pred: Symbol, args: impl IntoIterator<Item = Symbol>) -> Self {
-        Atom {
-            pred,
-            args: args.into_iter().collect(),
-        }
+        Atom(intern(pred, args.into_iter().collect()))
     }
 
     /// The predicate.
     pub fn pred(&self) -> Symbol {
-        self.pred
+        self.0.pred
     }
 
     /// The arguments, in order.
     pub fn args(&self) -> &[Symbol] {
-        &self.args
+        &self.0.args
     }
 
     /// Number of arguments.
     pub fn arity(&self) -> usize {
-        self.args.len()
+        self.0.args.len()
     }
 
     /// True if any argument is `object`.
     pub fn mentions(&self, object: Symbol) -> bool {
-        self.args.contains(&object)
+        self.0.args.contains(&object)
+    }
+
+    /// The dense interned id (stable for the life of the process).
+    pub fn id(&self) -> u32 {
+        self.0.id
+    }
+}
+
+impl PartialEq for Atom {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self.0, other.0)
+    }
+}
+
+impl Eq for Atom {}
+
+impl Hash for Atom {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        self.0.id.hash(state);
+    }
+}
+
+impl PartialOrd for Atom {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Atom {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.id.cmp(&other.0.id)
     }
 }
 
 impl fmt::Display for Atom {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "({}", self.pred)?;
-        for a in &self.args {
+        write!(f, "({}", self.pred())?;
+        for a in self.args() {
             write!(f, " {a}")?;
         }
         f.write_str(")")
@@ -129,7 +190,7 @@ impl FromStr for Atom {
                 "a name or ')'"
             };
             AtomParseError {
-                column: s.len() - s.trim_start().len() + offset + 1,
+                column: s.len() - s.trim_start().len() + text[..offset].chars().count() + 1,
                 expected,
                 found: text[offset..].chars().take(24).collect(),
             }
@@ -162,6 +223,17 @@ mod tests {
         }
         let spaced: Atom = "  ( InsideOf  apple   hinge_body )".parse().unwrap();
         assert_eq!(spaced, Atom::new("InsideOf", &["apple", "hinge_body"]));
+    }
+
+    #[test]
+    fn interning_gives_identity() {
+        let a = Atom::new("OnTopOf", &["x", "y"]);
+        let b = Atom::from_symbols(Symbol::new("OnTopOf"), [Symbol::new("x"), Symbol::new("y")]);
+        assert_eq!(a, b);
+        assert_eq!(a.id(), b.id());
+        assert_ne!(a, Atom::new("OnTopOf", &["y", "x"]));
+        assert_eq!(a.arity(), 2);
+        assert!(a.mentions(Symbol::new("y")));
     }
 
     #[test]

@@ -82,6 +82,41 @@ impl State {
         other.atoms.iter().all(|a| self.contains(a))
     }
 
+    /// The atoms as a slice, in storage order (by interned id).
+    pub fn as_slice(&self) -> &[Atom] {
+        &self.atoms
+    }
+
+    /// The state `(self \ deletes) ∪ adds`, PDDL's effect rule (deletes first, then adds).
+    ///
+    /// Both inputs must be sorted by [`Atom`]'s `Ord` and free of duplicates; the result is
+    /// built in one linear merge.
+    pub fn with_changes(&self, deletes: &[Atom], adds: &[Atom]) -> State {
+        debug_assert!(deletes.windows(2).all(|w| w[0] < w[1]));
+        debug_assert!(adds.windows(2).all(|w| w[0] < w[1]));
+        let mut out = Vec::with_capacity(self.atoms.len() + adds.len());
+        let (mut d, mut a) = (0, 0);
+        for &atom in &self.atoms {
+            while a < adds.len() && adds[a] < atom {
+                out.push(adds[a]);
+                a += 1;
+            }
+            while d < deletes.len() && deletes[d] < atom {
+                d += 1;
+            }
+            let deleted = d < deletes.len() && deletes[d] == atom;
+            let readded = a < adds.len() && adds[a] == atom;
+            if readded {
+                a += 1;
+            }
+            if !deleted || readded {
+                out.push(atom);
+            }
+        }
+        out.extend_from_slice(&adds[a..]);
+        State { atoms: out }
+    }
+
     /// Every object constant mentioned by some atom, in id order.
     pub fn objects(&self) -> Vec<Symbol> {
         let mut objs: Vec<Symbol> = self.atoms.iter().flat_map(|a| a.args().iter().copied()).collect();
@@ -92,10 +127,29 @@ impl State {
 
     /// What changed from `self` to `next`.
     pub fn diff(&self, next: &State) -> StateDiff {
-        StateDiff {
-            added: next.atoms.iter().filter(|a| !self.contains(a)).cloned().collect(),
-            removed: self.atoms.iter().filter(|a| !next.contains(a)).cloned().collect(),
+        // Both sides are sorted by id: one linear merge.
+        let (mut added, mut removed) = (Vec::new(), Vec::new());
+        let (mut i, mut j) = (0, 0);
+        let (a, b) = (&self.atoms, &next.atoms);
+        while i < a.len() && j < b.len() {
+            match a[i].cmp(&b[j]) {
+                std::cmp::Ordering::Less => {
+                    removed.push(a[i]);
+                    i += 1;
+                }
+                std::cmp::Ordering::Greater => {
+                    added.push(b[j]);
+                    j += 1;
+                }
+                std::cmp::Ordering::Equal => {
+                    i += 1;
+                    j += 1;
+                }
+            }
         }
+        removed.extend_from_slice(&a[i..]);
+        added.extend_from_slice(&b[j..]);
+        StateDiff { added, removed }
     }
 }
 
@@ -219,6 +273,17 @@ mod tests {
             "- (Closed hinge_lid)\n- (GripperOpen)\n- (OnTopOf b floor)"
         );
         assert_eq!(State::new().to_string(), "None");
+    }
+
+    #[test]
+    fn with_changes_deletes_then_adds() {
+        let s = State::from_atoms([atom("(A)"), atom("(B)"), atom("(C)")]);
+        let mut dels = vec![atom("(B)"), atom("(C)")];
+        let mut adds = vec![atom("(C)"), atom("(D)")];
+        dels.sort();
+        adds.sort();
+        let next = s.with_changes(&dels, &adds);
+        assert_eq!(next, State::from_atoms([atom("(A)"), atom("(C)"), atom("(D)")]));
     }
 
     #[test]
