@@ -1,0 +1,655 @@
+//! [`RobotApi`] for [`Sim`]: the paper's perception and action calls with spec §4's
+//! defaults, embodiment and feasibility rules, the action budget and the trace.
+
+use nalgebra::Vector3;
+
+use crate::api::{ApiCall, ApiError, ApiValue, Direction, Embodiment, RobotApi, TraceEntry};
+use crate::geometry::{Aabb, array_to_na, yaw_of};
+use crate::motion::{SETTLE_STEPS, ToolGoal};
+use crate::objects::PartRole;
+use crate::robot::FINGER_OPEN;
+use crate::scene::ObjectKind;
+use crate::sim::{FLOOR_AABB, HandleGrasp, Sim, TABLE_TOP};
+
+/// Largest distance between the tool and a handle's centre for a grasp (spec §4).
+pub const HANDLE_REACH: f64 = 0.1;
+/// Control steps for the fingers to open or close (0.04 m at 0.2 m/s takes 20).
+const GRIPPER_STEPS: u32 = 25;
+
+impl Sim {
+    fn known_names(&self) -> String {
+        self.names().join(", ")
+    }
+
+    /// `floor`, the scene's parts in order, then the robot's own entry.
+    pub fn names(&self) -> Vec<String> {
+        std::iter::once("floor".to_owned())
+            .chain(self.parts.iter().map(|p| p.name.clone()))
+            .chain(std::iter::once(self.gripper_name().to_owned()))
+            .collect()
+    }
+
+    fn aabb_or_unknown(&self, name: &str) -> Result<Aabb, ApiError> {
+        self.object_aabb(name).ok_or_else(|| ApiError::UnknownObject {
+            name: name.to_owned(),
+            known: self.known_names(),
+        })
+    }
+
+    fn part_or_unknown(&self, name: &str) -> Result<usize, ApiError> {
+        self.part_index(name).ok_or_else(|| ApiError::UnknownObject {
+            name: name.to_owned(),
+            known: self.known_names(),
+        })
+    }
+
+    /// Records a call, fires the hooks, and passes the result through.
+    fn record<T>(
+        &mut self,
+        call: ApiCall,
+        result: Result<T, ApiError>,
+        value: impl FnOnce(&T) -> ApiValue,
+    ) -> Result<T, ApiError> {
+        let entry = TraceEntry {
+            index: self.trace.len(),
+            call,
+            result: result.as_ref().map(value).map_err(Clone::clone),
+            sim_time: self.time(),
+        };
+        if !self.hooks.is_empty() {
+            let mut hooks = std::mem::take(&mut self.hooks);
+            for hook in hooks.iter_mut() {
+                hook.on_call(self, &entry);
+            }
+            hooks.append(&mut self.hooks);
+            self.hooks = hooks;
+        }
+        self.trace.push(entry);
+        result
+    }
+
+    /// Runs an action: refuses it if the budget is spent or the embodiment is wrong,
+    /// otherwise runs `body`, and records the call either way.
+    fn action(
+        &mut self,
+        call: ApiCall,
+        needs: Option<(Embodiment, &str)>,
+        body: impl FnOnce(&mut Sim) -> Result<(), ApiError>,
+    ) -> Result<(), ApiError> {
+        let result = if self.actions_used >= self.config.action_budget {
+            Err(ApiError::BudgetExhausted {
+                limit: self.config.action_budget,
+            })
+        } else {
+            self.actions_used += 1;
+            match needs {
+                Some((embodiment, use_instead)) if embodiment != self.scene.embodiment => {
+                    Err(ApiError::WrongEmbodiment {
+                        call: call.name().to_owned(),
+                        embodiment: self.scene.embodiment,
+                        use_instead: use_instead.to_owned(),
+                    })
+                }
+                _ => body(self),
+            }
+        };
+        self.record(call, result, |_| ApiValue::None)
+    }
+
+    /// Something stacked on a cube or cylinder (spec §4 feasibility rule 2).
+    pub fn stacked_on(&self, part: usize) -> Option<usize> {
+        let me = self.part_aabb(part);
+        self.parts.iter().enumerate().find_map(|(i, p)| {
+            if i == part || !matches!(p.kind, ObjectKind::Cube | ObjectKind::Cylinder) {
+                return None;
+            }
+            let other = self.part_aabb(i);
+            (other.overlaps_xy(&me, 0.005)
+                && other.min[2] >= me.max[2] - 0.004
+                && other.min[2] > me.min[2] + 0.004)
+                .then_some(i)
+        })
+    }
+
+    /// The open top drawer covering the bottom drawer's handle (spec §4 rule 3).
+    pub fn handle_covered_by(&self, part: usize) -> Option<usize> {
+        if self.parts[part].name != "bottom_drawer_handle" {
+            return None;
+        }
+        let top = self.part_index("top_drawer")?;
+        self.part_aabb(top)
+            .overlaps_xy(&self.part_aabb(part), 0.005)
+            .then_some(top)
+    }
+
+    /// A loose object resting on the articulation's link (it blocks a lid from opening).
+    fn blocking_load(&self, articulation: usize) -> Option<usize> {
+        let link = self.articulations[articulation].link;
+        if !matches!(
+            self.articulations[articulation].joint,
+            crate::objects::JointBuild::Revolute { .. }
+        ) {
+            return None;
+        }
+        let lid = self.part_aabb(link);
+        self.parts.iter().enumerate().find_map(|(i, p)| {
+            if p.role != PartRole::Loose || self.held.is_some_and(|h| h.part == i) {
+                return None;
+            }
+            let a = self.part_aabb(i);
+            let gap = a.min[2] - lid.max[2];
+            (a.overlaps_xy(&lid, 0.002) && (-0.01..=0.01).contains(&gap)).then_some(i)
+        })
+    }
+
+    fn check_workspace(&self, target: [f64; 3]) -> Result<(), ApiError> {
+        let inside = (0..2).all(|i| target[i] >= FLOOR_AABB.min[i] && target[i] <= FLOOR_AABB.max[i]);
+        if !inside
+            || !(TABLE_TOP - 0.05..=TABLE_TOP + 0.8).contains(&target[2])
+            || target.iter().any(|v| !v.is_finite())
+        {
+            return Err(ApiError::OutOfWorkspace { target });
+        }
+        Ok(())
+    }
+
+    /// The tool motion of `move_to_position` (no trace entry).
+    fn do_move_to_position(
+        &mut self,
+        pos: [f64; 3],
+        pointing: Direction,
+        clearance: f64,
+        angle: f64,
+    ) -> Result<(), ApiError> {
+        if !(clearance.is_finite() && clearance >= 0.0) || !angle.is_finite() {
+            return Err(ApiError::InvalidArgument {
+                call: "move_to_position".into(),
+                message: format!("lift_clearance must be ≥ 0 and angle finite, got {clearance} and {angle}"),
+            });
+        }
+        if pointing == Direction::Up {
+            return Err(ApiError::InvalidArgument {
+                call: "move_to_position".into(),
+                message: "pointing_to must be down, left, right, front or back".into(),
+            });
+        }
+        self.check_workspace(pos)?;
+        let angle = match self.scene.embodiment {
+            Embodiment::Finger => self.nearest_spin(pointing, angle, std::f64::consts::PI),
+            Embodiment::Vacuum => 0.0,
+        };
+        let rotation = Sim::pointing(pointing, angle);
+        let dir = array_to_na(pointing.unit());
+        let current = self.tool_pose();
+        let current_dir = current.rotation * Vector3::z();
+        let target = array_to_na(pos);
+        let delta = target - current.translation.vector;
+        // A move along the approach axis with unchanged pointing needs no clearance.
+        let along_axis = delta.norm() > 1e-9 && delta.normalize().cross(&dir).norm() < 0.05;
+        let clearance = if current_dir.dot(&dir) > 0.999 && along_axis {
+            0.0
+        } else {
+            clearance
+        };
+        let mut waypoints = Vec::new();
+        if clearance > 0.0 {
+            if self.moved_since_reset {
+                waypoints.push(ToolGoal {
+                    position: current.translation.vector - current_dir * clearance,
+                    rotation: current.rotation,
+                });
+            }
+            waypoints.push(ToolGoal {
+                position: target - dir * clearance,
+                rotation,
+            });
+        }
+        waypoints.push(ToolGoal {
+            position: target,
+            rotation,
+        });
+        let plan = self.plan(&waypoints, pointing)?;
+        self.execute(&plan, SETTLE_STEPS);
+        self.moved_since_reset = true;
+        Ok(())
+    }
+
+    fn do_move_gripper_to(&mut self, name: &str, pointing: Direction, depth: f64) -> Result<(), ApiError> {
+        let part = self.part_or_unknown(name)?;
+        let aabb = self.part_aabb(part);
+        let p = &self.parts[part];
+        let call = "move_gripper_to".to_owned();
+        if p.role == PartRole::Loose
+            && !(0..2).all(|i| aabb.min[i] >= FLOOR_AABB.min[i] && aabb.max[i] <= FLOOR_AABB.max[i])
+        {
+            return Err(ApiError::OutOfWorkspace {
+                target: aabb.centre(),
+            });
+        }
+        if let Some(on_top) = self.stacked_on(part) {
+            return Err(ApiError::Infeasible {
+                call,
+                target: name.into(),
+                reason: format!("{} is stacked on it; move that first", self.parts[on_top].name),
+            });
+        }
+        if let Some(top) = self.handle_covered_by(part) {
+            return Err(ApiError::Infeasible {
+                call,
+                target: name.into(),
+                reason: format!("the open {} covers it", self.parts[top].name),
+            });
+        }
+        if !depth.is_finite() {
+            return Err(ApiError::InvalidArgument {
+                call,
+                message: format!("depth must be finite, got {depth}"),
+            });
+        }
+        if !matches!(pointing, Direction::Down | Direction::Left | Direction::Right) {
+            return Err(ApiError::InvalidArgument {
+                call,
+                message: "pointing_to must be down, left or right".into(),
+            });
+        }
+        let is_handle = p.role == PartRole::Handle;
+        let depth = match self.scene.embodiment {
+            Embodiment::Vacuum if is_handle => -0.01,
+            Embodiment::Vacuum => 0.0,
+            Embodiment::Finger => depth,
+        };
+        let dir = pointing.unit();
+        let axis = dir.iter().position(|v| v.abs() > 0.5).unwrap_or(2);
+        let half = aabb.size()[axis] / 2.0;
+        let centre = aabb.centre();
+        let target: [f64; 3] = std::array::from_fn(|i| centre[i] + (depth - half) * dir[i]);
+        let yaw = match self.scene.embodiment {
+            Embodiment::Vacuum => 0.0,
+            Embodiment::Finger => {
+                let object_yaw = match p.role {
+                    PartRole::Loose => yaw_of(&self.part_pose(part).rotation),
+                    _ => p.base_yaw,
+                };
+                let step = match p.kind {
+                    ObjectKind::Cube | ObjectKind::Cylinder if p.role == PartRole::Loose => {
+                        std::f64::consts::FRAC_PI_2
+                    }
+                    _ => std::f64::consts::PI,
+                };
+                self.nearest_spin(pointing, object_yaw + p.grasp_yaw, step)
+            }
+        };
+        self.do_move_to_position(target, pointing, crate::api::DEFAULT_LIFT_CLEARANCE, yaw)
+    }
+
+    fn do_move_parallel(&mut self, dir: Direction, offset: f64) -> Result<(), ApiError> {
+        if dir == Direction::Down {
+            return Err(ApiError::InvalidArgument {
+                call: "move_parallel".into(),
+                message: "move_dir must be left, right, front, back or up".into(),
+            });
+        }
+        if !(offset.is_finite() && offset > 0.0) {
+            return Err(ApiError::InvalidArgument {
+                call: "move_parallel".into(),
+                message: format!("offset must be > 0, got {offset}"),
+            });
+        }
+        let current = self.tool_pose();
+        let target = current.translation.vector + array_to_na(dir.unit()) * offset;
+        self.check_workspace([target.x, target.y, target.z])?;
+        let plan = self.plan(
+            &[ToolGoal {
+                position: target,
+                rotation: current.rotation,
+            }],
+            dir,
+        )?;
+        self.execute(&plan, SETTLE_STEPS);
+        self.moved_since_reset = true;
+        Ok(())
+    }
+
+    /// Width of a part across the fingers (along the hand's y axis).
+    fn width_across_fingers(&self, part: usize) -> f64 {
+        let hand_inv = self.carrier_pose().inverse();
+        let aabb = self.parts[part].colliders.iter().fold(Aabb::EMPTY, |acc, &c| {
+            let collider = &self.world.colliders[c];
+            acc.union(&Aabb::from_parry(
+                &collider.shape().compute_aabb(&(hand_inv * *collider.position())),
+            ))
+        });
+        aabb.size()[1]
+    }
+
+    fn close_fingers(&mut self) {
+        self.closed = true;
+        let mut target = 0.0;
+        if let Some(grasp) = self.handle_grasp {
+            target = (self.width_across_fingers(grasp.part) / 2.0).min(FINGER_OPEN);
+        } else if self.held.is_none() {
+            let candidate = (0..self.parts.len())
+                .find(|&i| self.parts[i].role == PartRole::Loose && self.part_in_gripper(i));
+            if let Some(i) = candidate {
+                let width = self.width_across_fingers(i);
+                if width <= 2.0 * FINGER_OPEN + 1e-3 {
+                    target = width / 2.0;
+                    self.weld(i);
+                } else {
+                    // Wider than the opening: the fingers stop on it and nothing is held.
+                    target = self.gripper;
+                }
+            }
+        }
+        self.gripper_target = target;
+        self.step_idle(GRIPPER_STEPS);
+    }
+
+    fn open_fingers(&mut self) {
+        self.unweld();
+        self.closed = false;
+        self.gripper_target = if self.scene.embodiment == Embodiment::Finger {
+            FINGER_OPEN
+        } else {
+            0.0
+        };
+        self.step_idle(GRIPPER_STEPS + SETTLE_STEPS);
+    }
+
+    fn suction_on(&mut self) {
+        self.closed = true;
+        if self.held.is_none() && self.handle_grasp.is_none() {
+            let point = self.suction_point();
+            if let Some(i) = (0..self.parts.len())
+                .find(|&i| self.parts[i].role == PartRole::Loose && self.part_aabb(i).contains_point(point))
+            {
+                self.weld(i);
+            }
+        }
+        self.step_idle(GRIPPER_STEPS);
+    }
+
+    fn do_grasp_handle(&mut self, name: &str, call: &str) -> Result<(), ApiError> {
+        let part = self.part_or_unknown(name)?;
+        let infeasible = |reason: String| ApiError::Infeasible {
+            call: call.into(),
+            target: name.into(),
+            reason,
+        };
+        let Some(articulation) = self.parts[part]
+            .articulation
+            .filter(|_| self.parts[part].role == PartRole::Handle)
+        else {
+            return Err(infeasible("it is not a handle".into()));
+        };
+        if let Some(h) = self.held {
+            return Err(infeasible(format!(
+                "the gripper is holding {}",
+                self.parts[h.part].name
+            )));
+        }
+        if let Some(top) = self.handle_covered_by(part) {
+            return Err(infeasible(format!("the open {} covers it", self.parts[top].name)));
+        }
+        let tool = self.tool_pose().translation.vector;
+        let distance = (tool - array_to_na(self.part_aabb(part).centre())).norm();
+        if distance > HANDLE_REACH {
+            return Err(infeasible(format!(
+                "it is {distance:.3} m from the gripper (reach {HANDLE_REACH} m); move_gripper_to it first"
+            )));
+        }
+        if let Some(load) = self.blocking_load(articulation) {
+            return Err(infeasible(format!(
+                "{} rests on {} and blocks it",
+                self.parts[load].name, self.parts[self.articulations[articulation].link].name
+            )));
+        }
+        self.handle_grasp = Some(HandleGrasp {
+            part,
+            articulation,
+            tool0: tool,
+            q0: self.articulations[articulation].q,
+        });
+        match self.scene.embodiment {
+            Embodiment::Finger => self.close_fingers(),
+            Embodiment::Vacuum => self.suction_on(),
+        }
+        Ok(())
+    }
+
+    fn do_release_handle(&mut self) {
+        self.handle_grasp = None;
+        self.open_fingers();
+    }
+}
+
+const FINGER_ONLY: Embodiment = Embodiment::Finger;
+const VACUUM_ONLY: Embodiment = Embodiment::Vacuum;
+
+impl RobotApi for Sim {
+    fn embodiment(&self) -> Embodiment {
+        self.scene.embodiment
+    }
+
+    fn trace(&self) -> &[TraceEntry] {
+        &self.trace
+    }
+
+    fn is_obj_visible(&mut self, obj_name: &str) -> bool {
+        let visible = self.names().iter().any(|n| n == obj_name);
+        let call = ApiCall::IsObjVisible {
+            obj_name: obj_name.into(),
+        };
+        self.record(call, Ok(visible), |v| ApiValue::Bool(*v))
+            .unwrap_or(false)
+    }
+
+    fn get_obj_names(&mut self) -> Vec<String> {
+        let names = self.names();
+        self.record(ApiCall::GetObjNames, Ok(names), |n| ApiValue::Names(n.clone()))
+            .unwrap_or_default()
+    }
+
+    fn get_obj_pos(&mut self, obj_name: &str) -> Result<[f64; 3], ApiError> {
+        let result = self.aabb_or_unknown(obj_name).map(|a| {
+            let mut c = a.centre();
+            if obj_name == "floor" {
+                c[2] = TABLE_TOP;
+            }
+            c
+        });
+        self.record(
+            ApiCall::GetObjPos {
+                obj_name: obj_name.into(),
+            },
+            result,
+            |v| ApiValue::Vec3(*v),
+        )
+    }
+
+    fn get_obj_bbox(&mut self, obj_name: &str) -> Result<[[f64; 3]; 2], ApiError> {
+        let result = self.aabb_or_unknown(obj_name).map(|a| [a.min, a.max]);
+        self.record(
+            ApiCall::GetObjBbox {
+                obj_name: obj_name.into(),
+            },
+            result,
+            |v| ApiValue::Bbox(*v),
+        )
+    }
+
+    fn get_obj_size(&mut self, obj_name: &str) -> Result<[f64; 3], ApiError> {
+        let result = self.aabb_or_unknown(obj_name).map(|a| a.size());
+        self.record(
+            ApiCall::GetObjSize {
+                obj_name: obj_name.into(),
+            },
+            result,
+            |v| ApiValue::Vec3(*v),
+        )
+    }
+
+    fn gripper_is_open(&mut self) -> bool {
+        let open = !self.closed;
+        self.record(ApiCall::GripperIsOpen, Ok(open), |v| ApiValue::Bool(*v))
+            .unwrap_or(true)
+    }
+
+    fn obj_in_gripper(&mut self, obj_name: &str) -> Result<bool, ApiError> {
+        let result = self.part_or_unknown(obj_name).map(|p| self.part_in_gripper(p));
+        self.record(
+            ApiCall::ObjInGripper {
+                obj_name: obj_name.into(),
+            },
+            result,
+            |v| ApiValue::Bool(*v),
+        )
+    }
+
+    fn get_empty_floor_xy(&mut self, obj_name: &str) -> Result<[f64; 2], ApiError> {
+        let result = self.part_or_unknown(obj_name).and_then(|p| {
+            crate::floor::empty_floor_xy(self, p).ok_or(ApiError::NoEmptySpace {
+                obj_name: obj_name.into(),
+            })
+        });
+        self.record(
+            ApiCall::GetEmptyFloorXy {
+                obj_name: obj_name.into(),
+            },
+            result,
+            |v| ApiValue::Xy(*v),
+        )
+    }
+
+    fn move_gripper_to(
+        &mut self,
+        obj_name: &str,
+        pointing_to: Direction,
+        depth: f64,
+    ) -> Result<(), ApiError> {
+        let call = ApiCall::MoveGripperTo {
+            obj_name: obj_name.into(),
+            pointing_to,
+            depth,
+        };
+        self.action(call, None, |sim| {
+            sim.do_move_gripper_to(obj_name, pointing_to, depth)
+        })
+    }
+
+    fn move_to_position(
+        &mut self,
+        pos: [f64; 3],
+        pointing_to: Direction,
+        lift_clearance: f64,
+        angle: f64,
+    ) -> Result<(), ApiError> {
+        let call = ApiCall::MoveToPosition {
+            pos,
+            pointing_to,
+            lift_clearance,
+            angle,
+        };
+        self.action(call, None, |sim| {
+            sim.do_move_to_position(pos, pointing_to, lift_clearance, angle)
+        })
+    }
+
+    fn move_parallel(
+        &mut self,
+        move_dir: Direction,
+        offset: f64,
+        pointing_to: Direction,
+    ) -> Result<(), ApiError> {
+        let call = ApiCall::MoveParallel {
+            move_dir,
+            offset,
+            pointing_to,
+        };
+        self.action(call, None, |sim| sim.do_move_parallel(move_dir, offset))
+    }
+
+    fn grasp_handle(&mut self, handle_name: &str) -> Result<(), ApiError> {
+        let call = ApiCall::GraspHandle {
+            handle_name: handle_name.into(),
+        };
+        self.action(call, Some((FINGER_ONLY, "attach_vacuum_handle")), |sim| {
+            sim.do_grasp_handle(handle_name, "grasp_handle")
+        })
+    }
+
+    fn release_handle(&mut self) -> Result<(), ApiError> {
+        self.action(
+            ApiCall::ReleaseHandle,
+            Some((FINGER_ONLY, "detach_vacuum_handle")),
+            |sim| {
+                sim.do_release_handle();
+                Ok(())
+            },
+        )
+    }
+
+    fn open_gripper(&mut self) -> Result<(), ApiError> {
+        self.action(
+            ApiCall::OpenGripper,
+            Some((FINGER_ONLY, "deactivate_vacuum")),
+            |sim| {
+                sim.open_fingers();
+                Ok(())
+            },
+        )
+    }
+
+    fn close_gripper(&mut self) -> Result<(), ApiError> {
+        self.action(
+            ApiCall::CloseGripper,
+            Some((FINGER_ONLY, "activate_vacuum")),
+            |sim| {
+                sim.close_fingers();
+                Ok(())
+            },
+        )
+    }
+
+    fn attach_vacuum_handle(&mut self, handle_name: &str) -> Result<(), ApiError> {
+        let call = ApiCall::AttachVacuumHandle {
+            handle_name: handle_name.into(),
+        };
+        self.action(call, Some((VACUUM_ONLY, "grasp_handle")), |sim| {
+            sim.do_grasp_handle(handle_name, "attach_vacuum_handle")
+        })
+    }
+
+    fn detach_vacuum_handle(&mut self) -> Result<(), ApiError> {
+        self.action(
+            ApiCall::DetachVacuumHandle,
+            Some((VACUUM_ONLY, "release_handle")),
+            |sim| {
+                sim.do_release_handle();
+                Ok(())
+            },
+        )
+    }
+
+    fn activate_vacuum(&mut self) -> Result<(), ApiError> {
+        self.action(
+            ApiCall::ActivateVacuum,
+            Some((VACUUM_ONLY, "close_gripper")),
+            |sim| {
+                sim.suction_on();
+                Ok(())
+            },
+        )
+    }
+
+    fn deactivate_vacuum(&mut self) -> Result<(), ApiError> {
+        self.action(
+            ApiCall::DeactivateVacuum,
+            Some((VACUUM_ONLY, "open_gripper")),
+            |sim| {
+                sim.open_fingers();
+                Ok(())
+            },
+        )
+    }
+}
