@@ -13,6 +13,8 @@ pub mod exec;
 pub mod formula;
 pub mod operator;
 pub mod patch;
+pub mod pddl;
+pub mod planner;
 pub mod predicates;
 pub mod state;
 pub mod symbol;

@@ -14,6 +14,8 @@ pub(crate) struct Converter<'d> {
     doc: &'d str,
     /// PDDL is case-insensitive: in PDDL mode every name is lower-cased.
     lowercase: bool,
+    /// Declared predicates and arities; when set, atoms are checked against them.
+    predicates: Option<Vec<(Symbol, usize)>>,
 }
 
 fn is_name(t: &str) -> bool {
@@ -22,7 +24,13 @@ fn is_name(t: &str) -> bool {
 
 impl<'d> Converter<'d> {
     pub fn new(doc: &'d str, lowercase: bool) -> Self {
-        Converter { doc, lowercase }
+        Converter { doc, lowercase, predicates: None }
+    }
+
+    /// Checks every atom against declared predicates (PDDL's `:predicates`).
+    pub fn with_predicates(mut self, predicates: Vec<(Symbol, usize)>) -> Self {
+        self.predicates = Some(predicates);
+        self
     }
 
     pub fn err(&self, at: usize, kind: ParseErrorKind, expected: impl Into<String>) -> ParseError {
@@ -66,6 +74,25 @@ impl<'d> Converter<'d> {
 
     fn atom(&self, head: &SExpr<'_>, args: &[SExpr<'_>], scope: &[Symbol]) -> Result<AtomPattern, ParseError> {
         let pred = self.expect_name(head, "a predicate name")?;
+        if let Some(declared) = &self.predicates {
+            match declared.iter().find(|(p, _)| *p == pred) {
+                None => {
+                    return Err(self.err(
+                        head.span.start,
+                        ParseErrorKind::Reference,
+                        format!("a predicate declared in :predicates (`{pred}` is not)"),
+                    ));
+                }
+                Some((_, arity)) if *arity != args.len() => {
+                    return Err(self.err(
+                        head.span.start,
+                        ParseErrorKind::Reference,
+                        format!("{arity} argument(s) for `{pred}`, as declared (found {})", args.len()),
+                    ));
+                }
+                Some(_) => {}
+            }
+        }
         let args: SmallVec<[Term; 3]> = args.iter().map(|a| self.term(a, scope)).collect::<Result<_, _>>()?;
         Ok(AtomPattern { pred, args })
     }
