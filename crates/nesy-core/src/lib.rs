@@ -8,6 +8,7 @@
 //! This crate is pure: no IO, no async runtime, no physics. See `README.md` next to this
 //! crate's `Cargo.toml` for the file formats, the design decisions and measured figures.
 
+pub mod adapt;
 pub mod atom;
 pub mod exec;
 pub mod formula;

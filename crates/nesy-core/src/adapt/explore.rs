@@ -1,0 +1,310 @@
+//! Counterfactual identification (Eq. 6) and exploration with verified patches (Eq. 7–8).
+
+use super::reasoner::{Feedback, PatchRequest, Problem, Reasoner, ViolationKind};
+use super::{AdaptConfig, AdaptError, Outcome, Target, Trace, TraceEvent, Verdict, ViolationInfo, WorldModel};
+use crate::exec::{Report, UnmetPrecondition, format_unmet, implicit_universe, verify_procedure_in};
+use crate::formula::Formula;
+use crate::operator::Operator;
+use crate::patch::{AppliedPatch, apply_patch};
+use crate::state::State;
+use crate::text::parse_refinement_reply;
+
+/// Verifies `procedure` from `init` towards `goal` over the universe of the target's
+/// objects plus every constant the procedure and goal mention.
+fn verify(init: &State, target_objects: &[crate::symbol::Symbol], procedure: &[Operator], goal: &Formula) -> Report {
+    let mut universe = implicit_universe(init, procedure, Some(goal));
+    for o in target_objects {
+        universe.add_thing(*o);
+    }
+    verify_procedure_in(&universe, init, procedure, Some(goal))
+}
+
+/// Eq. 6: the first inconsistency of a verified procedure — the first failing step's unmet
+/// preconditions, or the unmet goal literals if every step applied. `None` if the report
+/// is valid.
+pub fn identify(report: &Report, procedure: &[Operator]) -> Option<ViolationInfo> {
+    if let Some(i) = report.first_failure {
+        let unmet = match &report.steps[i].status {
+            crate::exec::StepStatus::Failed { violation } => violation.unmet.clone(),
+            _ => Vec::new(),
+        };
+        return Some(ViolationInfo {
+            kind: ViolationKind::Precondition,
+            failing_step: Some(i),
+            action: Some(procedure[i].display_name()),
+            unmet,
+            state: report.failing_state.clone().unwrap_or_default(),
+        });
+    }
+    if let Some(g) = report.goal.as_ref().filter(|g| !g.satisfied) {
+        return Some(ViolationInfo {
+            kind: ViolationKind::Goal,
+            failing_step: None,
+            action: None,
+            unmet: g.unmet.clone(),
+            state: report.final_state.clone(),
+        });
+    }
+    None
+}
+
+/// How far a procedure gets: valid first, then every step applying, then fewer actions
+/// left from the failing one to the end (so inserting actions before a failure that stays
+/// put is no progress), then fewer unmet literals.
+type Progress = (bool, bool, std::cmp::Reverse<usize>, std::cmp::Reverse<usize>);
+
+fn progress(report: &Report) -> Progress {
+    let unmet = identify_unmet(report).map_or(0, |u| u.len());
+    let left = report.first_failure.map_or(0, |f| report.steps.len() - f);
+    (report.is_valid(), report.first_failure.is_none(), std::cmp::Reverse(left), std::cmp::Reverse(unmet))
+}
+
+fn identify_unmet(report: &Report) -> Option<Vec<UnmetPrecondition>> {
+    if let Some(v) = report.first_violation() {
+        return Some(v.unmet.clone());
+    }
+    report.goal.as_ref().map(|g| g.unmet.clone())
+}
+
+fn literal_set(unmet: &[UnmetPrecondition]) -> Vec<String> {
+    let mut v: Vec<String> = unmet.iter().map(|u| u.literal.to_string()).collect();
+    v.sort();
+    v.dedup();
+    v
+}
+
+fn strict_subset(new: &[UnmetPrecondition], old: &[UnmetPrecondition]) -> bool {
+    let (new, old) = (literal_set(new), literal_set(old));
+    new.len() < old.len() && new.iter().all(|x| old.contains(x))
+}
+
+/// Eq. 8: does the patched procedure resolve `violation`? The kept prefix and the inserted
+/// actions must all apply, and then either the erroneous action now applies (or was
+/// replaced), or it fails on a strict subset of its former unmet literals; for a goal
+/// violation, every step must apply and the unmet goal literals must shrink strictly (or
+/// vanish). Returns the remaining problem otherwise.
+pub fn resolves(violation: &ViolationInfo, applied: &AppliedPatch, report: &Report) -> Result<(), Problem> {
+    let region_end = applied.at + applied.inserted;
+    let not_resolved = || Problem::NotResolved {
+        failing_step: report.first_failure,
+        unmet: identify_unmet(report).unwrap_or_default(),
+    };
+    if report.first_failure.is_some_and(|f| f < region_end) {
+        return Err(not_resolved());
+    }
+    match violation.kind {
+        ViolationKind::Precondition => {
+            let p = violation.failing_step.unwrap_or(0);
+            if (applied.at..applied.at + applied.removed).contains(&p) {
+                return Ok(()); // the erroneous action itself was replaced or removed
+            }
+            let shifted = if p >= applied.at + applied.removed { p - applied.removed + applied.inserted } else { p };
+            match report.first_failure {
+                None => Ok(()),
+                Some(f) if f > shifted => Ok(()),
+                Some(f) if f == shifted => {
+                    let now = report.first_violation().map(|v| v.unmet.clone()).unwrap_or_default();
+                    if strict_subset(&now, &violation.unmet) { Ok(()) } else { Err(not_resolved()) }
+                }
+                Some(_) => Err(not_resolved()),
+            }
+        }
+        ViolationKind::Goal => {
+            if report.first_failure.is_some() {
+                return Err(not_resolved());
+            }
+            match &report.goal {
+                Some(g) if g.satisfied || strict_subset(&g.unmet, &violation.unmet) => Ok(()),
+                _ => Err(not_resolved()),
+            }
+        }
+        ViolationKind::Unidentified => Ok(()),
+    }
+}
+
+fn describe(problem: &Problem, procedure: &[Operator]) -> String {
+    match problem {
+        Problem::Unparsable { error } => format!("The reply could not be parsed: {error}."),
+        Problem::MultiplePatches { count } => format!(
+            "The reply held {count} SEARCH/REPLACE blocks; exactly one is required. Nothing was applied."
+        ),
+        Problem::PatchDidNotApply { error } => format!("The patch was not applied: {error}."),
+        Problem::NotResolved { failing_step: Some(i), unmet } => format!(
+            "After the patch the procedure still fails at step {} ({}) with these unfulfilled preconditions:\n{}",
+            i + 1,
+            procedure.get(*i).map_or_else(String::new, |o| o.display_name()),
+            format_unmet(unmet)
+        ),
+        Problem::NotResolved { failing_step: None, unmet } => format!(
+            "After the patch every action applies but these goal conditions still do not hold:\n{}",
+            format_unmet(unmet)
+        ),
+        Problem::Ungroundable { error } => format!("The patched procedure could not be grounded: {error}."),
+        other => format!("{other:?}"),
+    }
+}
+
+/// The result of exploration.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ExplorationResult {
+    /// How it ended.
+    pub outcome: Outcome,
+}
+
+/// Identification and exploration from the target's initial state (Algorithm 1, lines
+/// 9–20), within `config.budget` patch proposals.
+pub async fn explore<R: Reasoner>(
+    reasoner: &mut R,
+    world_model: &WorldModel,
+    target: &Target,
+    config: &AdaptConfig,
+    trace: &mut Trace,
+) -> Result<ExplorationResult, AdaptError> {
+    let ablation = config.ablation;
+    let goal = &world_model.goal;
+    let objects = &target.task.objects;
+    let mut procedure = world_model.procedure.clone();
+    let mut report = verify(&target.init, objects, &procedure, goal);
+    let mut best = (progress(&report), procedure.clone());
+    let mut feedback: Vec<Feedback> = Vec::new();
+    let mut last_violation: Option<ViolationInfo> = None;
+    let mut iteration = 0;
+    // With identification and verification both ablated nothing tells the loop whether a
+    // revision helped, so it makes one revision (retrying only replies that fail to parse
+    // or match) and stops.
+    let single_shot = !ablation.identification && !ablation.verification;
+    let mut revised = false;
+    loop {
+        if ablation.identification || ablation.verification {
+            trace.events.push(TraceEvent::Identification { iteration, procedure: procedure.clone(), report: report.clone() });
+        }
+        let violation = identify(&report, &procedure);
+        let finished = if single_shot { revised } else { violation.is_none() };
+        if finished || iteration >= config.budget {
+            let outcome = if report.is_valid() {
+                Outcome::Adapted { procedure, report, iterations: iteration }
+            } else {
+                Outcome::Unresolved { best: best.1, last: procedure, last_violation, iterations: iteration }
+            };
+            return Ok(ExplorationResult { outcome });
+        }
+        let violation = violation.unwrap_or(ViolationInfo {
+            kind: ViolationKind::Unidentified,
+            failing_step: None,
+            action: None,
+            unmet: Vec::new(),
+            state: target.init.clone(),
+        });
+        if last_violation.as_ref().is_some_and(|v| *v != violation) {
+            feedback.clear();
+        }
+        let request = if ablation.identification {
+            let split = violation.failing_step.unwrap_or(procedure.len());
+            PatchRequest {
+                iteration,
+                task: target.task.clone(),
+                kind: violation.kind,
+                procedure: procedure.clone(),
+                executed: procedure[..split].to_vec(),
+                erroneous: violation.failing_step.map(|i| procedure[i].clone()),
+                remaining: procedure.get(split + 1..).map(|r| r.to_vec()).unwrap_or_default(),
+                failing_step: violation.failing_step,
+                initial_state: target.init.clone(),
+                error_state: violation.state.clone(),
+                unmet: violation.unmet.clone(),
+                feedback: feedback.clone(),
+            }
+        } else {
+            PatchRequest {
+                iteration,
+                task: target.task.clone(),
+                kind: ViolationKind::Unidentified,
+                procedure: procedure.clone(),
+                executed: Vec::new(),
+                erroneous: None,
+                remaining: procedure.clone(),
+                failing_step: None,
+                initial_state: target.init.clone(),
+                error_state: target.init.clone(),
+                unmet: Vec::new(),
+                feedback: feedback.clone(),
+            }
+        };
+        let visible = if ablation.identification {
+            violation.clone()
+        } else {
+            ViolationInfo { kind: ViolationKind::Unidentified, failing_step: None, action: None, unmet: vec![], state: target.init.clone() }
+        };
+        last_violation = Some(violation.clone());
+        let reply = reasoner.propose_patch(&request).await?;
+        let this_iteration = iteration;
+        iteration += 1;
+
+        let parsed = parse_refinement_reply(&reply);
+        let near = visible.failing_step.unwrap_or(if visible.kind == ViolationKind::Goal { procedure.len() } else { 0 });
+        let attempt: Result<(AppliedPatch, Report), Problem> = (|| {
+            let r = parsed.as_ref().map_err(|e| Problem::Unparsable { error: e.clone() })?;
+            if r.patches.len() > 1 {
+                return Err(Problem::MultiplePatches { count: r.patches.len() });
+            }
+            let applied = apply_patch(&procedure, &r.patches[0], near)
+                .map_err(|error| Problem::PatchDidNotApply { error })?;
+            let new_report = verify(&target.init, objects, &applied.procedure, goal);
+            if ablation.verification {
+                if ablation.identification {
+                    resolves(&visible, &applied, &new_report)?;
+                } else if progress(&new_report) <= progress(&report) {
+                    return Err(Problem::NotResolved {
+                        failing_step: new_report.first_failure,
+                        unmet: identify_unmet(&new_report).unwrap_or_default(),
+                    });
+                }
+            }
+            Ok((applied, new_report))
+        })();
+        let parsed = parsed.ok();
+        match attempt {
+            Ok((applied, new_report)) => {
+                trace.events.push(TraceEvent::Proposal {
+                    iteration: this_iteration,
+                    reply,
+                    parsed,
+                    verdict: Verdict::Accepted { checked: ablation.verification },
+                    procedure_after: Some(applied.procedure.clone()),
+                });
+                procedure = applied.procedure;
+                report = new_report;
+                revised = true;
+                feedback.clear();
+                let p = progress(&report);
+                if p > best.0 {
+                    best = (p, procedure.clone());
+                }
+            }
+            Err(problem) => {
+                let candidate_procedure = match &problem {
+                    Problem::NotResolved { .. } => parsed
+                        .as_ref()
+                        .and_then(|r| apply_patch(&procedure, &r.patches[0], near).ok())
+                        .map(|a| a.procedure)
+                        .unwrap_or_default(),
+                    _ => Vec::new(),
+                };
+                let fb = Feedback {
+                    attempt: this_iteration,
+                    reply: reply.clone(),
+                    message: describe(&problem, &candidate_procedure),
+                    problem,
+                };
+                feedback.push(fb.clone());
+                trace.events.push(TraceEvent::Proposal {
+                    iteration: this_iteration,
+                    reply,
+                    parsed,
+                    verdict: Verdict::Rejected { feedback: fb },
+                    procedure_after: None,
+                });
+            }
+        }
+    }
+}
