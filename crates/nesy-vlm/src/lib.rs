@@ -3,3 +3,53 @@
 //! The client through which every NeSyCR step that thinks talks to a vision-language
 //! model: an OpenAI-compatible chat-completions client with backend profiles, retries,
 //! accounting and cassette record/replay.
+//!
+//! Layers, top to bottom:
+//! - [`VlmClient`]: typed [`ChatRequest`] in, typed [`ChatResponse`] out; the backend
+//!   [`Profile`] builds the body; retries, the concurrency cap and accounting live here.
+//! - [`Transport`]: a wire request (path + JSON body + task context that is never sent)
+//!   in, a wire response out. [`HttpTransport`] talks to a server; [`CassetteTransport`]
+//!   replays or records around an optional inner transport; an offline responder can be
+//!   added as another implementation without touching the client.
+//!
+//! ```no_run
+//! # async fn demo() -> Result<(), nesy_vlm::VlmError> {
+//! use nesy_vlm::{ChatRequest, Image, Message, Part, VlmClient, VlmConfig};
+//! let client = VlmClient::from_config(&VlmConfig::from_env()?)?;
+//! let png: Vec<u8> = std::fs::read("keyframe.png").unwrap();
+//! let reply = client
+//!     .chat(ChatRequest::new().purpose("describe").message(Message::user(vec![
+//!         Part::text("What is on the table?"),
+//!         Image::png(png)?.into(),
+//!     ])))
+//!     .await?;
+//! println!("{} ({} attempts)", reply.text, reply.attempts);
+//! client.finish()?;
+//! # Ok(()) }
+//! ```
+
+pub mod accounting;
+pub mod cassette;
+pub mod client;
+pub mod config;
+pub mod error;
+pub mod profile;
+pub mod request;
+pub mod response;
+pub mod retry;
+pub mod secret;
+mod timefmt;
+pub mod transport;
+
+pub use accounting::{CallRecord, ModelPrice, PriceTable, RunUsage, UsageTotals};
+pub use cassette::{CassetteError, CassetteMode, CassetteOptions, CassetteTransport};
+pub use client::VlmClient;
+pub use config::{CassetteSettings, ConfigError, ConfigOverrides, EnvSource, ProcessEnv, Timeouts, VlmConfig};
+pub use error::{ProviderError, TimeoutPhase, TransportError, VlmError};
+pub use profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, TokenCapField};
+pub use request::{ChatRequest, Image, ImageDetail, Message, Part, ReasoningEffort, Role, TaskContext};
+pub use response::{ChatResponse, FinishReason, Usage};
+pub use retry::RetryPolicy;
+pub use secret::SecretString;
+pub use transport::http::Auth;
+pub use transport::{BoxFuture, HttpTransport, Origin, Transport, WireRequest, WireResponse};

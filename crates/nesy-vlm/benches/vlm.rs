@@ -1,0 +1,2 @@
+//! Benchmarks of nesy-vlm (filled in below).
+fn main() {}

@@ -1,0 +1,378 @@
+//! The cassette file: pretty JSON with a schema version and metadata; requests stored with
+//! images as content references; responses stored whole (a JSON body is embedded verbatim,
+//! so replay is byte-identical); only allowlisted headers.
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, SystemTime};
+
+use base64::Engine as _;
+use bytes::Bytes;
+use serde::{Deserialize, Serialize};
+use serde_json::value::RawValue;
+
+use super::CassetteError;
+use crate::secret::SecretString;
+use crate::transport::{Origin, WireResponse, is_allowed_header};
+
+/// The cassette format version this crate reads and writes.
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// A whole cassette file.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CassetteFile {
+    /// Format version ([`SCHEMA_VERSION`]).
+    pub schema_version: u32,
+    /// Who recorded it, when, against what.
+    pub meta: CassetteMeta,
+    /// Recorded calls, in recording order.
+    pub interactions: Vec<Interaction>,
+}
+
+/// Cassette metadata.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CassetteMeta {
+    /// The recorder, e.g. `nesy-vlm 0.1.0`.
+    pub recorder: String,
+    /// When the file was first written (RFC 3339, UTC).
+    pub created_at: String,
+    /// When it was last written.
+    pub updated_at: String,
+    /// The model of the latest recorded request.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
+    /// The backend label of the recording transport (e.g. `http openai`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub backend: Option<String>,
+}
+
+/// One recorded call.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Interaction {
+    /// The request key (recomputed on load; a mismatch is reported by `verify`).
+    pub key: String,
+    /// The call's accounting label.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub purpose: Option<String>,
+    /// When it was recorded.
+    pub recorded_at: String,
+    /// How long the live call took.
+    pub latency_ms: f64,
+    /// The request.
+    pub request: StoredRequest,
+    /// The response.
+    pub response: StoredResponse,
+}
+
+/// A recorded request: images replaced by `blob:sha256:<hex>.<ext>` references.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StoredRequest {
+    /// Always `POST`.
+    pub method: String,
+    /// Path and query relative to the base URL.
+    pub path: String,
+    /// The canonical body.
+    pub body: serde_json::Value,
+}
+
+/// A recorded response. Exactly one of the body fields is present: `body` (JSON, embedded
+/// verbatim), `body_text` (other UTF-8) or `body_base64` (anything else).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StoredResponse {
+    /// HTTP status.
+    pub status: u16,
+    /// Allowlisted headers.
+    #[serde(default)]
+    pub headers: BTreeMap<String, String>,
+    /// A JSON body, byte for byte.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<Box<RawValue>>,
+    /// A non-JSON UTF-8 body.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_text: Option<String>,
+    /// A binary body.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_base64: Option<String>,
+}
+
+impl StoredResponse {
+    /// Stores a wire response: headers filtered again (defence in depth), body kept whole.
+    pub fn from_wire(response: &WireResponse) -> Self {
+        let headers = response
+            .headers
+            .iter()
+            .filter(|(name, _)| is_allowed_header(name))
+            .map(|(name, value)| (name.to_ascii_lowercase(), value.clone()))
+            .collect();
+        let mut stored =
+            Self { status: response.status, headers, body: None, body_text: None, body_base64: None };
+        match std::str::from_utf8(&response.body) {
+            Ok(text) => match RawValue::from_string(text.to_string()) {
+                // Only when the raw value is the whole text (no surrounding whitespace), and
+                // not `null`, which would read back as an absent body.
+                Ok(raw) if raw.get().len() == text.len() && text != "null" => stored.body = Some(raw),
+                _ => stored.body_text = Some(text.to_string()),
+            },
+            Err(_) => {
+                stored.body_base64 = Some(base64::engine::general_purpose::STANDARD.encode(&response.body))
+            }
+        }
+        stored
+    }
+
+    /// The response as a transport returns it.
+    pub fn to_wire(&self, origin: Origin) -> Result<WireResponse, String> {
+        let body = match (&self.body, &self.body_text, &self.body_base64) {
+            (Some(raw), None, None) => Bytes::copy_from_slice(raw.get().as_bytes()),
+            (None, Some(text), None) => Bytes::copy_from_slice(text.as_bytes()),
+            (None, None, Some(b64)) => Bytes::from(
+                base64::engine::general_purpose::STANDARD.decode(b64).map_err(|err| format!("body_base64: {err}"))?,
+            ),
+            (None, None, None) => Bytes::new(),
+            _ => return Err("more than one of body, body_text, body_base64".to_string()),
+        };
+        let headers = self.headers.iter().map(|(name, value)| (name.clone(), value.clone())).collect();
+        Ok(WireResponse { status: self.status, headers, body, origin })
+    }
+}
+
+impl CassetteFile {
+    /// An empty cassette.
+    pub fn new(model: Option<String>, backend: Option<String>) -> Self {
+        let now = crate::timefmt::now_rfc3339();
+        Self {
+            schema_version: SCHEMA_VERSION,
+            meta: CassetteMeta {
+                recorder: recorder(),
+                created_at: now.clone(),
+                updated_at: now,
+                model,
+                backend,
+            },
+            interactions: Vec::new(),
+        }
+    }
+
+    /// Reads a cassette; errors name the file, line and column.
+    pub fn load(path: &Path) -> Result<Self, CassetteError> {
+        let text = fs::read_to_string(path).map_err(|source| CassetteError::Io { path: path.to_path_buf(), source })?;
+        Self::parse(path, &text)
+    }
+
+    /// Parses cassette text (`path` is for messages).
+    pub fn parse(path: &Path, text: &str) -> Result<Self, CassetteError> {
+        #[derive(Deserialize)]
+        struct VersionOnly {
+            schema_version: Option<u32>,
+        }
+        let parse_error = |err: serde_json::Error| CassetteError::Parse {
+            path: path.to_path_buf(),
+            line: err.line(),
+            column: err.column(),
+            message: err.to_string(),
+        };
+        // Check the version first, so a newer file gets a clear message rather than an
+        // unknown-field error.
+        let version = serde_json::from_str::<VersionOnly>(text).map_err(parse_error)?.schema_version;
+        match version {
+            Some(SCHEMA_VERSION) => {}
+            Some(other) => {
+                return Err(CassetteError::Schema {
+                    path: path.to_path_buf(),
+                    message: format!(
+                        "schema_version {other} is not supported (this nesy reads version {SCHEMA_VERSION})"
+                    ),
+                });
+            }
+            None => {
+                return Err(CassetteError::Schema {
+                    path: path.to_path_buf(),
+                    message: "missing `schema_version`: not a nesy cassette".to_string(),
+                });
+            }
+        }
+        serde_json::from_str(text).map_err(parse_error)
+    }
+
+    /// Pretty JSON, with every occurrence of a secret replaced.
+    pub fn to_pretty_json(&self, redactions: &[SecretString]) -> String {
+        // Serialising plain data to a String cannot fail.
+        let mut text = serde_json::to_string_pretty(self).unwrap_or_default();
+        for secret in redactions.iter().filter(|s| s.expose().len() >= 8) {
+            if text.contains(secret.expose()) {
+                text = text.replace(secret.expose(), "[REDACTED]");
+            }
+        }
+        text.push('\n');
+        text
+    }
+
+    /// Writes the file atomically: a temporary file beside it, flushed, then renamed over.
+    pub fn save(&self, path: &Path, redactions: &[SecretString]) -> Result<(), CassetteError> {
+        write_atomically(path, self.to_pretty_json(redactions).as_bytes())
+    }
+}
+
+/// `nesy-vlm <version>`.
+pub(crate) fn recorder() -> String {
+    concat!("nesy-vlm ", env!("CARGO_PKG_VERSION")).to_string()
+}
+
+/// Writes bytes to `path` through a temporary file in the same directory and a rename, so a
+/// crash leaves either the old or the new file, never a torn one.
+pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), CassetteError> {
+    let io = |source| CassetteError::Io { path: path.to_path_buf(), source };
+    let dir = parent_dir(path);
+    fs::create_dir_all(&dir).map_err(io)?;
+    let mut temp = tempfile::NamedTempFile::new_in(&dir).map_err(io)?;
+    temp.write_all(bytes).map_err(io)?;
+    temp.as_file().sync_all().map_err(io)?;
+    // Temporary files are private (0600); a cassette is ordinary project data.
+    let permissions = match fs::metadata(path) {
+        Ok(existing) => existing.permissions(),
+        Err(_) => readable_permissions(temp.as_file()).map_err(io)?,
+    };
+    fs::set_permissions(temp.path(), permissions).map_err(io)?;
+    temp.persist(path).map_err(|err| io(err.error))?;
+    Ok(())
+}
+
+#[cfg(unix)]
+fn readable_permissions(_file: &fs::File) -> std::io::Result<fs::Permissions> {
+    use std::os::unix::fs::PermissionsExt as _;
+    Ok(fs::Permissions::from_mode(0o644))
+}
+
+#[cfg(not(unix))]
+fn readable_permissions(file: &fs::File) -> std::io::Result<fs::Permissions> {
+    Ok(file.metadata()?.permissions())
+}
+
+/// Writes a blob unless one with that name exists (content-addressed, so it is the same).
+pub(crate) fn write_blob(dir: &Path, name: &str, bytes: &[u8]) -> Result<bool, CassetteError> {
+    let path = dir.join(name);
+    if path.exists() {
+        return Ok(false);
+    }
+    let io = |source| CassetteError::Io { path: path.clone(), source };
+    fs::create_dir_all(dir).map_err(io)?;
+    let mut temp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
+    temp.write_all(bytes).map_err(io)?;
+    temp.as_file().sync_all().map_err(io)?;
+    fs::set_permissions(temp.path(), readable_permissions(temp.as_file()).map_err(io)?).map_err(io)?;
+    match temp.persist_noclobber(&path) {
+        Ok(_) => Ok(true),
+        // Another recorder wrote the same content first.
+        Err(_) if path.exists() => Ok(false),
+        Err(err) => Err(io(err.error)),
+    }
+}
+
+/// The directory holding a path (`.` for a bare file name).
+pub(crate) fn parent_dir(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// The `blobs/` directory beside a cassette.
+pub fn blobs_dir(cassette: &Path) -> PathBuf {
+    parent_dir(cassette).join("blobs")
+}
+
+/// An exclusive lock on a cassette across processes: `<cassette>.lock`, created with
+/// `O_EXCL`. A lock older than a minute is taken to be left by a crashed recorder.
+pub(crate) struct FileLock {
+    path: PathBuf,
+}
+
+impl FileLock {
+    pub(crate) fn acquire(cassette: &Path) -> Result<Self, CassetteError> {
+        let mut name = cassette.as_os_str().to_owned();
+        name.push(".lock");
+        let path = PathBuf::from(name);
+        let deadline = std::time::Instant::now() + Duration::from_secs(10);
+        loop {
+            match fs::OpenOptions::new().write(true).create_new(true).open(&path) {
+                Ok(mut file) => {
+                    let _ = writeln!(file, "{}", std::process::id());
+                    return Ok(Self { path });
+                }
+                Err(err) if err.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let stale = fs::metadata(&path)
+                        .and_then(|m| m.modified())
+                        .map(|modified| SystemTime::now().duration_since(modified).unwrap_or_default())
+                        .is_ok_and(|age| age > Duration::from_secs(60));
+                    if stale {
+                        let _ = fs::remove_file(&path);
+                        continue;
+                    }
+                    if std::time::Instant::now() > deadline {
+                        return Err(CassetteError::Locked { path });
+                    }
+                    std::thread::sleep(Duration::from_millis(5));
+                }
+                Err(source) => return Err(CassetteError::Io { path, source }),
+            }
+        }
+    }
+}
+
+impl Drop for FileLock {
+    fn drop(&mut self) {
+        let _ = fs::remove_file(&self.path);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bodies_round_trip_byte_for_byte() {
+        for body in [
+            &b"{\"id\":\"x\",  \"choices\":[ ]}"[..],
+            b"{\"a\":1}\n",
+            b"not json",
+            b"null",
+            b"",
+            b"\xff\xfe binary",
+        ] {
+            let wire = WireResponse::new(200, body.to_vec(), Origin::Live);
+            let stored = StoredResponse::from_wire(&wire);
+            let file = CassetteFile {
+                schema_version: SCHEMA_VERSION,
+                meta: CassetteMeta::default(),
+                interactions: vec![Interaction {
+                    key: "k".into(),
+                    purpose: None,
+                    recorded_at: "t".into(),
+                    latency_ms: 1.0,
+                    request: StoredRequest { method: "POST".into(), path: "/p".into(), body: serde_json::Value::Null },
+                    response: stored,
+                }],
+            };
+            let text = file.to_pretty_json(&[]);
+            let back = CassetteFile::parse(Path::new("c.json"), &text).unwrap();
+            let replayed = back.interactions[0].response.to_wire(Origin::Replayed).unwrap();
+            assert_eq!(&replayed.body[..], body, "{text}");
+        }
+    }
+
+    #[test]
+    fn parse_errors_and_versions_are_clear() {
+        let err = CassetteFile::parse(Path::new("x.json"), "{\n  \"schema_version\": 1,\n  oops").unwrap_err();
+        assert!(err.to_string().contains("x.json:3:"), "{err}");
+        let err = CassetteFile::parse(Path::new("x.json"), r#"{"schema_version": 9}"#).unwrap_err();
+        assert!(err.to_string().contains("schema_version 9 is not supported"), "{err}");
+        let err = CassetteFile::parse(Path::new("x.json"), r#"{"interactions": []}"#).unwrap_err();
+        assert!(err.to_string().contains("not a nesy cassette"), "{err}");
+    }
+}

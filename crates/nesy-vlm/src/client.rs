@@ -1,0 +1,262 @@
+//! The client: builds the wire body through the backend profile, then calls the transport
+//! under a concurrency cap and the retry policy, and accounts for every call.
+
+use std::sync::{Arc, Mutex};
+
+use tokio::sync::Semaphore;
+use tokio::time::Instant;
+
+use crate::accounting::{CallRecord, PriceTable, RunUsage};
+use crate::cassette::{CassetteMode, CassetteOptions, CassetteTransport};
+use crate::config::{ConfigError, VlmConfig};
+use crate::error::{ProviderError, VlmError};
+use crate::profile::{AuthScheme, Profile};
+use crate::request::ChatRequest;
+use crate::response::{ChatResponse, parse_completion};
+use crate::retry::{RetryPolicy, status_is_retryable};
+use crate::transport::http::Auth;
+use crate::transport::{HttpTransport, Origin, Transport, WireRequest, WireResponse};
+
+/// An OpenAI-compatible chat client. Cheap to clone; clones share the transport, the
+/// concurrency cap and the run's accounting.
+#[derive(Clone)]
+pub struct VlmClient {
+    inner: Arc<Inner>,
+}
+
+struct Inner {
+    profile: Profile,
+    transport: Arc<dyn Transport>,
+    retry: RetryPolicy,
+    concurrency: Semaphore,
+    max_concurrency: usize,
+    prices: PriceTable,
+    usage: Mutex<RunUsage>,
+}
+
+impl std::fmt::Debug for VlmClient {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("VlmClient")
+            .field("profile", &self.inner.profile)
+            .field("transport", &self.inner.transport)
+            .field("max_concurrency", &self.inner.max_concurrency)
+            .finish()
+    }
+}
+
+impl VlmClient {
+    /// Builds the client a configuration describes: HTTP when calls must go live, wrapped in
+    /// a cassette when one is configured. In `none` mode (and `once` with an existing file)
+    /// no HTTP client is built, so no key is needed.
+    pub fn from_config(config: &VlmConfig) -> Result<Self, VlmError> {
+        let needs_live = match &config.cassette {
+            None => true,
+            Some(cassette) => match cassette.mode {
+                CassetteMode::None => false,
+                CassetteMode::Once => !cassette.path.exists(),
+                CassetteMode::NewEpisodes | CassetteMode::All => true,
+            },
+        };
+        let live: Option<Arc<dyn Transport>> =
+            if needs_live { Some(Arc::new(Self::http_transport(config)?)) } else { None };
+        let transport: Arc<dyn Transport> = match &config.cassette {
+            Some(cassette) => Arc::new(CassetteTransport::open(
+                &cassette.path,
+                cassette.mode,
+                live,
+                CassetteOptions {
+                    strict: cassette.strict,
+                    usage_report: cassette.usage_report.clone(),
+                    model: Some(config.model.clone()),
+                    backend: Some(config.backend.as_str().to_string()),
+                    redact: config.api_key.iter().cloned().collect(),
+                    allow_playback_repeats: false,
+                },
+            )?),
+            None => live.ok_or_else(|| VlmError::InvalidRequest("no transport configured".into()))?,
+        };
+        Ok(Self::with_transport(config, transport))
+    }
+
+    /// The live HTTP transport for a configuration (checks that a required key is set).
+    pub fn http_transport(config: &VlmConfig) -> Result<HttpTransport, VlmError> {
+        let profile = config.profile();
+        let key = config.api_key.clone().filter(|key| !key.is_empty());
+        if key.is_none() && config.backend.requires_api_key() {
+            let var = match profile.auth {
+                AuthScheme::ApiKeyHeader => "AZURE_OPENAI_API_KEY",
+                AuthScheme::Bearer => "OPENAI_API_KEY",
+            };
+            return Err(ConfigError::Missing {
+                what: "API key",
+                hint: format!("the {} backend needs one: set {var} or NESY_VLM_API_KEY", config.backend),
+            }
+            .into());
+        }
+        let auth = match (key, profile.auth) {
+            (None, _) => Auth::None,
+            (Some(key), AuthScheme::Bearer) => Auth::Bearer(key),
+            (Some(key), AuthScheme::ApiKeyHeader) => Auth::ApiKeyHeader(key),
+        };
+        HttpTransport::new(&config.base_url, auth, &config.timeouts, format!("http {}", config.backend)).map_err(
+            |message| ConfigError::Invalid { origin: "base URL".into(), message }.into(),
+        )
+    }
+
+    /// A client over any transport (a cassette, an offline responder, a test double).
+    pub fn with_transport(config: &VlmConfig, transport: Arc<dyn Transport>) -> Self {
+        let max_concurrency = config.max_concurrency.max(1);
+        Self {
+            inner: Arc::new(Inner {
+                profile: config.profile(),
+                transport,
+                retry: config.retry,
+                concurrency: Semaphore::new(max_concurrency),
+                max_concurrency,
+                prices: config.prices.clone(),
+                usage: Mutex::new(RunUsage::default()),
+            }),
+        }
+    }
+
+    /// The resolved backend profile.
+    pub fn profile(&self) -> &Profile {
+        &self.inner.profile
+    }
+
+    /// The transport under the retry layer.
+    pub fn transport(&self) -> &Arc<dyn Transport> {
+        &self.inner.transport
+    }
+
+    /// The wire request a chat request becomes (body through the profile, task context and
+    /// purpose carried beside it).
+    pub fn wire_request(&self, request: &ChatRequest) -> WireRequest {
+        WireRequest {
+            path: self.inner.profile.path.clone(),
+            body: self.inner.profile.build_body(request),
+            task: request.task.clone(),
+            purpose: request.purpose.clone(),
+        }
+    }
+
+    /// Sends one chat request: retries transient failures, respects the concurrency cap,
+    /// and records usage, latency and attempts whatever the outcome.
+    pub async fn chat(&self, request: ChatRequest) -> Result<ChatResponse, VlmError> {
+        if request.messages.is_empty() {
+            return Err(VlmError::InvalidRequest("a chat request needs at least one message".into()));
+        }
+        let wire = self.wire_request(&request);
+        let started = Instant::now();
+        let (result, attempts, origin) = self.send_with_retries(&wire).await;
+        let (outcome, usage) = match result {
+            Ok(response) => self.read_success(response, attempts, started),
+            Err(err) => (Err(err), None),
+        };
+        let record = CallRecord {
+            model: self.inner.profile.model.clone(),
+            purpose: request.purpose.clone(),
+            usage,
+            latency: started.elapsed(),
+            attempts,
+            origin,
+            succeeded: outcome.is_ok(),
+        };
+        self.inner.usage.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).record(&record, &self.inner.prices);
+        outcome.map(|mut response| {
+            response.latency = record.latency;
+            response
+        })
+    }
+
+    async fn send_with_retries(&self, wire: &WireRequest) -> (Result<WireResponse, VlmError>, u32, Option<Origin>) {
+        let policy = &self.inner.retry;
+        let mut attempts = 0;
+        loop {
+            attempts += 1;
+            let sent = {
+                // Held for the attempt only, not the back-off, so waiting calls do not block others.
+                let Ok(_permit) = self.inner.concurrency.acquire().await else {
+                    return (Err(VlmError::InvalidRequest("the client was shut down".into())), attempts, None);
+                };
+                self.inner.transport.send(wire).await
+            };
+            let can_retry = attempts < policy.max_attempts;
+            match sent {
+                Ok(response) if response.is_success() => {
+                    let origin = response.origin;
+                    return (Ok(response), attempts, Some(origin));
+                }
+                Ok(response) => {
+                    let provider = ProviderError::from_body(&response.body);
+                    if can_retry && status_is_retryable(&response, &provider) {
+                        let delay = policy.delay(attempts, Some(&response));
+                        tracing::warn!(status = response.status, attempt = attempts, ?delay, "retrying: {provider}");
+                        // A replayed failure is not waited for: the recording already waited.
+                        if response.origin == Origin::Live {
+                            tokio::time::sleep(delay).await;
+                        }
+                        continue;
+                    }
+                    let error = VlmError::Http {
+                        status: response.status,
+                        path: wire.path.clone(),
+                        request_id: response.request_id().map(str::to_string),
+                        provider,
+                        attempts,
+                    };
+                    return (Err(error), attempts, Some(response.origin));
+                }
+                Err(err) => {
+                    if can_retry && err.is_retryable() {
+                        let delay = policy.delay(attempts, None);
+                        tracing::warn!(attempt = attempts, ?delay, "retrying after transport error: {err}");
+                        tokio::time::sleep(delay).await;
+                        continue;
+                    }
+                    return (Err(VlmError::Transport { source: err, attempts }), attempts, None);
+                }
+            }
+        }
+    }
+
+    fn read_success(
+        &self,
+        response: WireResponse,
+        attempts: u32,
+        started: Instant,
+    ) -> (Result<ChatResponse, VlmError>, Option<crate::response::Usage>) {
+        let request_id = response.request_id().map(str::to_string);
+        match parse_completion(response.status, &response.body, request_id.as_deref()) {
+            Err(err) => (Err(err), None),
+            Ok((parsed, Some(err))) => (Err(err), parsed.usage),
+            Ok((parsed, None)) => {
+                let usage = parsed.usage;
+                let chat = ChatResponse {
+                    text: parsed.text,
+                    finish_reason: parsed.finish_reason,
+                    usage: parsed.usage,
+                    model: parsed.model,
+                    response_id: parsed.response_id,
+                    request_id,
+                    latency: started.elapsed(),
+                    attempts,
+                    origin: response.origin,
+                };
+                (Ok(chat), usage)
+            }
+        }
+    }
+
+    /// Usage of the run so far.
+    pub fn usage(&self) -> RunUsage {
+        self.inner.usage.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).clone()
+    }
+
+    /// Ends the run: lets the transport finish (a cassette writes its usage report and, in
+    /// strict mode, fails on unused interactions) and returns the run's usage.
+    pub fn finish(&self) -> Result<RunUsage, VlmError> {
+        self.inner.transport.finish()?;
+        Ok(self.usage())
+    }
+}

@@ -1,0 +1,592 @@
+//! Configuration from flags, environment variables and an optional TOML file, in that order
+//! of precedence. API keys come only from the environment (never a flag, so they stay out of
+//! shell history and process lists); the file may name the variable that holds the key.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+use std::time::Duration;
+
+use serde::Deserialize;
+
+use crate::accounting::PriceTable;
+use crate::cassette::CassetteMode;
+use crate::profile::{BackendKind, BodyDefaults, Profile, ReasoningMode};
+use crate::request::{ImageDetail, ReasoningEffort};
+use crate::retry::RetryPolicy;
+use crate::secret::SecretString;
+
+/// The Azure `api-version` used when none is configured: recent enough for reasoning models
+/// and `max_completion_tokens`.
+pub const DEFAULT_AZURE_API_VERSION: &str = "2025-04-01-preview";
+
+/// A configuration problem, naming where the bad value came from.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The TOML file could not be read.
+    #[error("reading VLM config file {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The TOML file does not parse or has an unknown key (the message has line and column).
+    #[error("VLM config file {}: {message}", path.display())]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// The parser's message.
+        message: String,
+    },
+    /// A value is malformed.
+    #[error("{origin}: {message}")]
+    Invalid {
+        /// Where the value came from: a flag, a variable or a file key.
+        origin: String,
+        /// What was expected.
+        message: String,
+    },
+    /// A required value is missing.
+    #[error("no {what} configured: {hint}")]
+    Missing {
+        /// What is missing.
+        what: &'static str,
+        /// How to provide it.
+        hint: String,
+    },
+}
+
+/// Where environment variables come from: the process, or a map in tests.
+pub trait EnvSource {
+    /// The value of a variable; empty values count as unset.
+    fn var(&self, name: &str) -> Option<String>;
+}
+
+/// The process environment.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ProcessEnv;
+
+impl EnvSource for ProcessEnv {
+    fn var(&self, name: &str) -> Option<String> {
+        std::env::var(name).ok().filter(|v| !v.is_empty())
+    }
+}
+
+impl EnvSource for HashMap<String, String> {
+    fn var(&self, name: &str) -> Option<String> {
+        self.get(name).filter(|v| !v.is_empty()).cloned()
+    }
+}
+
+/// Connect, read and total timeouts. reqwest has none by default, so a hung server would
+/// hang a run forever.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Timeouts {
+    /// Establishing a connection.
+    pub connect: Option<Duration>,
+    /// Between bytes of the response. A non-streaming completion sends nothing until it is
+    /// done, so this is also the time to the first byte: reasoning models need minutes.
+    pub read: Option<Duration>,
+    /// One attempt from connecting to the end of the body.
+    pub total: Option<Duration>,
+}
+
+impl Default for Timeouts {
+    fn default() -> Self {
+        Self {
+            connect: Some(Duration::from_secs(10)),
+            read: Some(Duration::from_secs(300)),
+            total: Some(Duration::from_secs(600)),
+        }
+    }
+}
+
+/// Where and how to use a cassette.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CassetteSettings {
+    /// The cassette file (`.json`); blobs go to `blobs/` beside it.
+    pub path: PathBuf,
+    /// Record/replay mode.
+    pub mode: CassetteMode,
+    /// Fail at the end of a run if recorded interactions were not used.
+    pub strict: bool,
+    /// Where to write which interactions were used (input of `nesy cassette prune`).
+    pub usage_report: Option<PathBuf>,
+}
+
+/// Everything needed to build a [`crate::VlmClient`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct VlmConfig {
+    /// The kind of server.
+    pub backend: BackendKind,
+    /// Base URL, e.g. `https://api.openai.com/v1`; the request path is appended.
+    pub base_url: String,
+    /// Model name (for Azure: the deployment name).
+    pub model: String,
+    /// The API key, if any.
+    pub api_key: Option<SecretString>,
+    /// Classic Azure deployment (defaults to `model`).
+    pub azure_deployment: Option<String>,
+    /// Classic Azure `api-version`.
+    pub azure_api_version: String,
+    /// Whether the model is a reasoning model.
+    pub reasoning: ReasoningMode,
+    /// Defaults for token cap, temperature, reasoning effort and image detail.
+    pub defaults: BodyDefaults,
+    /// HTTP timeouts.
+    pub timeouts: Timeouts,
+    /// Retry policy.
+    pub retry: RetryPolicy,
+    /// Calls in flight at once.
+    pub max_concurrency: usize,
+    /// Cassette, if any.
+    pub cassette: Option<CassetteSettings>,
+    /// Prices for cost accounting.
+    pub prices: PriceTable,
+}
+
+impl VlmConfig {
+    /// A configuration with defaults for everything but the backend and model.
+    pub fn new(backend: BackendKind, model: impl Into<String>) -> Self {
+        Self {
+            backend,
+            base_url: backend.default_base_url().unwrap_or_default().to_string(),
+            model: model.into(),
+            api_key: None,
+            azure_deployment: None,
+            azure_api_version: DEFAULT_AZURE_API_VERSION.to_string(),
+            reasoning: ReasoningMode::Auto,
+            defaults: BodyDefaults { max_output_tokens: Some(4096), ..BodyDefaults::default() },
+            timeouts: Timeouts::default(),
+            retry: RetryPolicy::default(),
+            max_concurrency: 8,
+            cassette: None,
+            prices: PriceTable::default(),
+        }
+    }
+
+    /// The resolved backend profile.
+    pub fn profile(&self) -> Profile {
+        Profile::new(
+            self.backend,
+            &self.model,
+            self.reasoning,
+            self.azure_deployment.as_deref(),
+            &self.azure_api_version,
+            self.defaults.clone(),
+        )
+    }
+
+    /// Reads the process environment and the config file it names (`NESY_VLM_CONFIG`).
+    pub fn from_env() -> Result<Self, ConfigError> {
+        Self::resolve(&ConfigOverrides::default(), &ProcessEnv)
+    }
+
+    /// Resolves a configuration: flags override environment variables, which override the
+    /// TOML file (`--vlm-config` or `NESY_VLM_CONFIG`), which overrides defaults.
+    pub fn resolve(flags: &ConfigOverrides, env: &dyn EnvSource) -> Result<Self, ConfigError> {
+        let file_path = flags.config.clone().or_else(|| env.var("NESY_VLM_CONFIG").map(PathBuf::from));
+        let file = match &file_path {
+            Some(path) => FileConfig::load(path)?,
+            None => FileConfig::default(),
+        };
+        let file_origin = |key: &str| match &file_path {
+            Some(path) => format!("{}: `{key}`", path.display()),
+            None => key.to_string(),
+        };
+        let from_env = |name: &'static str| env.var(name).map(|value| (value, name.to_string()));
+
+        let backend = match (flags.backend, from_env("NESY_VLM_BACKEND"), &file.backend) {
+            (Some(backend), _, _) => backend,
+            (None, Some((value, origin)), _) => parse(&value, &origin)?,
+            (None, None, Some(value)) => parse(value, &file_origin("backend"))?,
+            (None, None, None) => BackendKind::OpenAi,
+        };
+        let model = flags.model.clone().or_else(|| env.var("NESY_VLM_MODEL")).or(file.model.clone()).ok_or_else(
+            || ConfigError::Missing {
+                what: "model",
+                hint: "set NESY_VLM_MODEL, pass --vlm-model, or put `model` in the config file".into(),
+            },
+        )?;
+        let mut config = Self::new(backend, model);
+
+        let azure = file.azure.unwrap_or_default();
+        let base_url = flags
+            .base_url
+            .clone()
+            .or_else(|| env.var("NESY_VLM_BASE_URL"))
+            .or(file.base_url.clone())
+            .or_else(|| matches!(backend, BackendKind::Azure | BackendKind::AzureV1).then(|| env.var("AZURE_OPENAI_ENDPOINT")).flatten())
+            .or_else(|| backend.default_base_url().map(str::to_string))
+            .ok_or_else(|| ConfigError::Missing {
+                what: "base URL",
+                hint: format!(
+                    "the {backend} backend needs the resource endpoint (https://NAME.openai.azure.com): set \
+                     NESY_VLM_BASE_URL or AZURE_OPENAI_ENDPOINT, or pass --vlm-base-url"
+                ),
+            })?;
+        config.base_url = normalise_base_url(backend, &base_url);
+
+        let key_var = file.api_key_env.clone();
+        config.api_key = env
+            .var("NESY_VLM_API_KEY")
+            .or_else(|| key_var.as_deref().and_then(|name| env.var(name)))
+            .or_else(|| match backend {
+                BackendKind::OpenAi => env.var("OPENAI_API_KEY"),
+                BackendKind::Azure | BackendKind::AzureV1 => env.var("AZURE_OPENAI_API_KEY"),
+                // A cloud key is never sent to a local server by accident.
+                BackendKind::Vllm | BackendKind::Ollama | BackendKind::LlamaCpp => None,
+            })
+            .map(SecretString::new);
+
+        config.azure_deployment =
+            env.var("NESY_VLM_AZURE_DEPLOYMENT").or(azure.deployment).or(config.azure_deployment);
+        if let Some(version) =
+            env.var("NESY_VLM_AZURE_API_VERSION").or_else(|| env.var("OPENAI_API_VERSION")).or(azure.api_version)
+        {
+            config.azure_api_version = version;
+        }
+
+        macro_rules! setting {
+            ($flag:expr, $var:literal, $file:expr, $key:literal) => {
+                match ($flag, env.var($var), $file) {
+                    (Some(value), _, _) => Some(value),
+                    (None, Some(value), _) => Some(parse(&value, $var)?),
+                    (None, None, Some(value)) => Some(value),
+                    (None, None, None) => None,
+                }
+            };
+        }
+        if let Some(mode) = setting!(flags.reasoning, "NESY_VLM_REASONING", file.reasoning, "reasoning") {
+            config.reasoning = mode;
+        }
+        if let Some(effort) =
+            setting!(flags.reasoning_effort, "NESY_VLM_REASONING_EFFORT", file.reasoning_effort, "reasoning_effort")
+        {
+            config.defaults.reasoning_effort = Some(effort);
+        }
+        if let Some(tokens) =
+            setting!(flags.max_output_tokens, "NESY_VLM_MAX_TOKENS", file.max_output_tokens, "max_output_tokens")
+        {
+            config.defaults.max_output_tokens = Some(tokens);
+        }
+        if let Some(temperature) = setting!(flags.temperature, "NESY_VLM_TEMPERATURE", file.temperature, "temperature")
+        {
+            config.defaults.temperature = Some(temperature);
+        }
+        if let Some(detail) = setting!(flags.image_detail, "NESY_VLM_IMAGE_DETAIL", file.image_detail, "image_detail") {
+            config.defaults.image_detail = Some(detail);
+        }
+        if let Some(limit) =
+            setting!(flags.max_concurrency, "NESY_VLM_MAX_CONCURRENCY", file.max_concurrency, "max_concurrency")
+        {
+            if limit == 0 {
+                return Err(invalid("max_concurrency", "must be at least 1"));
+            }
+            config.max_concurrency = limit;
+        }
+
+        let retry = file.retry.unwrap_or_default();
+        if let Some(attempts) = setting!(flags.max_attempts, "NESY_VLM_MAX_ATTEMPTS", retry.max_attempts, "max_attempts") {
+            if attempts == 0 {
+                return Err(invalid("max_attempts", "must be at least 1"));
+            }
+            config.retry.max_attempts = attempts;
+        }
+        if let Some(ms) = retry.base_delay_ms {
+            config.retry.base_delay = Duration::from_millis(ms);
+        }
+        if let Some(ms) = retry.max_delay_ms {
+            config.retry.max_delay = Duration::from_millis(ms);
+        }
+        if let Some(secs) = retry.max_retry_after_secs {
+            config.retry.max_retry_after = seconds(secs, &file_origin("retry.max_retry_after_secs"))?;
+        }
+
+        let timeouts = file.timeouts.unwrap_or_default();
+        let pick = |flag: Option<f64>, var: &'static str, file: Option<f64>, key: &str| -> Result<_, ConfigError> {
+            match (flag, env.var(var), file) {
+                (Some(v), _, _) => Ok(Some(seconds(v, "flag")?)),
+                (None, Some(v), _) => Ok(Some(seconds(parse(&v, var)?, var)?)),
+                (None, None, Some(v)) => Ok(Some(seconds(v, &file_origin(key))?)),
+                (None, None, None) => Ok(None),
+            }
+        };
+        if let Some(t) = pick(None, "NESY_VLM_TIMEOUT_CONNECT_SECS", timeouts.connect_secs, "timeouts.connect_secs")? {
+            config.timeouts.connect = Some(t);
+        }
+        if let Some(t) = pick(None, "NESY_VLM_TIMEOUT_READ_SECS", timeouts.read_secs, "timeouts.read_secs")? {
+            config.timeouts.read = Some(t);
+        }
+        if let Some(t) =
+            pick(flags.timeout_secs, "NESY_VLM_TIMEOUT_TOTAL_SECS", timeouts.total_secs, "timeouts.total_secs")?
+        {
+            config.timeouts.total = Some(t);
+        }
+
+        let cassette = file.cassette.unwrap_or_default();
+        let cassette_path = flags.cassette.clone().or_else(|| env.var("NESY_CASSETTE").map(PathBuf::from)).or(cassette.path);
+        if let Some(path) = cassette_path {
+            let mode = setting!(flags.cassette_mode, "NESY_CASSETTE_MODE", cassette.mode, "cassette.mode")
+                .unwrap_or(CassetteMode::None);
+            let strict = flags.cassette_strict
+                || match env.var("NESY_CASSETTE_STRICT") {
+                    Some(v) => parse_bool(&v, "NESY_CASSETTE_STRICT")?,
+                    None => cassette.strict.unwrap_or(false),
+                };
+            let usage_report = env.var("NESY_CASSETTE_USAGE").map(PathBuf::from).or(cassette.usage_report);
+            config.cassette = Some(CassetteSettings { path, mode, strict, usage_report });
+        }
+        config.prices = file.prices.unwrap_or_default();
+        Ok(config)
+    }
+}
+
+/// Azure v1 lives under `/openai/v1` of the resource endpoint; accept either form.
+fn normalise_base_url(backend: BackendKind, base_url: &str) -> String {
+    let trimmed = base_url.trim().trim_end_matches('/');
+    if backend == BackendKind::AzureV1 && !trimmed.ends_with("/openai/v1") {
+        format!("{}/openai/v1", trimmed.trim_end_matches("/openai"))
+    } else {
+        trimmed.to_string()
+    }
+}
+
+fn parse<T: FromStr>(value: &str, origin: &str) -> Result<T, ConfigError>
+where
+    T::Err: std::fmt::Display,
+{
+    value.trim().parse().map_err(|err: T::Err| invalid(origin, &err.to_string()))
+}
+
+fn parse_bool(value: &str, origin: &str) -> Result<bool, ConfigError> {
+    match value.trim().to_ascii_lowercase().as_str() {
+        "1" | "true" | "yes" | "on" => Ok(true),
+        "0" | "false" | "no" | "off" => Ok(false),
+        _ => Err(invalid(origin, &format!("expected true or false, got {value:?}"))),
+    }
+}
+
+fn seconds(value: f64, origin: &str) -> Result<Duration, ConfigError> {
+    Duration::try_from_secs_f64(value)
+        .map_err(|_| invalid(origin, &format!("expected a non-negative number of seconds, got {value}")))
+}
+
+fn invalid(origin: &str, message: &str) -> ConfigError {
+    ConfigError::Invalid { origin: origin.to_string(), message: message.to_string() }
+}
+
+/// Flags that override the environment and the file; the CLI flattens these into its
+/// commands (with the `clap` feature). There is deliberately no API-key flag.
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct ConfigOverrides {
+    /// TOML file with VLM settings [env: NESY_VLM_CONFIG].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-config", value_name = "FILE"))]
+    pub config: Option<PathBuf>,
+    /// Backend: openai, azure, azure-v1, vllm, ollama, llamacpp [env: NESY_VLM_BACKEND].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-backend", value_name = "KIND"))]
+    pub backend: Option<BackendKind>,
+    /// Base URL of the server [env: NESY_VLM_BASE_URL].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-base-url", value_name = "URL"))]
+    pub base_url: Option<String>,
+    /// Model (Azure: deployment) name [env: NESY_VLM_MODEL].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-model", value_name = "NAME"))]
+    pub model: Option<String>,
+    /// Treat the model as a reasoning model: auto, on, off [env: NESY_VLM_REASONING].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-reasoning", value_name = "MODE"))]
+    pub reasoning: Option<ReasoningMode>,
+    /// Reasoning effort for reasoning models [env: NESY_VLM_REASONING_EFFORT].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-reasoning-effort", value_name = "EFFORT"))]
+    pub reasoning_effort: Option<ReasoningEffort>,
+    /// Output-token cap per call [env: NESY_VLM_MAX_TOKENS].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-max-tokens", value_name = "N"))]
+    pub max_output_tokens: Option<u32>,
+    /// Sampling temperature for non-reasoning models [env: NESY_VLM_TEMPERATURE].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-temperature", value_name = "T"))]
+    pub temperature: Option<f32>,
+    /// Image detail: auto, low, high [env: NESY_VLM_IMAGE_DETAIL].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-image-detail", value_name = "DETAIL"))]
+    pub image_detail: Option<ImageDetail>,
+    /// Calls in flight at once [env: NESY_VLM_MAX_CONCURRENCY].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-max-concurrency", value_name = "N"))]
+    pub max_concurrency: Option<usize>,
+    /// Attempts per call, the first included [env: NESY_VLM_MAX_ATTEMPTS].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-max-attempts", value_name = "N"))]
+    pub max_attempts: Option<u32>,
+    /// Total timeout of one attempt in seconds [env: NESY_VLM_TIMEOUT_TOTAL_SECS].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-timeout-secs", value_name = "SECS"))]
+    pub timeout_secs: Option<f64>,
+    /// Cassette file for record/replay [env: NESY_CASSETTE].
+    #[cfg_attr(feature = "clap", arg(long = "cassette", value_name = "FILE"))]
+    pub cassette: Option<PathBuf>,
+    /// Cassette mode: none, once, new_episodes, all [env: NESY_CASSETTE_MODE].
+    #[cfg_attr(feature = "clap", arg(long = "cassette-mode", value_name = "MODE"))]
+    pub cassette_mode: Option<CassetteMode>,
+    /// Fail if recorded interactions go unused [env: NESY_CASSETTE_STRICT].
+    #[cfg_attr(feature = "clap", arg(long = "cassette-strict"))]
+    pub cassette_strict: bool,
+}
+
+/// The TOML file's shape. Unknown keys are errors, so a typo is reported, not ignored.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileConfig {
+    backend: Option<String>,
+    base_url: Option<String>,
+    model: Option<String>,
+    /// The name of the environment variable holding the key (the key itself never goes in
+    /// a file).
+    api_key_env: Option<String>,
+    reasoning: Option<ReasoningMode>,
+    reasoning_effort: Option<ReasoningEffort>,
+    max_output_tokens: Option<u32>,
+    temperature: Option<f32>,
+    image_detail: Option<ImageDetail>,
+    max_concurrency: Option<usize>,
+    azure: Option<FileAzure>,
+    timeouts: Option<FileTimeouts>,
+    retry: Option<FileRetry>,
+    cassette: Option<FileCassette>,
+    prices: Option<PriceTable>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileAzure {
+    deployment: Option<String>,
+    api_version: Option<String>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileTimeouts {
+    connect_secs: Option<f64>,
+    read_secs: Option<f64>,
+    total_secs: Option<f64>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileRetry {
+    max_attempts: Option<u32>,
+    base_delay_ms: Option<u64>,
+    max_delay_ms: Option<u64>,
+    max_retry_after_secs: Option<f64>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileCassette {
+    path: Option<PathBuf>,
+    mode: Option<CassetteMode>,
+    strict: Option<bool>,
+    usage_report: Option<PathBuf>,
+}
+
+impl FileConfig {
+    fn load(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| ConfigError::Io { path: path.to_path_buf(), source })?;
+        toml::from_str(&text).map_err(|err| ConfigError::File { path: path.to_path_buf(), message: err.to_string() })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn env(pairs: &[(&str, &str)]) -> HashMap<String, String> {
+        pairs.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    }
+
+    #[test]
+    fn env_configures_openai_and_flags_win() {
+        let vars = env(&[
+            ("NESY_VLM_MODEL", "gpt-5"),
+            ("OPENAI_API_KEY", "sk-env-secret-123"),
+            ("NESY_VLM_REASONING_EFFORT", "low"),
+            ("NESY_CASSETTE", "c.json"),
+            ("NESY_CASSETTE_MODE", "new_episodes"),
+        ]);
+        let flags = ConfigOverrides { model: Some("gpt-5-mini".into()), ..Default::default() };
+        let config = VlmConfig::resolve(&flags, &vars).unwrap();
+        assert_eq!(config.backend, BackendKind::OpenAi);
+        assert_eq!(config.base_url, "https://api.openai.com/v1");
+        assert_eq!(config.model, "gpt-5-mini");
+        assert_eq!(config.api_key.as_ref().map(SecretString::expose), Some("sk-env-secret-123"));
+        assert_eq!(config.defaults.reasoning_effort, Some(ReasoningEffort::Low));
+        assert_eq!(config.cassette.as_ref().unwrap().mode, CassetteMode::NewEpisodes);
+        assert!(config.profile().reasoning);
+        // The key never shows in Debug output.
+        assert!(!format!("{config:?}").contains("sk-env-secret"));
+    }
+
+    #[test]
+    fn file_settings_apply_below_env() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("vlm.toml");
+        std::fs::write(
+            &path,
+            r#"
+backend = "azure"
+base_url = "https://res.openai.azure.com/"
+model = "gpt-4o-deploy"
+api_key_env = "MY_AZURE_KEY"
+temperature = 0.2
+[azure]
+api_version = "2024-10-21"
+[timeouts]
+connect_secs = 3
+[prices."gpt-4o"]
+input_per_mtok = 2.5
+output_per_mtok = 10.0
+"#,
+        )
+        .unwrap();
+        let vars = env(&[("NESY_VLM_CONFIG", path.to_str().unwrap()), ("MY_AZURE_KEY", "azure-secret"), ("NESY_VLM_TEMPERATURE", "0.5")]);
+        let config = VlmConfig::resolve(&ConfigOverrides::default(), &vars).unwrap();
+        assert_eq!(config.backend, BackendKind::Azure);
+        assert_eq!(config.base_url, "https://res.openai.azure.com");
+        assert_eq!(config.api_key.as_ref().map(SecretString::expose), Some("azure-secret"));
+        assert_eq!(config.defaults.temperature, Some(0.5));
+        assert_eq!(config.timeouts.connect, Some(Duration::from_secs(3)));
+        assert_eq!(config.profile().path, "/openai/deployments/gpt-4o-deploy/chat/completions?api-version=2024-10-21");
+        assert!(config.prices.lookup("gpt-4o").is_some());
+    }
+
+    #[test]
+    fn errors_name_their_origin() {
+        let err = VlmConfig::resolve(&ConfigOverrides::default(), &env(&[])).unwrap_err().to_string();
+        assert!(err.contains("NESY_VLM_MODEL"), "{err}");
+        let vars = env(&[("NESY_VLM_MODEL", "m"), ("NESY_VLM_MAX_TOKENS", "lots")]);
+        let err = VlmConfig::resolve(&ConfigOverrides::default(), &vars).unwrap_err().to_string();
+        assert!(err.starts_with("NESY_VLM_MAX_TOKENS:"), "{err}");
+        let vars = env(&[("NESY_VLM_MODEL", "m"), ("NESY_VLM_BACKEND", "azure")]);
+        let err = VlmConfig::resolve(&ConfigOverrides::default(), &vars).unwrap_err().to_string();
+        assert!(err.contains("AZURE_OPENAI_ENDPOINT"), "{err}");
+
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, "model = \"m\"\nmax_tokens = 5\n").unwrap();
+        let vars = env(&[("NESY_VLM_CONFIG", path.to_str().unwrap())]);
+        let err = VlmConfig::resolve(&ConfigOverrides::default(), &vars).unwrap_err().to_string();
+        assert!(err.contains("bad.toml") && err.contains("max_tokens") && err.contains("line 2"), "{err}");
+    }
+
+    #[test]
+    fn local_backends_never_pick_up_cloud_keys_and_azure_v1_path_is_normalised() {
+        let vars = env(&[("NESY_VLM_MODEL", "qwen"), ("NESY_VLM_BACKEND", "vllm"), ("OPENAI_API_KEY", "sk-x")]);
+        let config = VlmConfig::resolve(&ConfigOverrides::default(), &vars).unwrap();
+        assert_eq!(config.api_key, None);
+        assert_eq!(config.base_url, "http://localhost:8000/v1");
+        let vars = env(&[
+            ("NESY_VLM_MODEL", "gpt-5"),
+            ("NESY_VLM_BACKEND", "azure-v1"),
+            ("AZURE_OPENAI_ENDPOINT", "https://res.openai.azure.com/"),
+        ]);
+        let config = VlmConfig::resolve(&ConfigOverrides::default(), &vars).unwrap();
+        assert_eq!(config.base_url, "https://res.openai.azure.com/openai/v1");
+    }
+}

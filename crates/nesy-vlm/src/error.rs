@@ -1,0 +1,272 @@
+//! Typed errors of the client and its transports.
+
+use std::fmt;
+
+use serde::Deserialize;
+
+use crate::cassette::CassetteError;
+use crate::config::ConfigError;
+use crate::response::Usage;
+
+/// Everything a chat call can fail with. Each variant that comes from a server carries the
+/// HTTP status (where there is one), the provider's error body and the request id, so a
+/// failure in a long benchmark run can be looked up on the provider's side.
+#[derive(Debug, thiserror::Error)]
+pub enum VlmError {
+    /// The configuration is incomplete or contradictory.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// The request cannot be sent as built (for example an image that is not PNG/JPEG).
+    #[error("invalid request: {0}")]
+    InvalidRequest(String),
+    /// The transport failed without an HTTP response (timeout, refused connection, cut body).
+    #[error("{source} (after {attempts} attempt(s))")]
+    Transport {
+        /// What went wrong on the last attempt.
+        source: TransportError,
+        /// Attempts made, including the last.
+        attempts: u32,
+    },
+    /// The server answered with a non-success status.
+    #[error("HTTP {status} on {path}{}: {provider}{}", request_id_suffix(request_id), attempts_suffix(*attempts))]
+    Http {
+        /// The HTTP status code.
+        status: u16,
+        /// The request path (relative to the base URL).
+        path: String,
+        /// The provider's error object, parsed tolerantly, with the raw body.
+        provider: ProviderError,
+        /// `x-request-id` / `apim-request-id` of the failed response.
+        request_id: Option<String>,
+        /// Attempts made, including the last.
+        attempts: u32,
+    },
+    /// A success status whose body is not a chat-completions response.
+    #[error("invalid response body (HTTP {status}{}): {detail}; body starts {excerpt:?}", request_id_suffix(request_id))]
+    InvalidResponse {
+        /// The HTTP status code.
+        status: u16,
+        /// What is wrong: the JSON error with line and column, or the missing field.
+        detail: String,
+        /// The first bytes of the body.
+        excerpt: String,
+        /// Request id, if the server sent one.
+        request_id: Option<String>,
+    },
+    /// The model stopped at the token cap (`finish_reason == "length"`).
+    #[error("output truncated at the token cap (finish_reason \"length\"){}", request_id_suffix(request_id))]
+    Truncated {
+        /// The text produced before the cap.
+        partial_text: String,
+        /// Token usage, if reported.
+        usage: Option<Usage>,
+        /// Request id, if the server sent one.
+        request_id: Option<String>,
+    },
+    /// The model refused (a `refusal` message or `finish_reason == "content_filter"`).
+    #[error("model refused{}: {reason}", request_id_suffix(request_id))]
+    Refusal {
+        /// The refusal text, or a note that the content filter stopped the output.
+        reason: String,
+        /// Request id, if the server sent one.
+        request_id: Option<String>,
+    },
+    /// A cassette failed: a miss in replay mode, a corrupt file, unused interactions.
+    #[error(transparent)]
+    Cassette(#[from] CassetteError),
+}
+
+impl VlmError {
+    /// The HTTP status, for errors that came with one.
+    pub fn status(&self) -> Option<u16> {
+        match self {
+            Self::Http { status, .. } | Self::InvalidResponse { status, .. } => Some(*status),
+            _ => None,
+        }
+    }
+
+    /// The provider's request id, for errors that came with one.
+    pub fn request_id(&self) -> Option<&str> {
+        match self {
+            Self::Http { request_id, .. }
+            | Self::InvalidResponse { request_id, .. }
+            | Self::Truncated { request_id, .. }
+            | Self::Refusal { request_id, .. } => request_id.as_deref(),
+            _ => None,
+        }
+    }
+
+    /// How many attempts the call made before failing, where the client counted them.
+    pub fn attempts(&self) -> Option<u32> {
+        match self {
+            Self::Http { attempts, .. } | Self::Transport { attempts, .. } => Some(*attempts),
+            _ => None,
+        }
+    }
+}
+
+fn request_id_suffix(request_id: &Option<String>) -> String {
+    request_id.as_ref().map(|id| format!(" [request id {id}]")).unwrap_or_default()
+}
+
+fn attempts_suffix(attempts: u32) -> String {
+    if attempts > 1 { format!(" (after {attempts} attempts)") } else { String::new() }
+}
+
+/// The provider's error object (`{"error": {"message", "type", "code", "param"}}`), read
+/// tolerantly: servers differ, so every field is optional and the raw body is kept.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ProviderError {
+    /// `error.message`, or the body text when it is not the usual shape.
+    pub message: String,
+    /// `error.type`, e.g. `insufficient_quota`, `invalid_request_error`.
+    pub error_type: Option<String>,
+    /// `error.code`, e.g. `rate_limit_exceeded`, `insufficient_quota`.
+    pub code: Option<String>,
+    /// `error.param`, the request field the server objected to.
+    pub param: Option<String>,
+    /// The raw body, cut to 4 KiB.
+    pub body: String,
+}
+
+impl ProviderError {
+    /// Reads an error body. Never fails: a body that is not JSON becomes the message.
+    pub fn from_body(body: &[u8]) -> Self {
+        #[derive(Deserialize)]
+        struct Envelope {
+            error: Option<Inner>,
+            message: Option<String>,
+        }
+        #[derive(Deserialize)]
+        struct Inner {
+            message: Option<String>,
+            #[serde(rename = "type")]
+            error_type: Option<serde_json::Value>,
+            code: Option<serde_json::Value>,
+            param: Option<serde_json::Value>,
+        }
+        let text = String::from_utf8_lossy(body);
+        let raw = truncate_chars(&text, 4096);
+        let as_string = |v: Option<serde_json::Value>| match v {
+            Some(serde_json::Value::String(s)) => Some(s),
+            Some(serde_json::Value::Null) | None => None,
+            Some(other) => Some(other.to_string()),
+        };
+        match serde_json::from_slice::<Envelope>(body) {
+            Ok(Envelope { error: Some(inner), .. }) => Self {
+                message: inner.message.unwrap_or_default(),
+                error_type: as_string(inner.error_type),
+                code: as_string(inner.code),
+                param: as_string(inner.param),
+                body: raw,
+            },
+            Ok(Envelope { message: Some(message), .. }) => Self { message, body: raw, ..Self::default() },
+            _ => Self { message: truncate_chars(text.trim(), 300), body: raw, ..Self::default() },
+        }
+    }
+
+    /// Whether the account is out of credit: such a 429 must never be retried.
+    pub fn is_insufficient_quota(&self) -> bool {
+        self.code.as_deref() == Some("insufficient_quota")
+            || self.error_type.as_deref() == Some("insufficient_quota")
+    }
+}
+
+impl fmt::Display for ProviderError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(if self.message.is_empty() { "(no error message)" } else { &self.message })?;
+        let tags: Vec<String> = [("type", &self.error_type), ("code", &self.code), ("param", &self.param)]
+            .iter()
+            .filter_map(|(name, value)| value.as_ref().map(|v| format!("{name}={v}")))
+            .collect();
+        if !tags.is_empty() {
+            write!(f, " ({})", tags.join(", "))?;
+        }
+        Ok(())
+    }
+}
+
+/// Cuts a string to at most `max` characters, marking the cut.
+pub(crate) fn truncate_chars(text: &str, max: usize) -> String {
+    match text.char_indices().nth(max) {
+        Some((cut, _)) => format!("{}…", &text[..cut]),
+        None => text.to_string(),
+    }
+}
+
+/// Which timeout fired.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TimeoutPhase {
+    /// Establishing the connection.
+    Connect,
+    /// Waiting for or reading the response: the read timeout (between bytes) or the total
+    /// timeout of the attempt fired.
+    Response,
+}
+
+/// A transport-level failure: no (complete) HTTP response was obtained.
+#[derive(Debug, thiserror::Error)]
+pub enum TransportError {
+    /// A timeout fired.
+    #[error("timed out ({phase:?} timeout): {message}")]
+    Timeout {
+        /// Which timeout.
+        phase: TimeoutPhase,
+        /// The underlying error text.
+        message: String,
+    },
+    /// The connection could not be established.
+    #[error("connection failed: {0}")]
+    Connect(String),
+    /// The response body could not be read to the end.
+    #[error("reading the response body failed: {0}")]
+    Body(String),
+    /// A cassette could not answer or record (never retried).
+    #[error(transparent)]
+    Cassette(#[from] CassetteError),
+    /// Any other failure; `retryable` tells the retry layer whether to try again.
+    #[error("{message}")]
+    Failed {
+        /// What went wrong.
+        message: String,
+        /// Whether another attempt may succeed.
+        retryable: bool,
+    },
+}
+
+impl TransportError {
+    /// Whether the retry layer may try again: timeouts, connection and body errors are
+    /// transient; cassette errors are not.
+    pub fn is_retryable(&self) -> bool {
+        match self {
+            Self::Timeout { .. } | Self::Connect(_) | Self::Body(_) => true,
+            Self::Cassette(_) => false,
+            Self::Failed { retryable, .. } => *retryable,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn provider_error_reads_openai_shape_and_quota() {
+        let body = br#"{"error":{"message":"You exceeded your current quota","type":"insufficient_quota","param":null,"code":"insufficient_quota"}}"#;
+        let err = ProviderError::from_body(body);
+        assert!(err.is_insufficient_quota());
+        assert_eq!(err.param, None);
+        assert_eq!(
+            err.to_string(),
+            "You exceeded your current quota (type=insufficient_quota, code=insufficient_quota)"
+        );
+    }
+
+    #[test]
+    fn provider_error_tolerates_other_shapes() {
+        assert_eq!(ProviderError::from_body(b"upstream down").message, "upstream down");
+        assert_eq!(ProviderError::from_body(br#"{"message":"bad"}"#).message, "bad");
+        let numeric = ProviderError::from_body(br#"{"error":{"message":"m","code":429}}"#);
+        assert_eq!(numeric.code.as_deref(), Some("429"));
+    }
+}
