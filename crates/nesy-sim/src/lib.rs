@@ -15,6 +15,7 @@ pub mod kinematics;
 pub mod motion;
 pub mod objects;
 pub mod observer;
+pub mod render;
 pub mod robot;
 pub mod scene;
 pub mod sim;

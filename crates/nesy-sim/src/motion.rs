@@ -91,6 +91,16 @@ impl Sim {
             rot_tol: 5e-3,
             ..IkOptions::default()
         };
+        // The final goal first, so an unreachable target is reported as such rather than
+        // as one of the clearance waypoints in front of it.
+        if let Some(last) = waypoints.last()
+            && self.ik(last, &self.q, &full).is_none()
+        {
+            return Err(ApiError::IkFailed {
+                target: [last.position.x, last.position.y, last.position.z],
+                pointing_to: pointing,
+            });
+        }
         let mut segments = Vec::new();
         let mut q_from = self.q.clone();
         let mut pose_from: Iso = self.tool_pose();

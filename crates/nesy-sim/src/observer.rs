@@ -288,11 +288,12 @@ mod tests {
 
     #[test]
     fn joint_thresholds_match_spec() {
-        // Hinge: Closed when q ≤ −0.31, Open when q ≥ 0.32.
+        // Hinge: Closed when q ≤ −0.31, Open when q ≥ 0.3245 (progress 0.7).
         assert_eq!(open_closed(-0.785, -0.785, 0.8), Some("Closed"));
         assert_eq!(open_closed(-0.31, -0.785, 0.8), Some("Closed"));
         assert_eq!(open_closed(0.0, -0.785, 0.8), None);
-        assert_eq!(open_closed(0.32, -0.785, 0.8), Some("Open"));
+        assert_eq!(open_closed(0.32, -0.785, 0.8), None);
+        assert_eq!(open_closed(0.325, -0.785, 0.8), Some("Open"));
         // Drawer: Closed when q ≤ 0.10.
         assert_eq!(open_closed(0.10, 0.0, 0.1232), Some("Closed"));
         assert_eq!(open_closed(0.11, 0.0, 0.1232), Some("Open"));

@@ -123,8 +123,9 @@ pub(crate) struct HandleGrasp {
 }
 
 /// Something that wants to watch the simulation: goal checks every N steps, keyframe
-/// recorders after every call. Hooks receive the simulator read-only.
-pub trait SimHook: Any {
+/// recorders after every call. Hooks receive the simulator read-only. They must be `Send`
+/// so the simulator can move between threads (e.g. into a Python runtime's worker).
+pub trait SimHook: Any + Send {
     /// Run [`SimHook::on_step`] every this many control steps (`None`: never).
     fn step_interval(&self) -> Option<u64> {
         None

@@ -1,0 +1,29 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+use nesy_sim::{Sim, observe};
+
+/// Path of a scene fixture.
+pub fn scene_path(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenes").join(format!("{name}.json"))
+}
+
+/// Builds the world of a scene fixture.
+pub fn load(name: &str) -> Sim {
+    Sim::from_file(&scene_path(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// Asserts that the observed state holds every `present` atom and none of `absent`.
+#[track_caller]
+pub fn expect(sim: &Sim, step: &str, present: &[&str], absent: &[&str]) {
+    let state = observe(sim).to_string();
+    let atoms: Vec<&str> = state.lines().map(|l| l.trim_start_matches("- ")).collect();
+    for p in present {
+        assert!(atoms.contains(p), "after {step}: expected {p} in\n{state}");
+    }
+    for a in absent {
+        assert!(!atoms.contains(a), "after {step}: did not expect {a} in\n{state}");
+    }
+}
