@@ -45,7 +45,11 @@ fn intern(pred: Symbol, args: Args) -> &'static AtomData {
     let id = u32::try_from(table.len()).expect("more than 2^32 distinct atoms");
     // Leaked on purpose: the table lives for the whole process and hands out `'static`
     // references, which is what makes `Atom` a plain pointer.
-    let data: &'static AtomData = Box::leak(Box::new(AtomData { id, pred: key.0, args: key.1.clone() }));
+    let data: &'static AtomData = Box::leak(Box::new(AtomData {
+        id,
+        pred: key.0,
+        args: key.1.clone(),
+    }));
     table.insert(key, data);
     data
 }
@@ -60,7 +64,10 @@ pub struct Atom(&'static AtomData);
 impl Atom {
     /// Builds an atom from a predicate name and argument names, interning them.
     pub fn new(pred: &str, args: &[&str]) -> Self {
-        Atom(intern(Symbol::new(pred), args.iter().map(|a| Symbol::new(a)).collect()))
+        Atom(intern(
+            Symbol::new(pred),
+            args.iter().map(|a| Symbol::new(a)).collect(),
+        ))
     }
 
     /// Builds an atom from already interned symbols.

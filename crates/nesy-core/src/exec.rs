@@ -44,7 +44,11 @@ pub fn format_unmet(unmet: &[UnmetPrecondition]) -> String {
     if unmet.is_empty() {
         return "None".to_string();
     }
-    unmet.iter().map(|u| format!("- {}", u.literal)).collect::<Vec<_>>().join("\n")
+    unmet
+        .iter()
+        .map(|u| format!("- {}", u.literal))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 impl Violation {
@@ -92,10 +96,16 @@ impl CompiledOperator {
             .map(|(i, g)| {
                 let mut atoms = Vec::new();
                 g.explain(state, &mut atoms);
-                UnmetPrecondition { literal: source.pre[*i].clone(), atoms }
+                UnmetPrecondition {
+                    literal: source.pre[*i].clone(),
+                    atoms,
+                }
             })
             .collect();
-        Violation { action: self.name.clone(), unmet }
+        Violation {
+            action: self.name.clone(),
+            unmet,
+        }
     }
 }
 
@@ -208,7 +218,9 @@ pub struct Report {
 impl Report {
     /// True if every step applied and the goal (if any) holds.
     pub fn is_valid(&self) -> bool {
-        self.first_failure.is_none() && self.goal_error.is_none() && self.goal.as_ref().is_none_or(|g| g.satisfied)
+        self.first_failure.is_none()
+            && self.goal_error.is_none()
+            && self.goal.as_ref().is_none_or(|g| g.satisfied)
     }
 
     /// The first failing step's violation, if it failed on preconditions.
@@ -233,10 +245,16 @@ pub fn check_goal(universe: &Universe, state: &State, goal: &Formula) -> Result<
         if !g.holds(state) {
             let mut atoms = Vec::new();
             g.explain(state, &mut atoms);
-            unmet.push(UnmetPrecondition { literal: conjunct, atoms });
+            unmet.push(UnmetPrecondition {
+                literal: conjunct,
+                atoms,
+            });
         }
     }
-    Ok(GoalCheck { satisfied: unmet.is_empty(), unmet })
+    Ok(GoalCheck {
+        satisfied: unmet.is_empty(),
+        unmet,
+    })
 }
 
 /// Verifies a procedure of ground operators from `init` over the implicit universe
@@ -248,8 +266,14 @@ pub fn verify_procedure(init: &State, ops: &[Operator], goal: Option<&Formula>) 
 }
 
 /// [`verify_procedure`] over an explicit universe.
-pub fn verify_procedure_in(universe: &Universe, init: &State, ops: &[Operator], goal: Option<&Formula>) -> Report {
-    let compiled: Vec<Result<CompiledOperator, GroundError>> = ops.iter().map(|o| o.compile(universe)).collect();
+pub fn verify_procedure_in(
+    universe: &Universe,
+    init: &State,
+    ops: &[Operator],
+    goal: Option<&Formula>,
+) -> Report {
+    let compiled: Vec<Result<CompiledOperator, GroundError>> =
+        ops.iter().map(|o| o.compile(universe)).collect();
     verify_compiled(universe, init, ops, &compiled, goal)
 }
 
@@ -269,7 +293,11 @@ pub fn verify_compiled(
     for (index, (op, c)) in ops.iter().zip(compiled).enumerate() {
         let action = op.display_name();
         if first_failure.is_some() {
-            steps.push(StepOutcome { index, action, status: StepStatus::NotExecuted });
+            steps.push(StepOutcome {
+                index,
+                action,
+                status: StepStatus::NotExecuted,
+            });
             continue;
         }
         let status = match c {
@@ -278,7 +306,10 @@ pub fn verify_compiled(
                 Ok(next) => {
                     let diff = state.diff(&next);
                     state = next;
-                    StepStatus::Applied { added: diff.added, removed: diff.removed }
+                    StepStatus::Applied {
+                        added: diff.added,
+                        removed: diff.removed,
+                    }
                 }
                 Err(violation) => StepStatus::Failed { violation },
             },
@@ -287,7 +318,11 @@ pub fn verify_compiled(
             first_failure = Some(index);
             failing_state = Some(state.clone());
         }
-        steps.push(StepOutcome { index, action, status });
+        steps.push(StepOutcome {
+            index,
+            action,
+            status,
+        });
     }
     let (goal, goal_error) = match (goal, first_failure) {
         (Some(g), None) => match check_goal(universe, &state, g) {
@@ -296,5 +331,12 @@ pub fn verify_compiled(
         },
         _ => (None, None),
     };
-    Report { steps, first_failure, failing_state, final_state: state, goal, goal_error }
+    Report {
+        steps,
+        first_failure,
+        failing_state,
+        final_state: state,
+        goal,
+        goal_error,
+    }
 }

@@ -48,7 +48,10 @@ pub struct AtomPattern {
 impl AtomPattern {
     /// A pattern with only constant arguments.
     pub fn ground(atom: Atom) -> Self {
-        AtomPattern { pred: atom.pred(), args: atom.args().iter().map(|a| Term::Const(*a)).collect() }
+        AtomPattern {
+            pred: atom.pred(),
+            args: atom.args().iter().map(|a| Term::Const(*a)).collect(),
+        }
     }
 
     /// The ground atom, if no argument is a variable.
@@ -174,9 +177,20 @@ impl Formula {
             Formula::Atom(p) => Ground::Atom(p.resolve(env)?),
             Formula::Eq(a, b) => Ground::constant(env.resolve(*a)? == env.resolve(*b)?),
             Formula::Not(f) => Ground::not(f.ground(universe, env)?),
-            Formula::And(fs) => Ground::and(fs.iter().map(|f| f.ground(universe, env)).collect::<Result<_, _>>()?),
-            Formula::Or(fs) => Ground::or(fs.iter().map(|f| f.ground(universe, env)).collect::<Result<_, _>>()?),
-            Formula::Imply(a, b) => Ground::or(vec![Ground::not(a.ground(universe, env)?), b.ground(universe, env)?]),
+            Formula::And(fs) => Ground::and(
+                fs.iter()
+                    .map(|f| f.ground(universe, env))
+                    .collect::<Result<_, _>>()?,
+            ),
+            Formula::Or(fs) => Ground::or(
+                fs.iter()
+                    .map(|f| f.ground(universe, env))
+                    .collect::<Result<_, _>>()?,
+            ),
+            Formula::Imply(a, b) => Ground::or(vec![
+                Ground::not(a.ground(universe, env)?),
+                b.ground(universe, env)?,
+            ]),
             Formula::Forall(vars, body) => {
                 let mut parts = Vec::new();
                 for_each_binding(vars, universe, env, &mut |env| {
@@ -199,19 +213,31 @@ impl Formula {
     /// Substitutes constants for free variables, structurally (quantified variables shadow).
     pub fn substitute(&self, bindings: &[(Symbol, Symbol)]) -> Formula {
         let sub_term = |t: &Term| match t {
-            Term::Var(v) => bindings.iter().rev().find(|(n, _)| n == v).map_or(*t, |(_, c)| Term::Const(*c)),
+            Term::Var(v) => bindings
+                .iter()
+                .rev()
+                .find(|(n, _)| n == v)
+                .map_or(*t, |(_, c)| Term::Const(*c)),
             Term::Const(_) => *t,
         };
         match self {
-            Formula::Atom(p) => Formula::Atom(AtomPattern { pred: p.pred, args: p.args.iter().map(sub_term).collect() }),
+            Formula::Atom(p) => Formula::Atom(AtomPattern {
+                pred: p.pred,
+                args: p.args.iter().map(sub_term).collect(),
+            }),
             Formula::Eq(a, b) => Formula::Eq(sub_term(a), sub_term(b)),
             Formula::Not(f) => Formula::Not(Box::new(f.substitute(bindings))),
             Formula::And(fs) => Formula::And(fs.iter().map(|f| f.substitute(bindings)).collect()),
             Formula::Or(fs) => Formula::Or(fs.iter().map(|f| f.substitute(bindings)).collect()),
-            Formula::Imply(a, b) => Formula::Imply(Box::new(a.substitute(bindings)), Box::new(b.substitute(bindings))),
+            Formula::Imply(a, b) => {
+                Formula::Imply(Box::new(a.substitute(bindings)), Box::new(b.substitute(bindings)))
+            }
             Formula::Forall(vars, body) | Formula::Exists(vars, body) => {
-                let inner: Vec<(Symbol, Symbol)> =
-                    bindings.iter().filter(|(n, _)| !vars.iter().any(|v| v.name == *n)).copied().collect();
+                let inner: Vec<(Symbol, Symbol)> = bindings
+                    .iter()
+                    .filter(|(n, _)| !vars.iter().any(|v| v.name == *n))
+                    .copied()
+                    .collect();
                 let body = Box::new(body.substitute(&inner));
                 if matches!(self, Formula::Forall(..)) {
                     Formula::Forall(vars.clone(), body)
@@ -225,10 +251,10 @@ impl Formula {
 
 fn terms_constants(terms: &[Term], out: &mut Vec<Symbol>) {
     for t in terms {
-        if let Term::Const(c) = t {
-            if !out.contains(c) {
-                out.push(*c);
-            }
+        if let Term::Const(c) = t
+            && !out.contains(c)
+        {
+            out.push(*c);
         }
     }
 }
@@ -309,7 +335,11 @@ impl Effect {
                 match condition {
                     None if add => out.adds.push(atom),
                     None => out.dels.push(atom),
-                    Some(c) => out.conditional.push(ConditionalEffect { condition: c.clone(), atom, add }),
+                    Some(c) => out.conditional.push(ConditionalEffect {
+                        condition: c.clone(),
+                        atom,
+                        add,
+                    }),
                 }
             }
             Effect::Forall(vars, effects) => {
@@ -354,11 +384,17 @@ impl Effect {
             Effect::Add(p) => Effect::Add(sub_atom(p)),
             Effect::Del(p) => Effect::Del(sub_atom(p)),
             Effect::Forall(vars, es) => {
-                let inner: Vec<(Symbol, Symbol)> =
-                    bindings.iter().filter(|(n, _)| !vars.iter().any(|v| v.name == *n)).copied().collect();
+                let inner: Vec<(Symbol, Symbol)> = bindings
+                    .iter()
+                    .filter(|(n, _)| !vars.iter().any(|v| v.name == *n))
+                    .copied()
+                    .collect();
                 Effect::Forall(vars.clone(), es.iter().map(|e| e.substitute(&inner)).collect())
             }
-            Effect::When(c, es) => Effect::When(c.substitute(bindings), es.iter().map(|e| e.substitute(bindings)).collect()),
+            Effect::When(c, es) => Effect::When(
+                c.substitute(bindings),
+                es.iter().map(|e| e.substitute(bindings)).collect(),
+            ),
         }
     }
 }
@@ -421,7 +457,9 @@ impl Bindings {
 
     /// Bindings for parameters.
     pub fn from_pairs(pairs: impl IntoIterator<Item = (Symbol, Symbol)>) -> Self {
-        Bindings { stack: pairs.into_iter().collect() }
+        Bindings {
+            stack: pairs.into_iter().collect(),
+        }
     }
 
     /// The constant a term denotes.
@@ -434,7 +472,9 @@ impl Bindings {
                 .rev()
                 .find(|(n, _)| *n == v)
                 .map(|(_, c)| *c)
-                .ok_or_else(|| GroundError::UnboundVariable { name: format!("?{v}") }),
+                .ok_or_else(|| GroundError::UnboundVariable {
+                    name: format!("?{v}"),
+                }),
         }
     }
 }
@@ -587,7 +627,10 @@ impl Ground {
         match self {
             Ground::True | Ground::False => {}
             Ground::Atom(a) => {
-                let truth = AtomTruth { atom: *a, holds: state.contains(a) };
+                let truth = AtomTruth {
+                    atom: *a,
+                    holds: state.contains(a),
+                };
                 if !out.contains(&truth) {
                     out.push(truth);
                 }
@@ -597,7 +640,9 @@ impl Ground {
                 if self.holds(state) {
                     gs.iter().for_each(|g| g.explain(state, out));
                 } else {
-                    gs.iter().filter(|g| !g.holds(state)).for_each(|g| g.explain(state, out));
+                    gs.iter()
+                        .filter(|g| !g.holds(state))
+                        .for_each(|g| g.explain(state, out));
                 }
             }
             Ground::Or(gs) => {
@@ -632,7 +677,12 @@ pub struct AtomTruth {
 
 impl fmt::Display for AtomTruth {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} is {}", self.atom, if self.holds { "true" } else { "false" })
+        write!(
+            f,
+            "{} is {}",
+            self.atom,
+            if self.holds { "true" } else { "false" }
+        )
     }
 }
 
@@ -677,7 +727,11 @@ impl GroundEffects {
         let mut dels = self.dels.clone();
         for c in &self.conditional {
             if c.condition.holds(state) {
-                if c.add { adds.push(c.atom) } else { dels.push(c.atom) }
+                if c.add {
+                    adds.push(c.atom)
+                } else {
+                    dels.push(c.atom)
+                }
             }
         }
         adds.sort_unstable();

@@ -12,6 +12,7 @@ pub mod adapt;
 pub mod atom;
 pub mod exec;
 pub mod formula;
+pub mod metrics;
 pub mod operator;
 pub mod patch;
 pub mod pddl;
@@ -23,7 +24,9 @@ pub mod text;
 pub mod types;
 
 pub use atom::Atom;
-pub use exec::{ExecError, Report, UnmetPrecondition, Violation, apply, apply_in, verify_procedure, verify_procedure_in};
+pub use exec::{
+    ExecError, Report, UnmetPrecondition, Violation, apply, apply_in, verify_procedure, verify_procedure_in,
+};
 pub use formula::{Effect, Formula, Term, TypedVar};
 pub use operator::{CompiledOperator, Operator, format_procedure};
 pub use patch::{Patch, PatchError, apply_patch};

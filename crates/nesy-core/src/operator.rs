@@ -45,9 +45,14 @@ mod typed_vars_serde {
             .map(|item| {
                 let (name, ty) = item.split_once(" - ").unwrap_or((item.as_str(), "thing"));
                 let name = name.trim().strip_prefix('?').ok_or_else(|| {
-                    serde::de::Error::custom(format!("expected a typed variable like `?x - thing`, found {item:?}"))
+                    serde::de::Error::custom(format!(
+                        "expected a typed variable like `?x - thing`, found {item:?}"
+                    ))
                 })?;
-                Ok(TypedVar { name: Symbol::new(name), ty: Symbol::new(ty.trim()) })
+                Ok(TypedVar {
+                    name: Symbol::new(name),
+                    ty: Symbol::new(ty.trim()),
+                })
             })
             .collect()
     }
@@ -56,7 +61,13 @@ mod typed_vars_serde {
 impl Operator {
     /// A ground operator with the given name, preconditions and effects.
     pub fn new(name: impl Into<String>, pre: Vec<Formula>, eff: Vec<Effect>) -> Self {
-        Operator { name: name.into(), params: Vec::new(), args: Vec::new(), pre, eff }
+        Operator {
+            name: name.into(),
+            params: Vec::new(),
+            args: Vec::new(),
+            pre,
+            eff,
+        }
     }
 
     /// The name as shown in plans and reports: `name` for ground operators, `(name a b)`
@@ -107,7 +118,9 @@ impl Operator {
         let mut bindings = Vec::with_capacity(args.len());
         for (p, a) in self.params.iter().zip(args) {
             universe.types.check(p.ty)?;
-            let ok = universe.type_of(*a).is_some_and(|t| universe.types.is_subtype(t, p.ty));
+            let ok = universe
+                .type_of(*a)
+                .is_some_and(|t| universe.types.is_subtype(t, p.ty));
             if !ok {
                 return Err(GroundError::BadArgument {
                     action: self.name.clone(),
@@ -126,7 +139,11 @@ impl Operator {
     }
 
     /// Compiles a lifted schema bound to `args` (no substitution copy is made).
-    pub fn compile_with(&self, args: &[Symbol], universe: &Universe) -> Result<CompiledOperator, GroundError> {
+    pub fn compile_with(
+        &self,
+        args: &[Symbol],
+        universe: &Universe,
+    ) -> Result<CompiledOperator, GroundError> {
         let bindings = self.check_args(args, universe)?;
         let mut env = Bindings::from_pairs(bindings);
         let mut pre = Vec::with_capacity(self.pre.len());
@@ -144,7 +161,11 @@ impl Operator {
         let name = if args.is_empty() {
             self.display_name()
         } else {
-            Operator { args: args.to_vec(), ..self.clone() }.display_name()
+            Operator {
+                args: args.to_vec(),
+                ..self.clone()
+            }
+            .display_name()
         };
         Ok(CompiledOperator { name, pre, effects })
     }
@@ -155,12 +176,13 @@ impl Operator {
 /// ```text
 /// Name
 /// - Preconditions:
-/// 	(GripperOpen)
+///     (GripperOpen)
 /// - Effects:
-/// 	(GripperClosed)
+///     (GripperClosed)
 /// ```
 ///
-/// with `\tNone` for an empty section. Lifted schemas print their name with parameters.
+/// (formula lines are indented with one tab, shown here as spaces) with `\tNone` for an
+/// empty section. Lifted schemas print their name with parameters.
 impl fmt::Display for Operator {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.display_name())?;
@@ -215,6 +237,10 @@ impl CompiledOperator {
 
     /// Every atom the operator may add (unconditionally or not).
     pub fn possible_adds(&self) -> impl Iterator<Item = Atom> + '_ {
-        self.effects.adds.iter().copied().chain(self.effects.conditional.iter().filter(|c| c.add).map(|c| c.atom))
+        self.effects
+            .adds
+            .iter()
+            .copied()
+            .chain(self.effects.conditional.iter().filter(|c| c.add).map(|c| c.atom))
     }
 }

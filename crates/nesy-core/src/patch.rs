@@ -73,7 +73,10 @@ impl ActionKey {
 
     fn difference(&self, other: &ActionKey) -> Option<String> {
         if self.name != other.name {
-            return Some(format!("the name differs (`{}` in SEARCH, `{}` in the procedure)", self.name, other.name));
+            return Some(format!(
+                "the name differs (`{}` in SEARCH, `{}` in the procedure)",
+                self.name, other.name
+            ));
         }
         let section = |what: &str, mine: &[String], theirs: &[String]| -> Option<String> {
             let missing: Vec<&String> = mine.iter().filter(|x| !theirs.contains(x)).collect();
@@ -173,12 +176,21 @@ pub fn apply_patch(procedure: &[Operator], patch: &Patch, near: usize) -> Result
     let search: Vec<ActionKey> = patch.search.iter().map(ActionKey::of).collect();
     let keys: Vec<ActionKey> = procedure.iter().map(ActionKey::of).collect();
     if keys.len() < k {
-        return Err(PatchError::NoMatch { search_len: k, closest: None });
+        return Err(PatchError::NoMatch {
+            search_len: k,
+            closest: None,
+        });
     }
     let starts = 0..=keys.len() - k;
     let matches: Vec<usize> = starts.clone().filter(|&i| keys[i..i + k] == search[..]).collect();
     let distance = |i: usize| {
-        if (i..i + k).contains(&near) { 0 } else if near < i { i - near } else { near - (i + k - 1) }
+        if (i..i + k).contains(&near) {
+            0
+        } else if near < i {
+            i - near
+        } else {
+            near - (i + k - 1)
+        }
     };
     let Some(&at) = matches.iter().min_by_key(|&&i| (distance(i), i)) else {
         let best = starts
@@ -193,7 +205,10 @@ pub fn apply_patch(procedure: &[Operator], patch: &Patch, near: usize) -> Result
             let first_mismatch = (0..k).find(|&j| keys[start + j] != search[j]).unwrap_or(0);
             ClosestCandidate {
                 start,
-                actions: procedure[start..start + k].iter().map(|o| o.display_name()).collect(),
+                actions: procedure[start..start + k]
+                    .iter()
+                    .map(|o| o.display_name())
+                    .collect(),
                 matching: (0..k).filter(|&j| keys[start + j] == search[j]).count(),
                 first_mismatch,
                 difference: search[first_mismatch]
@@ -201,7 +216,10 @@ pub fn apply_patch(procedure: &[Operator], patch: &Patch, near: usize) -> Result
                     .unwrap_or_else(|| "they differ".to_string()),
             }
         });
-        return Err(PatchError::NoMatch { search_len: k, closest });
+        return Err(PatchError::NoMatch {
+            search_len: k,
+            closest,
+        });
     };
     let mut out = Vec::with_capacity(procedure.len() - k + patch.replace.len());
     out.extend_from_slice(&procedure[..at]);
@@ -234,7 +252,10 @@ mod tests {
         let a = block("A", "(P)", "(Q)");
         let b = block("B", "(Q)", "(R)");
         let proc_ = ops(&[a.clone(), b.clone(), a.clone(), b.clone()].join("\n\n"));
-        let patch = Patch { search: ops(&a), replace: vec![] };
+        let patch = Patch {
+            search: ops(&a),
+            replace: vec![],
+        };
         let applied = apply_patch(&proc_, &patch, 3).unwrap();
         assert_eq!(applied.at, 2);
         assert_eq!(applied.other_matches, vec![0]);
@@ -246,15 +267,39 @@ mod tests {
     #[test]
     fn normalised_comparison_and_no_match() {
         let proc_ = ops(&block("GraspOrange", "(GripperOpen)", "(GripperHolding orange)"));
-        let search = ops("grasp orange\n- Preconditions:\n  - (GripperOpen)\n- Effects:\n  * (GripperHolding orange)");
-        let patch = Patch { search, replace: ops(&block("X", "(A)", "(B)")) };
+        let search =
+            ops("grasp orange\n- Preconditions:\n  - (GripperOpen)\n- Effects:\n  * (GripperHolding orange)");
+        let patch = Patch {
+            search,
+            replace: ops(&block("X", "(A)", "(B)")),
+        };
         assert_eq!(apply_patch(&proc_, &patch, 0).unwrap().procedure[0].name, "X");
-        let wrong = Patch { search: ops(&block("GraspOrange", "(GripperClosed)", "(GripperHolding orange)")), replace: vec![] };
+        let wrong = Patch {
+            search: ops(&block(
+                "GraspOrange",
+                "(GripperClosed)",
+                "(GripperHolding orange)",
+            )),
+            replace: vec![],
+        };
         let err = apply_patch(&proc_, &wrong, 0).unwrap_err();
-        let PatchError::NoMatch { closest: Some(c), .. } = &err else { panic!("{err:?}") };
+        let PatchError::NoMatch { closest: Some(c), .. } = &err else {
+            panic!("{err:?}")
+        };
         assert_eq!(c.start, 0);
         assert!(c.difference.contains("(GripperClosed)"), "{}", c.difference);
         assert!(err.to_string().contains("closest candidate"));
-        assert_eq!(apply_patch(&proc_, &Patch { search: vec![], replace: vec![] }, 0).unwrap_err(), PatchError::EmptySearch);
+        assert_eq!(
+            apply_patch(
+                &proc_,
+                &Patch {
+                    search: vec![],
+                    replace: vec![]
+                },
+                0
+            )
+            .unwrap_err(),
+            PatchError::EmptySearch
+        );
     }
 }

@@ -113,14 +113,31 @@ fn keyword_is(e: &SExpr<'_>, kw: &str) -> bool {
 fn define<'a>(doc: &'a str, kind: &str) -> Result<(Symbol, Vec<SExpr<'a>>), ParseError> {
     let top = parse_all(doc, 0, doc.len())?;
     let Some(first) = top.first() else {
-        return Err(err(doc, doc.len(), ParseErrorKind::Empty, format!("`(define ({kind} NAME) ...)`")));
+        return Err(err(
+            doc,
+            doc.len(),
+            ParseErrorKind::Empty,
+            format!("`(define ({kind} NAME) ...)`"),
+        ));
     };
     if let Some(extra) = top.get(1) {
-        return Err(err(doc, extra.span.start, ParseErrorKind::Syntax, "end of file after the `(define ...)`"));
+        return Err(err(
+            doc,
+            extra.span.start,
+            ParseErrorKind::Syntax,
+            "end of file after the `(define ...)`",
+        ));
     }
     let items = match first.list() {
         Some(items) if items.first().is_some_and(|h| keyword_is(h, "define")) => items,
-        _ => return Err(err(doc, first.span.start, ParseErrorKind::Syntax, "`(define ...`")),
+        _ => {
+            return Err(err(
+                doc,
+                first.span.start,
+                ParseErrorKind::Syntax,
+                "`(define ...`",
+            ));
+        }
     };
     let conv = Converter::new(doc, true);
     let header = items.get(1).and_then(|h| h.list());
@@ -137,7 +154,12 @@ fn define<'a>(doc: &'a str, kind: &str) -> Result<(Symbol, Vec<SExpr<'a>>), Pars
 fn section_name(doc: &str, s: &SExpr<'_>) -> Result<String, ParseError> {
     match s.list().and_then(|l| l.first()).and_then(|h| h.token()) {
         Some(t) if t.starts_with(':') => Ok(t.to_ascii_lowercase()),
-        _ => Err(err(doc, s.span.start, ParseErrorKind::Syntax, "a section like `(:predicates ...)`")),
+        _ => Err(err(
+            doc,
+            s.span.start,
+            ParseErrorKind::Syntax,
+            "a section like `(:predicates ...)`",
+        )),
     }
 }
 
@@ -145,8 +167,14 @@ fn section_name(doc: &str, s: &SExpr<'_>) -> Result<String, ParseError> {
 pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
     let (name, sections) = define(doc, "domain")?;
     let conv = Converter::new(doc, true);
-    let mut domain =
-        Domain { name, requirements: vec![], types: vec![], constants: vec![], predicates: vec![], actions: vec![] };
+    let mut domain = Domain {
+        name,
+        requirements: vec![],
+        types: vec![],
+        constants: vec![],
+        predicates: vec![],
+        actions: vec![],
+    };
     let mut action_exprs = Vec::new();
     for s in &sections {
         let kw = section_name(doc, s)?;
@@ -168,14 +196,28 @@ pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
             }
             ":types" => {
                 for (n, t, _) in conv.typed_list(body, false)? {
-                    domain.types.push((n, if t.as_str() == "thing" { Symbol::new("object") } else { t }));
+                    domain.types.push((
+                        n,
+                        if t.as_str() == "thing" {
+                            Symbol::new("object")
+                        } else {
+                            t
+                        },
+                    ));
                 }
             }
-            ":constants" => domain.constants.extend(conv.typed_list(body, false)?.into_iter().map(|(n, t, _)| (n, t))),
+            ":constants" => domain
+                .constants
+                .extend(conv.typed_list(body, false)?.into_iter().map(|(n, t, _)| (n, t))),
             ":predicates" => {
                 for p in body {
                     let Some((head, params)) = p.list().and_then(|l| l.split_first()) else {
-                        return Err(err(doc, p.span.start, ParseErrorKind::Syntax, "a predicate declaration `(name ?x ...)`"));
+                        return Err(err(
+                            doc,
+                            p.span.start,
+                            ParseErrorKind::Syntax,
+                            "a predicate declaration `(name ?x ...)`",
+                        ));
                     };
                     let name = conv.expect_name(head, "a predicate name")?;
                     let params = conv
@@ -200,9 +242,16 @@ pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
     // Types must form a hierarchy.
     let mut universe = Universe::new();
     for (t, parent) in &domain.types {
-        universe.types.declare(*t, *parent).map_err(|e| err(doc, 0, ParseErrorKind::Reference, e.to_string()))?;
+        universe
+            .types
+            .declare(*t, *parent)
+            .map_err(|e| err(doc, 0, ParseErrorKind::Reference, e.to_string()))?;
     }
-    let declared: Vec<(Symbol, usize)> = domain.predicates.iter().map(|p| (p.name, p.params.len())).collect();
+    let declared: Vec<(Symbol, usize)> = domain
+        .predicates
+        .iter()
+        .map(|p| (p.name, p.params.len()))
+        .collect();
     let conv = Converter::new(doc, true).with_predicates(declared);
     for s in action_exprs {
         domain.actions.push(parse_action(doc, &conv, s, &universe)?);
@@ -210,10 +259,20 @@ pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
     Ok(domain)
 }
 
-fn parse_action(doc: &str, conv: &Converter<'_>, s: &SExpr<'_>, universe: &Universe) -> Result<Operator, ParseError> {
+fn parse_action(
+    doc: &str,
+    conv: &Converter<'_>,
+    s: &SExpr<'_>,
+    universe: &Universe,
+) -> Result<Operator, ParseError> {
     let items = s.list().unwrap_or(&[]);
     let Some(name_expr) = items.get(1) else {
-        return Err(err(doc, s.span.end.saturating_sub(1), ParseErrorKind::Syntax, "an action name"));
+        return Err(err(
+            doc,
+            s.span.end.saturating_sub(1),
+            ParseErrorKind::Syntax,
+            "an action name",
+        ));
     };
     let name = conv.expect_name(name_expr, "an action name")?;
     let mut params = Vec::new();
@@ -224,14 +283,26 @@ fn parse_action(doc: &str, conv: &Converter<'_>, s: &SExpr<'_>, universe: &Unive
     while i < items.len() {
         let key = items[i].token().map(|t| t.to_ascii_lowercase());
         let Some(value) = items.get(i + 1) else {
-            return Err(err(doc, items[i].span.end, ParseErrorKind::Syntax, "a value after the keyword"));
+            return Err(err(
+                doc,
+                items[i].span.end,
+                ParseErrorKind::Syntax,
+                "a value after the keyword",
+            ));
         };
         match key.as_deref() {
             Some(":parameters") => {
-                let list = value.list().ok_or_else(|| err(doc, value.span.start, ParseErrorKind::Syntax, "a parameter list"))?;
+                let list = value
+                    .list()
+                    .ok_or_else(|| err(doc, value.span.start, ParseErrorKind::Syntax, "a parameter list"))?;
                 for (n, t, at) in conv.typed_list(list, true)? {
                     if !universe.types.contains(t) {
-                        return Err(err(doc, at, ParseErrorKind::Reference, format!("a declared type (`{t}` is not)")));
+                        return Err(err(
+                            doc,
+                            at,
+                            ParseErrorKind::Reference,
+                            format!("a declared type (`{t}` is not)"),
+                        ));
                     }
                     params.push(TypedVar { name: n, ty: t });
                 }
@@ -263,15 +334,30 @@ fn parse_action(doc: &str, conv: &Converter<'_>, s: &SExpr<'_>, universe: &Unive
         i += 2;
     }
     if !seen_effect {
-        return Err(err(doc, s.span.end.saturating_sub(1), ParseErrorKind::MissingSection, "an `:effect`"));
+        return Err(err(
+            doc,
+            s.span.end.saturating_sub(1),
+            ParseErrorKind::MissingSection,
+            "an `:effect`",
+        ));
     }
-    Ok(Operator { name: name.to_string(), params, args: vec![], pre, eff })
+    Ok(Operator {
+        name: name.to_string(),
+        params,
+        args: vec![],
+        pre,
+        eff,
+    })
 }
 
 /// Parses a PDDL problem. Atoms and the goal are checked against the domain's predicates.
 pub fn parse_problem(doc: &str, domain: &Domain) -> Result<Problem, ParseError> {
     let (name, sections) = define(doc, "problem")?;
-    let declared: Vec<(Symbol, usize)> = domain.predicates.iter().map(|p| (p.name, p.params.len())).collect();
+    let declared: Vec<(Symbol, usize)> = domain
+        .predicates
+        .iter()
+        .map(|p| (p.name, p.params.len()))
+        .collect();
     let conv = Converter::new(doc, true).with_predicates(declared);
     let mut dom_name = None;
     let mut objects = Vec::new();
@@ -303,7 +389,12 @@ pub fn parse_problem(doc: &str, domain: &Domain) -> Result<Problem, ParseError> 
                         || t.as_str() == "object"
                         || domain.types.iter().any(|(d, _)| *d == t);
                     if !known {
-                        return Err(err(doc, at, ParseErrorKind::Reference, format!("a declared type (`{t}` is not)")));
+                        return Err(err(
+                            doc,
+                            at,
+                            ParseErrorKind::Reference,
+                            format!("a declared type (`{t}` is not)"),
+                        ));
                     }
                     objects.push((n, t));
                 }
@@ -328,7 +419,14 @@ pub fn parse_problem(doc: &str, domain: &Domain) -> Result<Problem, ParseError> 
             }
             ":goal" => match body {
                 [g] => goal = Some(conv.formula(g, &mut Vec::new())?),
-                _ => return Err(err(doc, s.span.start, ParseErrorKind::Syntax, "`(:goal FORMULA)`")),
+                _ => {
+                    return Err(err(
+                        doc,
+                        s.span.start,
+                        ParseErrorKind::Syntax,
+                        "`(:goal FORMULA)`",
+                    ));
+                }
             },
             _ => {
                 return Err(err(
@@ -341,19 +439,42 @@ pub fn parse_problem(doc: &str, domain: &Domain) -> Result<Problem, ParseError> 
         }
     }
     let Some(domain_name) = dom_name else {
-        return Err(err(doc, 0, ParseErrorKind::MissingSection, "a `(:domain NAME)` section"));
+        return Err(err(
+            doc,
+            0,
+            ParseErrorKind::MissingSection,
+            "a `(:domain NAME)` section",
+        ));
     };
     let Some(goal) = goal else {
-        return Err(err(doc, doc.len(), ParseErrorKind::MissingSection, "a `(:goal ...)` section"));
+        return Err(err(
+            doc,
+            doc.len(),
+            ParseErrorKind::MissingSection,
+            "a `(:goal ...)` section",
+        ));
     };
-    let problem = Problem { name, domain: domain_name, objects, init: State::from_atoms(init), goal };
+    let problem = Problem {
+        name,
+        domain: domain_name,
+        objects,
+        init: State::from_atoms(init),
+        goal,
+    };
     // Every constant in init and goal must be an object or a domain constant.
-    let universe = domain.universe(&problem).map_err(|e| err(doc, 0, ParseErrorKind::Reference, e.to_string()))?;
+    let universe = domain
+        .universe(&problem)
+        .map_err(|e| err(doc, 0, ParseErrorKind::Reference, e.to_string()))?;
     let mut mentioned = problem.init.objects();
     problem.goal.constants(&mut mentioned);
     if let Some(unknown) = mentioned.iter().find(|o| !universe.contains(**o)) {
         let at = find_token(doc, unknown.as_str()).unwrap_or(0);
-        return Err(err(doc, at, ParseErrorKind::Reference, format!("a declared object (`{unknown}` is not in :objects)")));
+        return Err(err(
+            doc,
+            at,
+            ParseErrorKind::Reference,
+            format!("a declared object (`{unknown}` is not in :objects)"),
+        ));
     }
     Ok(problem)
 }
@@ -419,21 +540,36 @@ pub fn parse_plan(doc: &str) -> Result<Vec<PlanStep>, ParseError> {
             }
         }
         // Optional `[duration]` suffix.
-        if code.trim_end().ends_with(']') {
-            if let Some(open) = code.rfind('[') {
-                end = line_start + open;
-            }
+        if code.trim_end().ends_with(']')
+            && let Some(open) = code.rfind('[')
+        {
+            end = line_start + open;
         }
         let e = parse_single(doc, start, end)?;
         let items = match e.list() {
             Some(items) if !items.is_empty() => items,
-            _ => return Err(err(doc, e.span.start, ParseErrorKind::Syntax, "a plan step `(action arg...)`")),
+            _ => {
+                return Err(err(
+                    doc,
+                    e.span.start,
+                    ParseErrorKind::Syntax,
+                    "a plan step `(action arg...)`",
+                ));
+            }
         };
         let conv = Converter::new(doc, true);
         let action = conv.expect_name(&items[0], "an action name")?;
-        let args = items[1..].iter().map(|a| conv.expect_name(a, "an object name")).collect::<Result<_, _>>()?;
+        let args = items[1..]
+            .iter()
+            .map(|a| conv.expect_name(a, "an object name"))
+            .collect::<Result<_, _>>()?;
         let (line, column) = crate::text::line_col(doc, e.span.start);
-        steps.push(PlanStep { action, args, line, column });
+        steps.push(PlanStep {
+            action,
+            args,
+            line,
+            column,
+        });
     }
     Ok(steps)
 }
@@ -470,10 +606,15 @@ pub fn ground_plan(
                     plan_text,
                     at(s),
                     ParseErrorKind::Reference,
-                    format!("an action of domain `{}` (`{}` is not one)", domain.name, s.action),
+                    format!(
+                        "an action of domain `{}` (`{}` is not one)",
+                        domain.name, s.action
+                    ),
                 ));
             };
-            schema.instantiate(&s.args, universe).map_err(|e| err(plan_text, at(s), ParseErrorKind::Reference, e.to_string()))
+            schema
+                .instantiate(&s.args, universe)
+                .map_err(|e| err(plan_text, at(s), ParseErrorKind::Reference, e.to_string()))
         })
         .collect()
 }

@@ -120,6 +120,9 @@ enum Cond {
     Or(Vec<Cond>),
 }
 
+/// A search node: state, (parent, action) and path cost.
+type Node = (Bits, Option<(usize, usize)>, usize);
+
 struct GroundAction {
     op: Operator,
     pre: Cond,
@@ -136,7 +139,11 @@ fn get(bits: &Bits, i: u32) -> bool {
 
 fn set(bits: &mut Bits, i: u32, v: bool) {
     let w = &mut bits[(i / 64) as usize];
-    if v { *w |= 1 << (i % 64) } else { *w &= !(1 << (i % 64)) }
+    if v {
+        *w |= 1 << (i % 64)
+    } else {
+        *w &= !(1 << (i % 64))
+    }
 }
 
 impl Cond {
@@ -247,8 +254,11 @@ impl Task {
                 compiled.push((schema.clone(), schema.compile(universe)?));
                 continue;
             }
-            let domains: Vec<Vec<Symbol>> =
-                schema.params.iter().map(|p| universe.objects_of(p.ty)).collect::<Result<_, _>>()?;
+            let domains: Vec<Vec<Symbol>> = schema
+                .params
+                .iter()
+                .map(|p| universe.objects_of(p.ty))
+                .collect::<Result<_, _>>()?;
             for args in tuples(&domains) {
                 let op = schema.instantiate(&args, universe)?;
                 let c = op.compile(universe)?;
@@ -261,7 +271,10 @@ impl Task {
             changing.extend(c.effects.conditional.iter().map(|e| e.atom.pred()));
         }
         let is_static = |a: Atom| !changing.contains(&a.pred());
-        let mut facts = Facts { index: FxHashMap::default(), atoms: Vec::new() };
+        let mut facts = Facts {
+            index: FxHashMap::default(),
+            atoms: Vec::new(),
+        };
         for a in init.sorted_by_text() {
             facts.id(*a);
         }
@@ -274,11 +287,24 @@ impl Task {
             let pre = facts.cond(&pre);
             let adds = c.effects.adds.iter().map(|a| facts.id(*a)).collect();
             let dels = c.effects.dels.iter().map(|a| facts.id(*a)).collect();
-            let conditional =
-                c.effects.conditional.iter().map(|e| (facts.cond(&e.condition), facts.id(e.atom), e.add)).collect();
-            ground.push(GroundAction { op, pre, adds, dels, conditional });
+            let conditional = c
+                .effects
+                .conditional
+                .iter()
+                .map(|e| (facts.cond(&e.condition), facts.id(e.atom), e.add))
+                .collect();
+            ground.push(GroundAction {
+                op,
+                pre,
+                adds,
+                dels,
+                conditional,
+            });
         }
-        Ok(Task { facts, actions: ground })
+        Ok(Task {
+            facts,
+            actions: ground,
+        })
     }
 
     /// Number of ground actions after pruning.
@@ -319,13 +345,19 @@ impl Task {
     }
 
     /// Plans from `init` to `goal`.
-    pub fn plan(&mut self, universe: &Universe, init: &State, goal: &Formula, config: &PlannerConfig) -> Result<Plan, PlanError> {
+    pub fn plan(
+        &mut self,
+        universe: &Universe,
+        init: &State,
+        goal: &Formula,
+        config: &PlannerConfig,
+    ) -> Result<Plan, PlanError> {
         let goal_ground = goal.ground(universe, &mut Default::default())?;
         let goal = self.facts.cond(&goal_ground);
         let started = Instant::now();
         let start = self.encode(init);
         let mut heuristic = Relaxed::new(self);
-        let mut nodes: Vec<(Bits, Option<(usize, usize)>, usize)> = Vec::new(); // state, (parent, action), g
+        let mut nodes: Vec<Node> = Vec::new();
         let mut seen: FxHashMap<Bits, usize> = FxHashMap::default();
         let mut open: BinaryHeap<Reverse<(u64, u64, usize)>> = BinaryHeap::new();
         let h0 = heuristic.eval(self, &start, &goal, config.heuristic);
@@ -350,7 +382,9 @@ impl Task {
             }
             expanded += 1;
             if expanded > config.max_expansions {
-                return Err(PlanError::NodeLimit { expanded: expanded - 1 });
+                return Err(PlanError::NodeLimit {
+                    expanded: expanded - 1,
+                });
             }
             if expanded % 256 == 0 && config.time_limit.is_some_and(|t| started.elapsed() > t) {
                 return Err(PlanError::TimeLimit { expanded });
@@ -378,14 +412,18 @@ impl Task {
         Err(PlanError::Unsolvable { expanded })
     }
 
-    fn extract(&self, nodes: &[(Bits, Option<(usize, usize)>, usize)], mut id: usize, expanded: usize, generated: usize) -> Plan {
+    fn extract(&self, nodes: &[Node], mut id: usize, expanded: usize, generated: usize) -> Plan {
         let mut steps = Vec::new();
         while let Some((parent, action)) = nodes[id].1 {
             steps.push(self.actions[action].op.clone());
             id = parent;
         }
         steps.reverse();
-        Plan { steps, expanded, generated }
+        Plan {
+            steps,
+            expanded,
+            generated,
+        }
     }
 }
 
@@ -400,7 +438,10 @@ const INF: u64 = u64::MAX / 4;
 impl Relaxed {
     fn new(task: &Task) -> Self {
         let n = task.facts.atoms.len();
-        Relaxed { cost: vec![INF; n], supporter: vec![None; n] }
+        Relaxed {
+            cost: vec![INF; n],
+            supporter: vec![None; n],
+        }
     }
 
     fn cond_cost(&self, c: &Cond, s: &Bits, max: bool) -> u64 {
@@ -412,7 +453,11 @@ impl Relaxed {
             Cond::Not(_) => 0,
             Cond::And(cs) => {
                 let it = cs.iter().map(|c| self.cond_cost(c, s, max));
-                if max { it.max().unwrap_or(0) } else { it.fold(0, |a, b| (a + b).min(INF)) }
+                if max {
+                    it.max().unwrap_or(0)
+                } else {
+                    it.fold(0, |a, b| (a + b).min(INF))
+                }
             }
             Cond::Or(cs) => cs.iter().map(|c| self.cond_cost(c, s, max)).min().unwrap_or(INF),
         }
@@ -447,7 +492,11 @@ impl Relaxed {
                 if c >= INF {
                     continue;
                 }
-                let effects = a.adds.iter().copied().chain(a.conditional.iter().filter(|e| e.2).map(|e| e.1));
+                let effects = a
+                    .adds
+                    .iter()
+                    .copied()
+                    .chain(a.conditional.iter().filter(|e| e.2).map(|e| e.1));
                 for f in effects {
                     if c + 1 < self.cost[f as usize] {
                         self.cost[f as usize] = c + 1;
@@ -476,10 +525,10 @@ impl Relaxed {
             if !visited.insert(f) {
                 continue;
             }
-            if let Some(ai) = self.supporter[f as usize] {
-                if used.insert(ai) {
-                    self.needed(&task.actions[ai].pre, s, &mut queue);
-                }
+            if let Some(ai) = self.supporter[f as usize]
+                && used.insert(ai)
+            {
+                self.needed(&task.actions[ai].pre, s, &mut queue);
             }
         }
         // Negative goal literals that hold now each need at least one step.
@@ -530,7 +579,11 @@ mod tests {
         let u = d.universe(&p).unwrap();
         for search in [Search::Gbfs, Search::AStar] {
             for heuristic in [Heuristic::HFf, Heuristic::HAdd, Heuristic::HMax, Heuristic::Blind] {
-                let cfg = PlannerConfig { search, heuristic, ..Default::default() };
+                let cfg = PlannerConfig {
+                    search,
+                    heuristic,
+                    ..Default::default()
+                };
                 let plan1 = plan(&d.actions, &u, &p.init, &p.goal, &cfg).unwrap();
                 let plan2 = plan(&d.actions, &u, &p.init, &p.goal, &cfg).unwrap();
                 assert_eq!(plan1, plan2);
@@ -553,7 +606,13 @@ mod tests {
         )
         .unwrap();
         let u = d.universe(&p).unwrap();
-        let cfg = PlannerConfig { heuristic: Heuristic::Blind, ..Default::default() };
-        assert!(matches!(plan(&d.actions, &u, &p.init, &p.goal, &cfg), Err(PlanError::Unsolvable { .. })));
+        let cfg = PlannerConfig {
+            heuristic: Heuristic::Blind,
+            ..Default::default()
+        };
+        assert!(matches!(
+            plan(&d.actions, &u, &p.init, &p.goal, &cfg),
+            Err(PlanError::Unsolvable { .. })
+        ));
     }
 }

@@ -74,7 +74,9 @@ impl std::str::FromStr for Tier {
         Tier::ALL
             .into_iter()
             .find(|t| t.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| format!("unknown predicate tier `{s}` (expected partial, full, extended or end_effector)"))
+            .ok_or_else(|| {
+                format!("unknown predicate tier `{s}` (expected partial, full, extended or end_effector)")
+            })
     }
 }
 
@@ -248,7 +250,9 @@ pub fn builtin_predicates() -> Vec<PredicateInfo> {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error, Serialize, Deserialize)]
 pub enum VocabularyError {
     /// A declared predicate already exists with another arity.
-    #[error("predicate `{name}` already exists with arity {existing}, cannot redeclare it with arity {declared}")]
+    #[error(
+        "predicate `{name}` already exists with arity {existing}, cannot redeclare it with arity {declared}"
+    )]
     ArityConflict {
         /// The predicate.
         name: String,
@@ -283,7 +287,9 @@ pub struct Vocabulary {
 
 impl Default for Vocabulary {
     fn default() -> Self {
-        Vocabulary { predicates: builtin_predicates() }
+        Vocabulary {
+            predicates: builtin_predicates(),
+        }
     }
 }
 
@@ -319,7 +325,10 @@ impl Vocabulary {
                     declared: info.arity,
                 });
             }
-            *existing = PredicateInfo { tiers: existing.tiers.clone(), ..info };
+            *existing = PredicateInfo {
+                tiers: existing.tiers.clone(),
+                ..info
+            };
             return Ok(());
         }
         self.predicates.push(info);
@@ -346,7 +355,9 @@ impl Vocabulary {
     /// Checks that an atom-shaped use of a predicate matches its declaration.
     pub fn check_use(&self, name: Symbol, arity: usize) -> Result<(), VocabularyError> {
         match self.get(name) {
-            None => Err(VocabularyError::Unknown { name: name.to_string() }),
+            None => Err(VocabularyError::Unknown {
+                name: name.to_string(),
+            }),
             Some(p) if p.arity != arity => Err(VocabularyError::WrongArity {
                 name: name.to_string(),
                 expected: p.arity,
@@ -358,13 +369,20 @@ impl Vocabulary {
 
     /// The predicates a tier shows: the built-ins of the tier, then every extra.
     pub fn tier(&self, tier: Tier) -> Vec<&PredicateInfo> {
-        self.predicates.iter().filter(|p| p.tiers.is_empty() || p.tiers.contains(&tier)).collect()
+        self.predicates
+            .iter()
+            .filter(|p| p.tiers.is_empty() || p.tiers.contains(&tier))
+            .collect()
     }
 
     /// The "predicate definitions" block a prompt embeds: one
     /// `(Name ?a ?b): definition` line per predicate of the tier.
     pub fn render_definitions(&self, tier: Tier) -> String {
-        self.tier(tier).iter().map(|p| p.definition_line()).collect::<Vec<_>>().join("\n")
+        self.tier(tier)
+            .iter()
+            .map(|p| p.definition_line())
+            .collect::<Vec<_>>()
+            .join("\n")
     }
 }
 
@@ -376,20 +394,48 @@ mod tests {
     fn tiers_match_the_spec() {
         let v = Vocabulary::new();
         let names = |t| v.tier(t).iter().map(|p| p.name.as_str()).collect::<Vec<_>>();
-        assert_eq!(names(Tier::Partial), ["OverOf", "OnTopOf", "InsideOf", "GripperSurrounding", "GripperHolding"]);
+        assert_eq!(
+            names(Tier::Partial),
+            [
+                "OverOf",
+                "OnTopOf",
+                "InsideOf",
+                "GripperSurrounding",
+                "GripperHolding"
+            ]
+        );
         assert_eq!(names(Tier::Full).len(), 9);
         assert_eq!(names(Tier::Extended).len(), 15);
         assert_eq!(
             names(Tier::EndEffector),
-            ["FingerGripper", "VacuumSuction", "GripperOpen", "GripperClosed", "VacuumActive", "VacuumInactive"]
+            [
+                "FingerGripper",
+                "VacuumSuction",
+                "GripperOpen",
+                "GripperClosed",
+                "VacuumActive",
+                "VacuumInactive"
+            ]
         );
     }
 
     #[test]
     fn extras_and_rendering() {
         let mut v = Vocabulary::new();
-        v.declare("Finegrained", &["x"], Category::Physics, "?x consists of many small loose parts.").unwrap();
-        v.declare("Gathered", &["x"], Category::Physics, "the parts of ?x lie together in one pile.").unwrap();
+        v.declare(
+            "Finegrained",
+            &["x"],
+            Category::Physics,
+            "?x consists of many small loose parts.",
+        )
+        .unwrap();
+        v.declare(
+            "Gathered",
+            &["x"],
+            Category::Physics,
+            "the parts of ?x lie together in one pile.",
+        )
+        .unwrap();
         assert!(v.declare("Gathered", &["x", "y"], Category::Physics, "").is_err());
         let block = v.render_definitions(Tier::Partial);
         assert!(block.starts_with("(OverOf ?a ?b): "));

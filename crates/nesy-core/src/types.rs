@@ -72,7 +72,11 @@ impl TypeHierarchy {
 
     /// Canonical symbol of a type name: `object` means the root.
     pub fn canonical(name: Symbol) -> Symbol {
-        if name.as_str() == PDDL_ROOT_TYPE { Symbol::new(ROOT_TYPE) } else { name }
+        if name.as_str() == PDDL_ROOT_TYPE {
+            Symbol::new(ROOT_TYPE)
+        } else {
+            name
+        }
     }
 
     /// Declares `name` as a subtype of `parent` (declaring the parent as a child of the root
@@ -83,14 +87,17 @@ impl TypeHierarchy {
         if name.as_str() == ROOT_TYPE {
             return Ok(());
         }
-        if !self.parents.contains_key(&parent) {
-            self.parents.insert(parent, Some(Symbol::new(ROOT_TYPE)));
-        }
+        self.parents
+            .entry(parent)
+            .or_insert_with(|| Some(Symbol::new(ROOT_TYPE)));
         // Reject cycles: walking up from the parent must not reach `name`.
         let mut cursor = Some(parent);
         while let Some(t) = cursor {
             if t == name {
-                return Err(TypeError::Cycle { name: name.to_string(), via: parent.to_string() });
+                return Err(TypeError::Cycle {
+                    name: name.to_string(),
+                    via: parent.to_string(),
+                });
             }
             cursor = self.parents.get(&t).copied().flatten();
         }
@@ -109,7 +116,10 @@ impl TypeHierarchy {
         if self.parents.contains_key(&canonical) {
             Ok(canonical)
         } else {
-            Err(TypeError::UnknownType { name: name.to_string(), known: self.known_list() })
+            Err(TypeError::UnknownType {
+                name: name.to_string(),
+                known: self.known_list(),
+            })
         }
     }
 
@@ -218,7 +228,12 @@ impl Universe {
     /// The objects of type `ty` or a subtype, in insertion order. Unknown types are errors.
     pub fn objects_of(&self, ty: Symbol) -> Result<Vec<Symbol>, TypeError> {
         let ty = self.types.check(ty)?;
-        Ok(self.objects.iter().filter(|(_, t)| self.types.is_subtype(*t, ty)).map(|(o, _)| *o).collect())
+        Ok(self
+            .objects
+            .iter()
+            .filter(|(_, t)| self.types.is_subtype(*t, ty))
+            .map(|(o, _)| *o)
+            .collect())
     }
 }
 
@@ -241,7 +256,10 @@ mod tests {
         assert_eq!(u.objects_of(s("fruit")).unwrap(), vec![s("orange"), s("apple")]);
         assert_eq!(u.objects_of(s("thing")).unwrap().len(), 3);
         assert_eq!(u.objects_of(s("object")).unwrap().len(), 3);
-        assert!(matches!(u.objects_of(s("vegetable")), Err(TypeError::UnknownType { .. })));
+        assert!(matches!(
+            u.objects_of(s("vegetable")),
+            Err(TypeError::UnknownType { .. })
+        ));
         assert!(u.add(s("orange"), s("fruit")).is_err());
         assert!(u.types.declare(s("fruit"), s("citrus")).is_err());
     }

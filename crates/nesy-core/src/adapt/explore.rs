@@ -1,7 +1,9 @@
 //! Counterfactual identification (Eq. 6) and exploration with verified patches (Eq. 7–8).
 
 use super::reasoner::{Feedback, PatchRequest, Problem, Reasoner, ViolationKind};
-use super::{AdaptConfig, AdaptError, Outcome, Target, Trace, TraceEvent, Verdict, ViolationInfo, WorldModel};
+use super::{
+    AdaptConfig, AdaptError, Outcome, Target, Trace, TraceEvent, Verdict, ViolationInfo, WorldModel,
+};
 use crate::exec::{Report, UnmetPrecondition, format_unmet, implicit_universe, verify_procedure_in};
 use crate::formula::Formula;
 use crate::operator::Operator;
@@ -11,7 +13,12 @@ use crate::text::parse_refinement_reply;
 
 /// Verifies `procedure` from `init` towards `goal` over the universe of the target's
 /// objects plus every constant the procedure and goal mention.
-fn verify(init: &State, target_objects: &[crate::symbol::Symbol], procedure: &[Operator], goal: &Formula) -> Report {
+fn verify(
+    init: &State,
+    target_objects: &[crate::symbol::Symbol],
+    procedure: &[Operator],
+    goal: &Formula,
+) -> Report {
     let mut universe = implicit_universe(init, procedure, Some(goal));
     for o in target_objects {
         universe.add_thing(*o);
@@ -56,7 +63,12 @@ type Progress = (bool, bool, std::cmp::Reverse<usize>, std::cmp::Reverse<usize>)
 fn progress(report: &Report) -> Progress {
     let unmet = identify_unmet(report).map_or(0, |u| u.len());
     let left = report.first_failure.map_or(0, |f| report.steps.len() - f);
-    (report.is_valid(), report.first_failure.is_none(), std::cmp::Reverse(left), std::cmp::Reverse(unmet))
+    (
+        report.is_valid(),
+        report.first_failure.is_none(),
+        std::cmp::Reverse(left),
+        std::cmp::Reverse(unmet),
+    )
 }
 
 fn identify_unmet(report: &Report) -> Option<Vec<UnmetPrecondition>> {
@@ -98,13 +110,24 @@ pub fn resolves(violation: &ViolationInfo, applied: &AppliedPatch, report: &Repo
             if (applied.at..applied.at + applied.removed).contains(&p) {
                 return Ok(()); // the erroneous action itself was replaced or removed
             }
-            let shifted = if p >= applied.at + applied.removed { p - applied.removed + applied.inserted } else { p };
+            let shifted = if p >= applied.at + applied.removed {
+                p - applied.removed + applied.inserted
+            } else {
+                p
+            };
             match report.first_failure {
                 None => Ok(()),
                 Some(f) if f > shifted => Ok(()),
                 Some(f) if f == shifted => {
-                    let now = report.first_violation().map(|v| v.unmet.clone()).unwrap_or_default();
-                    if strict_subset(&now, &violation.unmet) { Ok(()) } else { Err(not_resolved()) }
+                    let now = report
+                        .first_violation()
+                        .map(|v| v.unmet.clone())
+                        .unwrap_or_default();
+                    if strict_subset(&now, &violation.unmet) {
+                        Ok(())
+                    } else {
+                        Err(not_resolved())
+                    }
                 }
                 Some(_) => Err(not_resolved()),
             }
@@ -129,13 +152,19 @@ fn describe(problem: &Problem, procedure: &[Operator]) -> String {
             "The reply held {count} SEARCH/REPLACE blocks; exactly one is required. Nothing was applied."
         ),
         Problem::PatchDidNotApply { error } => format!("The patch was not applied: {error}."),
-        Problem::NotResolved { failing_step: Some(i), unmet } => format!(
+        Problem::NotResolved {
+            failing_step: Some(i),
+            unmet,
+        } => format!(
             "After the patch the procedure still fails at step {} ({}) with these unfulfilled preconditions:\n{}",
             i + 1,
             procedure.get(*i).map_or_else(String::new, |o| o.display_name()),
             format_unmet(unmet)
         ),
-        Problem::NotResolved { failing_step: None, unmet } => format!(
+        Problem::NotResolved {
+            failing_step: None,
+            unmet,
+        } => format!(
             "After the patch every action applies but these goal conditions still do not hold:\n{}",
             format_unmet(unmet)
         ),
@@ -176,15 +205,28 @@ pub async fn explore<R: Reasoner>(
     let mut revised = false;
     loop {
         if ablation.identification || ablation.verification {
-            trace.events.push(TraceEvent::Identification { iteration, procedure: procedure.clone(), report: report.clone() });
+            trace.events.push(TraceEvent::Identification {
+                iteration,
+                procedure: procedure.clone(),
+                report: report.clone(),
+            });
         }
         let violation = identify(&report, &procedure);
         let finished = if single_shot { revised } else { violation.is_none() };
         if finished || iteration >= config.budget {
             let outcome = if report.is_valid() {
-                Outcome::Adapted { procedure, report, iterations: iteration }
+                Outcome::Adapted {
+                    procedure,
+                    report,
+                    iterations: iteration,
+                }
             } else {
-                Outcome::Unresolved { best: best.1, last: procedure, last_violation, iterations: iteration }
+                Outcome::Unresolved {
+                    best: best.1,
+                    last: procedure,
+                    last_violation,
+                    iterations: iteration,
+                }
             };
             return Ok(ExplorationResult { outcome });
         }
@@ -233,7 +275,13 @@ pub async fn explore<R: Reasoner>(
         let visible = if ablation.identification {
             violation.clone()
         } else {
-            ViolationInfo { kind: ViolationKind::Unidentified, failing_step: None, action: None, unmet: vec![], state: target.init.clone() }
+            ViolationInfo {
+                kind: ViolationKind::Unidentified,
+                failing_step: None,
+                action: None,
+                unmet: vec![],
+                state: target.init.clone(),
+            }
         };
         last_violation = Some(violation.clone());
         let reply = reasoner.propose_patch(&request).await?;
@@ -241,11 +289,21 @@ pub async fn explore<R: Reasoner>(
         iteration += 1;
 
         let parsed = parse_refinement_reply(&reply);
-        let near = visible.failing_step.unwrap_or(if visible.kind == ViolationKind::Goal { procedure.len() } else { 0 });
+        let near = visible
+            .failing_step
+            .unwrap_or(if visible.kind == ViolationKind::Goal {
+                procedure.len()
+            } else {
+                0
+            });
         let attempt: Result<(AppliedPatch, Report), Problem> = (|| {
-            let r = parsed.as_ref().map_err(|e| Problem::Unparsable { error: e.clone() })?;
+            let r = parsed
+                .as_ref()
+                .map_err(|e| Problem::Unparsable { error: e.clone() })?;
             if r.patches.len() > 1 {
-                return Err(Problem::MultiplePatches { count: r.patches.len() });
+                return Err(Problem::MultiplePatches {
+                    count: r.patches.len(),
+                });
             }
             let applied = apply_patch(&procedure, &r.patches[0], near)
                 .map_err(|error| Problem::PatchDidNotApply { error })?;
@@ -269,7 +327,9 @@ pub async fn explore<R: Reasoner>(
                     iteration: this_iteration,
                     reply,
                     parsed,
-                    verdict: Verdict::Accepted { checked: ablation.verification },
+                    verdict: Verdict::Accepted {
+                        checked: ablation.verification,
+                    },
                     procedure_after: Some(applied.procedure.clone()),
                 });
                 procedure = applied.procedure;

@@ -71,22 +71,45 @@ pub struct Ablation {
 
 impl Default for Ablation {
     fn default() -> Self {
-        Ablation { world_model: true, identification: true, verification: true }
+        Ablation {
+            world_model: true,
+            identification: true,
+            verification: true,
+        }
     }
 }
 
 impl Ablation {
     /// The full method.
-    pub const FULL: Ablation = Ablation { world_model: true, identification: true, verification: true };
+    pub const FULL: Ablation = Ablation {
+        world_model: true,
+        identification: true,
+        verification: true,
+    };
     /// w/o Eq. 8.
-    pub const NO_VERIFICATION: Ablation = Ablation { world_model: true, identification: true, verification: false };
+    pub const NO_VERIFICATION: Ablation = Ablation {
+        world_model: true,
+        identification: true,
+        verification: false,
+    };
     /// w/o Eq. 6.
-    pub const NO_IDENTIFICATION: Ablation = Ablation { world_model: true, identification: false, verification: true };
+    pub const NO_IDENTIFICATION: Ablation = Ablation {
+        world_model: true,
+        identification: false,
+        verification: true,
+    };
     /// w/o Eq. 6 & Eq. 8.
-    pub const NO_IDENTIFICATION_NO_VERIFICATION: Ablation =
-        Ablation { world_model: true, identification: false, verification: false };
+    pub const NO_IDENTIFICATION_NO_VERIFICATION: Ablation = Ablation {
+        world_model: true,
+        identification: false,
+        verification: false,
+    };
     /// w/o Eq. 3.
-    pub const NO_WORLD_MODEL: Ablation = Ablation { world_model: false, identification: true, verification: true };
+    pub const NO_WORLD_MODEL: Ablation = Ablation {
+        world_model: false,
+        identification: true,
+        verification: true,
+    };
 }
 
 /// Loop settings.
@@ -104,7 +127,12 @@ pub struct AdaptConfig {
 
 impl Default for AdaptConfig {
     fn default() -> Self {
-        AdaptConfig { induction_tries: 5, budget: 10, transition_check: TransitionCheck::Exact, ablation: Ablation::FULL }
+        AdaptConfig {
+            induction_tries: 5,
+            budget: 10,
+            transition_check: TransitionCheck::Exact,
+            ablation: Ablation::FULL,
+        }
     }
 }
 
@@ -139,8 +167,16 @@ pub enum Complexity {
 /// The exploration budget of spec §7 and the paper's hyper-parameter table: 10, or 15 for
 /// the combination factor, doubled at high complexity (20 / 30).
 pub fn iteration_budget(factor: DomainFactor, complexity: Complexity) -> usize {
-    let base = if factor == DomainFactor::Combination { 15 } else { 10 };
-    if complexity == Complexity::High { base * 2 } else { base }
+    let base = if factor == DomainFactor::Combination {
+        15
+    } else {
+        10
+    };
+    if complexity == Complexity::High {
+        base * 2
+    } else {
+        base
+    }
 }
 
 /// The goal-relevant atoms of a demonstration: atoms true in the last state whose
@@ -355,7 +391,11 @@ pub async fn run<R: Reasoner>(
     let mut trace = Trace::default();
     let world_model = construct_world_model(reasoner, demo, config, &mut trace).await?;
     let result = explore(reasoner, &world_model, target, config, &mut trace).await?;
-    Ok(Adaptation { world_model, outcome: result.outcome, trace })
+    Ok(Adaptation {
+        world_model,
+        outcome: result.outcome,
+        trace,
+    })
 }
 
 #[cfg(test)]

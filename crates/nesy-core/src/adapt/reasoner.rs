@@ -35,7 +35,11 @@ impl TaskContext {
 
     /// The objects as a comma-separated list.
     pub fn object_list(&self) -> String {
-        self.objects.iter().map(|o| o.as_str()).collect::<Vec<_>>().join(", ")
+        self.objects
+            .iter()
+            .map(|o| o.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 }
 
@@ -172,7 +176,9 @@ impl PatchRequest {
 
     /// The erroneous action as an action block (`None` if there is none).
     pub fn erroneous_text(&self) -> String {
-        self.erroneous.as_ref().map_or_else(|| "None".to_string(), |o| o.to_string())
+        self.erroneous
+            .as_ref()
+            .map_or_else(|| "None".to_string(), |o| o.to_string())
     }
 
     /// The remaining actions as action blocks (`None` if empty).
@@ -193,7 +199,9 @@ pub struct ReasonerError {
 impl ReasonerError {
     /// An error with a message.
     pub fn new(message: impl Into<String>) -> Self {
-        ReasonerError { message: message.into() }
+        ReasonerError {
+            message: message.into(),
+        }
     }
 }
 
@@ -205,9 +213,15 @@ impl ReasonerError {
 pub trait Reasoner {
     /// Induces the operator of one demonstrated transition: a reply in the Action
     /// Prediction format (see [`crate::text::parse_induction_reply`]).
-    fn induce_operator(&mut self, request: &InductionRequest) -> impl Future<Output = Result<String, ReasonerError>> + Send;
+    fn induce_operator(
+        &mut self,
+        request: &InductionRequest,
+    ) -> impl Future<Output = Result<String, ReasonerError>> + Send;
 
     /// Proposes a patch for a violation: a reply in the Refinement Proposal format (see
     /// [`crate::text::parse_refinement_reply`]).
-    fn propose_patch(&mut self, request: &PatchRequest) -> impl Future<Output = Result<String, ReasonerError>> + Send;
+    fn propose_patch(
+        &mut self,
+        request: &PatchRequest,
+    ) -> impl Future<Output = Result<String, ReasonerError>> + Send;
 }

@@ -20,12 +20,16 @@ struct Scripted {
 impl Reasoner for Scripted {
     async fn induce_operator(&mut self, request: &InductionRequest) -> Result<String, ReasonerError> {
         self.induction_requests.push(request.clone());
-        self.induction.pop_front().ok_or_else(|| ReasonerError::new("script exhausted (induction)"))
+        self.induction
+            .pop_front()
+            .ok_or_else(|| ReasonerError::new("script exhausted (induction)"))
     }
 
     async fn propose_patch(&mut self, request: &PatchRequest) -> Result<String, ReasonerError> {
         self.patch_requests.push(request.clone());
-        self.patches.pop_front().ok_or_else(|| ReasonerError::new("script exhausted (patch)"))
+        self.patches
+            .pop_front()
+            .ok_or_else(|| ReasonerError::new("script exhausted (patch)"))
     }
 }
 
@@ -36,7 +40,10 @@ fn state(atoms: &[&str]) -> State {
 fn task() -> TaskContext {
     TaskContext {
         instruction: "Put the fruits in the hinge box.".into(),
-        objects: ["orange", "hinge_body", "hinge_lid", "floor"].iter().map(|o| Symbol::new(o)).collect(),
+        objects: ["orange", "hinge_body", "hinge_lid", "floor"]
+            .iter()
+            .map(|o| Symbol::new(o))
+            .collect(),
         tier: Tier::Full,
         vocabulary: Vocabulary::new(),
     }
@@ -44,17 +51,52 @@ fn task() -> TaskContext {
 
 fn demo() -> Demonstration {
     let s0 = state(&["(GripperOpen)", "(OnTopOf orange floor)", "(Open hinge_lid)"]);
-    let s1 = state(&["(GripperOpen)", "(GripperSurrounding orange)", "(OnTopOf orange floor)", "(Open hinge_lid)"]);
-    let s2 = state(&["(GripperClosed)", "(GripperHolding orange)", "(OnTopOf orange floor)", "(Open hinge_lid)"]);
-    let s3 = state(&["(GripperClosed)", "(GripperHolding orange)", "(OverOf orange hinge_body)", "(Open hinge_lid)"]);
-    let s4 = state(&["(GripperOpen)", "(InsideOf orange hinge_body)", "(Open hinge_lid)"]);
-    Demonstration { states: vec![s0, s1, s2, s3, s4], task: task() }
+    let s1 = state(&[
+        "(GripperOpen)",
+        "(GripperSurrounding orange)",
+        "(OnTopOf orange floor)",
+        "(Open hinge_lid)",
+    ]);
+    let s2 = state(&[
+        "(GripperClosed)",
+        "(GripperHolding orange)",
+        "(OnTopOf orange floor)",
+        "(Open hinge_lid)",
+    ]);
+    let s3 = state(&[
+        "(GripperClosed)",
+        "(GripperHolding orange)",
+        "(OverOf orange hinge_body)",
+        "(Open hinge_lid)",
+    ]);
+    let s4 = state(&[
+        "(GripperOpen)",
+        "(InsideOf orange hinge_body)",
+        "(Open hinge_lid)",
+    ]);
+    Demonstration {
+        states: vec![s0, s1, s2, s3, s4],
+        task: task(),
+    }
 }
 
 fn induction_reply(name: &str, pre: &[&str], eff: &[&str]) -> String {
-    let pre = if pre.is_empty() { "None".to_string() } else { pre.iter().map(|p| format!("- {p}")).collect::<Vec<_>>().join("\n") };
-    let eff = eff.iter().map(|p| format!("- {p}")).collect::<Vec<_>>().join("\n");
-    format!("* Prediction Rationale:\n- Reasoning about {name}.\n\n* Predicted Action:\nAction Semantic:\n- {name}\nPrecondition:\n{pre}\nEffect:\n{eff}\n")
+    let pre = if pre.is_empty() {
+        "None".to_string()
+    } else {
+        pre.iter()
+            .map(|p| format!("- {p}"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let eff = eff
+        .iter()
+        .map(|p| format!("- {p}"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    format!(
+        "* Prediction Rationale:\n- Reasoning about {name}.\n\n* Predicted Action:\nAction Semantic:\n- {name}\nPrecondition:\n{pre}\nEffect:\n{eff}\n"
+    )
 }
 
 const APPROACH: (&str, &[&str], &[&str]) = (
@@ -65,7 +107,12 @@ const APPROACH: (&str, &[&str], &[&str]) = (
 const GRASP: (&str, &[&str], &[&str]) = (
     "Close gripper to grasp orange",
     &["(GripperSurrounding orange)", "(GripperOpen)"],
-    &["(GripperClosed)", "(GripperHolding orange)", "(not (GripperOpen))", "(not (GripperSurrounding orange))"],
+    &[
+        "(GripperClosed)",
+        "(GripperHolding orange)",
+        "(not (GripperOpen))",
+        "(not (GripperSurrounding orange))",
+    ],
 );
 const LIFT: (&str, &[&str], &[&str]) = (
     "Move held orange over hinge body",
@@ -74,17 +121,40 @@ const LIFT: (&str, &[&str], &[&str]) = (
 );
 const DROP: (&str, &[&str], &[&str]) = (
     "Open gripper to drop orange into hinge body",
-    &["(GripperHolding orange)", "(OverOf orange hinge_body)", "(not (Closed hinge_lid))"],
-    &["(InsideOf orange hinge_body)", "(GripperOpen)", "(not (GripperClosed))", "(not (GripperHolding orange))", "(not (OverOf orange hinge_body))"],
+    &[
+        "(GripperHolding orange)",
+        "(OverOf orange hinge_body)",
+        "(not (Closed hinge_lid))",
+    ],
+    &[
+        "(InsideOf orange hinge_body)",
+        "(GripperOpen)",
+        "(not (GripperClosed))",
+        "(not (GripperHolding orange))",
+        "(not (OverOf orange hinge_body))",
+    ],
 );
 
 fn good_inductions() -> VecDeque<String> {
-    [APPROACH, GRASP, LIFT, DROP].iter().map(|(n, p, e)| induction_reply(n, p, e)).collect()
+    [APPROACH, GRASP, LIFT, DROP]
+        .iter()
+        .map(|(n, p, e)| induction_reply(n, p, e))
+        .collect()
 }
 
 fn block(name: &str, pre: &[&str], eff: &[&str]) -> String {
-    let section = |xs: &[&str]| if xs.is_empty() { "\tNone".to_string() } else { xs.iter().map(|x| format!("\t{x}")).collect::<Vec<_>>().join("\n") };
-    format!("{name}\n- Preconditions:\n{}\n- Effects:\n{}", section(pre), section(eff))
+    let section = |xs: &[&str]| {
+        if xs.is_empty() {
+            "\tNone".to_string()
+        } else {
+            xs.iter().map(|x| format!("\t{x}")).collect::<Vec<_>>().join("\n")
+        }
+    };
+    format!(
+        "{name}\n- Preconditions:\n{}\n- Effects:\n{}",
+        section(pre),
+        section(eff)
+    )
 }
 
 fn drop_block() -> String {
@@ -100,11 +170,16 @@ fn open_lid_block() -> String {
 }
 
 fn refinement(search: &str, replace: &str) -> String {
-    format!("* Refinement rationale:\n- The lid is closed in the deployment scene.\n\n* Refinement patch:\n```\n<<<<<<< SEARCH\n{search}\n=======\n{replace}\n>>>>>>> REPLACE\n```\n")
+    format!(
+        "* Refinement rationale:\n- The lid is closed in the deployment scene.\n\n* Refinement patch:\n```\n<<<<<<< SEARCH\n{search}\n=======\n{replace}\n>>>>>>> REPLACE\n```\n"
+    )
 }
 
 fn target() -> Target {
-    Target { init: state(&["(GripperOpen)", "(OnTopOf orange floor)", "(Closed hinge_lid)"]), task: task() }
+    Target {
+        init: state(&["(GripperOpen)", "(OnTopOf orange floor)", "(Closed hinge_lid)"]),
+        task: task(),
+    }
 }
 
 #[test]
@@ -112,22 +187,38 @@ fn world_model_reprediction_with_feedback() {
     let mut r = Scripted::default();
     // Transition 0: first an unparsable reply, then one whose effects miss an atom, then right.
     r.induction.push_back("I think the robot moved.".into());
-    r.induction.push_back(induction_reply(APPROACH.0, APPROACH.1, &["(GripperClosed)"]));
+    r.induction
+        .push_back(induction_reply(APPROACH.0, APPROACH.1, &["(GripperClosed)"]));
     r.induction.extend(good_inductions());
     let mut trace = Trace::default();
-    let wm = pollster::block_on(construct_world_model(&mut r, &demo(), &AdaptConfig::default(), &mut trace)).unwrap();
+    let wm = pollster::block_on(construct_world_model(
+        &mut r,
+        &demo(),
+        &AdaptConfig::default(),
+        &mut trace,
+    ))
+    .unwrap();
     assert!(wm.is_verified());
     assert_eq!(wm.procedure.len(), 4);
     assert_eq!(wm.procedure[0].name, "MoveGripperToSurroundOrange");
     assert_eq!(wm.goal.to_string(), "(and (InsideOf orange hinge_body))");
     // The second and third requests for transition 0 carry the verifier's feedback.
     assert_eq!(r.induction_requests[1].feedback.len(), 1);
-    assert!(matches!(r.induction_requests[1].feedback[0].problem, Problem::Unparsable { .. }));
+    assert!(matches!(
+        r.induction_requests[1].feedback[0].problem,
+        Problem::Unparsable { .. }
+    ));
     let fb = &r.induction_requests[2].feedback[1];
-    let Problem::EffectMismatch { missing, unexpected } = &fb.problem else { panic!("{fb:?}") };
+    let Problem::EffectMismatch { missing, unexpected } = &fb.problem else {
+        panic!("{fb:?}")
+    };
     assert_eq!(missing, &vec![Atom::new("GripperSurrounding", &["orange"])]);
     assert_eq!(unexpected, &vec![Atom::new("GripperClosed", &[])]);
-    assert!(fb.message.contains("- (GripperSurrounding orange)"), "{}", fb.message);
+    assert!(
+        fb.message.contains("- (GripperSurrounding orange)"),
+        "{}",
+        fb.message
+    );
     assert_eq!(r.induction_requests[3].step, 1);
     assert_eq!(r.induction_requests[3].diff.added.len(), 2);
 }
@@ -135,50 +226,108 @@ fn world_model_reprediction_with_feedback() {
 #[test]
 fn world_model_rejects_unmet_preconditions_and_keeps_precondition_free_operators() {
     let mut r = Scripted::default();
-    r.induction.push_back(induction_reply(APPROACH.0, &["(GripperClosed)"], APPROACH.2));
-    r.induction.push_back(induction_reply(APPROACH.0, &[], APPROACH.2));
+    r.induction
+        .push_back(induction_reply(APPROACH.0, &["(GripperClosed)"], APPROACH.2));
+    r.induction
+        .push_back(induction_reply(APPROACH.0, &[], APPROACH.2));
     r.induction.extend(good_inductions().into_iter().skip(1));
     let mut trace = Trace::default();
-    let wm = pollster::block_on(construct_world_model(&mut r, &demo(), &AdaptConfig::default(), &mut trace)).unwrap();
-    assert!(wm.procedure[0].pre.is_empty(), "an operator without preconditions is kept, not dropped");
+    let wm = pollster::block_on(construct_world_model(
+        &mut r,
+        &demo(),
+        &AdaptConfig::default(),
+        &mut trace,
+    ))
+    .unwrap();
+    assert!(
+        wm.procedure[0].pre.is_empty(),
+        "an operator without preconditions is kept, not dropped"
+    );
     let fb = &r.induction_requests[1].feedback[0];
-    assert!(matches!(&fb.problem, Problem::PreconditionsUnmet { unmet } if unmet[0].literal.to_string() == "(GripperClosed)"));
+    assert!(
+        matches!(&fb.problem, Problem::PreconditionsUnmet { unmet } if unmet[0].literal.to_string() == "(GripperClosed)")
+    );
 }
 
 #[test]
 fn unverifiable_transition_is_recorded_not_hidden() {
     let mut r = Scripted::default();
     for _ in 0..2 {
-        r.induction.push_back(induction_reply(APPROACH.0, APPROACH.1, &["(GripperClosed)"]));
+        r.induction
+            .push_back(induction_reply(APPROACH.0, APPROACH.1, &["(GripperClosed)"]));
     }
     r.induction.extend(good_inductions().into_iter().skip(1));
-    let config = AdaptConfig { induction_tries: 2, ..Default::default() };
-    let wm = pollster::block_on(construct_world_model(&mut r, &demo(), &config, &mut Trace::default())).unwrap();
+    let config = AdaptConfig {
+        induction_tries: 2,
+        ..Default::default()
+    };
+    let wm = pollster::block_on(construct_world_model(
+        &mut r,
+        &demo(),
+        &config,
+        &mut Trace::default(),
+    ))
+    .unwrap();
     assert_eq!(wm.unverified_steps, vec![0]);
     // Without world-model verification the wrong operator is accepted at once.
     let mut r = Scripted::default();
-    r.induction.push_back(induction_reply(APPROACH.0, APPROACH.1, &["(GripperClosed)"]));
+    r.induction
+        .push_back(induction_reply(APPROACH.0, APPROACH.1, &["(GripperClosed)"]));
     r.induction.extend(good_inductions().into_iter().skip(1));
-    let config = AdaptConfig { ablation: Ablation::NO_WORLD_MODEL, ..Default::default() };
-    let wm = pollster::block_on(construct_world_model(&mut r, &demo(), &config, &mut Trace::default())).unwrap();
+    let config = AdaptConfig {
+        ablation: Ablation::NO_WORLD_MODEL,
+        ..Default::default()
+    };
+    let wm = pollster::block_on(construct_world_model(
+        &mut r,
+        &demo(),
+        &config,
+        &mut Trace::default(),
+    ))
+    .unwrap();
     assert!(wm.is_verified());
     assert_eq!(r.induction_requests.len(), 4);
 }
 
 #[test]
 fn exploration_rejects_bad_proposals_then_adapts() {
-    let mut r = Scripted::default();
-    r.induction = good_inductions();
+    let mut r = Scripted {
+        induction: good_inductions(),
+        ..Default::default()
+    };
     // 1: unparsable; 2: SEARCH does not match; 3: parses and matches but does not fix the
     // lid; 4: two patches; 5: the fix.
-    r.patches.push_back("Let me think about the lid... no patch today.".into());
-    r.patches.push_back(refinement(&block("OpenGripperToDropOrangeIntoHingeBody", &["(GripperHolding orange)"], DROP.2), &open_lid_block()));
-    r.patches.push_back(refinement(&drop_block(), &format!("{}\n\n{}", block("Wiggle", &["(GripperHolding orange)"], &["(Wiggled)"]), drop_block())));
-    let fix = refinement(&drop_block(), &format!("{}\n\n{}", open_lid_block(), drop_block()));
+    r.patches
+        .push_back("Let me think about the lid... no patch today.".into());
+    r.patches.push_back(refinement(
+        &block(
+            "OpenGripperToDropOrangeIntoHingeBody",
+            &["(GripperHolding orange)"],
+            DROP.2,
+        ),
+        &open_lid_block(),
+    ));
+    r.patches.push_back(refinement(
+        &drop_block(),
+        &format!(
+            "{}\n\n{}",
+            block("Wiggle", &["(GripperHolding orange)"], &["(Wiggled)"]),
+            drop_block()
+        ),
+    ));
+    let fix = refinement(
+        &drop_block(),
+        &format!("{}\n\n{}", open_lid_block(), drop_block()),
+    );
     r.patches.push_back(format!("{fix}\n{fix}"));
     r.patches.push_back(fix.clone());
     let adaptation = pollster::block_on(run(&mut r, &demo(), &target(), &AdaptConfig::default())).unwrap();
-    let Outcome::Adapted { procedure, report, iterations } = &adaptation.outcome else {
+    let Outcome::Adapted {
+        procedure,
+        report,
+        iterations,
+    } = &adaptation.outcome
+    else {
         panic!("{:?}", adaptation.outcome)
     };
     assert_eq!(*iterations, 5);
@@ -190,7 +339,10 @@ fn exploration_rejects_bad_proposals_then_adapts() {
     let first = &r.patch_requests[0];
     assert_eq!(first.kind, ViolationKind::Precondition);
     assert_eq!(first.failing_step, Some(3));
-    assert_eq!(first.erroneous.as_ref().unwrap().name, "OpenGripperToDropOrangeIntoHingeBody");
+    assert_eq!(
+        first.erroneous.as_ref().unwrap().name,
+        "OpenGripperToDropOrangeIntoHingeBody"
+    );
     assert_eq!(first.unfulfilled_preconditions(), "- (not (Closed hinge_lid))");
     assert!(first.error_state.contains(&Atom::new("Closed", &["hinge_lid"])));
     assert_eq!(first.executed.len(), 3);
@@ -199,12 +351,31 @@ fn exploration_rejects_bad_proposals_then_adapts() {
     let kinds: Vec<&Problem> = r.patch_requests[4].feedback.iter().map(|f| &f.problem).collect();
     assert!(matches!(kinds[0], Problem::Unparsable { .. }));
     assert!(matches!(kinds[1], Problem::PatchDidNotApply { .. }));
-    assert!(matches!(kinds[2], Problem::NotResolved { failing_step: Some(4), .. }), "{:?}", kinds[2]);
+    assert!(
+        matches!(
+            kinds[2],
+            Problem::NotResolved {
+                failing_step: Some(4),
+                ..
+            }
+        ),
+        "{:?}",
+        kinds[2]
+    );
     assert!(matches!(kinds[3], Problem::MultiplePatches { count: 2 }));
-    assert!(r.patch_requests[4].feedback[1].message.contains("closest candidate"));
+    assert!(
+        r.patch_requests[4].feedback[1]
+            .message
+            .contains("closest candidate")
+    );
 
     // The trace records every proposal and serialises.
-    let proposals = adaptation.trace.events.iter().filter(|e| matches!(e, TraceEvent::Proposal { .. })).count();
+    let proposals = adaptation
+        .trace
+        .events
+        .iter()
+        .filter(|e| matches!(e, TraceEvent::Proposal { .. }))
+        .count();
     assert_eq!(proposals, 5);
     let json = serde_json::to_string(&adaptation).unwrap();
     let back: Adaptation = serde_json::from_str(&json).unwrap();
@@ -213,17 +384,33 @@ fn exploration_rejects_bad_proposals_then_adapts() {
 
 #[test]
 fn removal_then_goal_violation_then_budget() {
-    let mut r = Scripted::default();
-    r.induction = good_inductions();
+    let mut r = Scripted {
+        induction: good_inductions(),
+        ..Default::default()
+    };
     // Removing the erroneous drop resolves that violation but leaves the goal unmet.
     r.patches.push_back(refinement(&drop_block(), ""));
     r.patches.push_back("still no patch".into());
-    let config = AdaptConfig { budget: 2, ..Default::default() };
+    let config = AdaptConfig {
+        budget: 2,
+        ..Default::default()
+    };
     let adaptation = pollster::block_on(run(&mut r, &demo(), &target(), &config)).unwrap();
     assert_eq!(r.patch_requests[1].kind, ViolationKind::Goal);
-    assert_eq!(r.patch_requests[1].unfulfilled_preconditions(), "- (InsideOf orange hinge_body)");
+    assert_eq!(
+        r.patch_requests[1].unfulfilled_preconditions(),
+        "- (InsideOf orange hinge_body)"
+    );
     assert!(r.patch_requests[1].erroneous.is_none());
-    let Outcome::Unresolved { best, last, last_violation, iterations } = adaptation.outcome else { panic!() };
+    let Outcome::Unresolved {
+        best,
+        last,
+        last_violation,
+        iterations,
+    } = adaptation.outcome
+    else {
+        panic!()
+    };
     assert_eq!(iterations, 2);
     assert_eq!(last.len(), 3);
     assert_eq!(best.len(), 3, "all three remaining steps apply");
@@ -233,29 +420,63 @@ fn removal_then_goal_violation_then_budget() {
 #[test]
 fn ablations_change_what_is_checked_and_shown() {
     // w/o Eq. 8: the wiggle patch (which does not fix the lid) is accepted.
-    let wiggle = refinement(&drop_block(), &format!("{}\n\n{}", block("Wiggle", &["(GripperHolding orange)"], &["(Wiggled)"]), drop_block()));
-    let mut r = Scripted { induction: good_inductions(), ..Default::default() };
+    let wiggle = refinement(
+        &drop_block(),
+        &format!(
+            "{}\n\n{}",
+            block("Wiggle", &["(GripperHolding orange)"], &["(Wiggled)"]),
+            drop_block()
+        ),
+    );
+    let mut r = Scripted {
+        induction: good_inductions(),
+        ..Default::default()
+    };
     r.patches.push_back(wiggle.clone());
-    let config = AdaptConfig { budget: 1, ablation: Ablation::NO_VERIFICATION, ..Default::default() };
+    let config = AdaptConfig {
+        budget: 1,
+        ablation: Ablation::NO_VERIFICATION,
+        ..Default::default()
+    };
     let a = pollster::block_on(run(&mut r, &demo(), &target(), &config)).unwrap();
-    let Outcome::Unresolved { last, .. } = &a.outcome else { panic!() };
+    let Outcome::Unresolved { last, .. } = &a.outcome else {
+        panic!()
+    };
     assert_eq!(last[3].name, "Wiggle");
 
     // w/o Eq. 6: the request hides the failure; a fixing patch is still verified and accepted.
-    let mut r = Scripted { induction: good_inductions(), ..Default::default() };
+    let mut r = Scripted {
+        induction: good_inductions(),
+        ..Default::default()
+    };
     r.patches.push_back(wiggle.clone());
-    r.patches.push_back(refinement(&drop_block(), &format!("{}\n\n{}", open_lid_block(), drop_block())));
-    let config = AdaptConfig { ablation: Ablation::NO_IDENTIFICATION, ..Default::default() };
+    r.patches.push_back(refinement(
+        &drop_block(),
+        &format!("{}\n\n{}", open_lid_block(), drop_block()),
+    ));
+    let config = AdaptConfig {
+        ablation: Ablation::NO_IDENTIFICATION,
+        ..Default::default()
+    };
     let a = pollster::block_on(run(&mut r, &demo(), &target(), &config)).unwrap();
     assert!(a.outcome.is_adapted());
     assert_eq!(r.patch_requests[0].kind, ViolationKind::Unidentified);
     assert!(r.patch_requests[0].erroneous.is_none() && r.patch_requests[0].unmet.is_empty());
-    assert!(matches!(r.patch_requests[1].feedback[0].problem, Problem::NotResolved { .. }));
+    assert!(matches!(
+        r.patch_requests[1].feedback[0].problem,
+        Problem::NotResolved { .. }
+    ));
 
     // w/o both: one revision, unchecked.
-    let mut r = Scripted { induction: good_inductions(), ..Default::default() };
+    let mut r = Scripted {
+        induction: good_inductions(),
+        ..Default::default()
+    };
     r.patches.push_back(wiggle);
-    let config = AdaptConfig { ablation: Ablation::NO_IDENTIFICATION_NO_VERIFICATION, ..Default::default() };
+    let config = AdaptConfig {
+        ablation: Ablation::NO_IDENTIFICATION_NO_VERIFICATION,
+        ..Default::default()
+    };
     let a = pollster::block_on(run(&mut r, &demo(), &target(), &config)).unwrap();
     assert!(!a.outcome.is_adapted());
     assert_eq!(r.patch_requests.len(), 1);
@@ -263,24 +484,50 @@ fn ablations_change_what_is_checked_and_shown() {
 
 #[test]
 fn consistent_target_needs_no_patch_and_budget_table() {
-    let mut r = Scripted { induction: good_inductions(), ..Default::default() };
-    let same = Target { init: demo().states[0].clone(), task: task() };
+    let mut r = Scripted {
+        induction: good_inductions(),
+        ..Default::default()
+    };
+    let same = Target {
+        init: demo().states[0].clone(),
+        task: task(),
+    };
     let a = pollster::block_on(run(&mut r, &demo(), &same, &AdaptConfig::default())).unwrap();
     assert!(matches!(a.outcome, Outcome::Adapted { iterations: 0, .. }));
     assert!(r.patch_requests.is_empty());
     assert_eq!(iteration_budget(DomainFactor::Obstruction, Complexity::Low), 10);
     assert_eq!(iteration_budget(DomainFactor::Gripper, Complexity::High), 20);
-    assert_eq!(iteration_budget(DomainFactor::Combination, Complexity::Medium), 15);
+    assert_eq!(
+        iteration_budget(DomainFactor::Combination, Complexity::Medium),
+        15
+    );
     assert_eq!(iteration_budget(DomainFactor::Combination, Complexity::High), 30);
 }
 
 #[test]
 fn goal_excludes_embodiment_atoms() {
     let s0 = state(&["(GripperOpen)", "(FingerGripper)", "(OnTopOf a floor)"]);
-    let s1 = state(&["(GripperClosed)", "(GripperHolding a)", "(FingerGripper)", "(Gathered a)"]);
-    let s2 = state(&["(GripperClosed)", "(GripperHolding a)", "(FingerGripper)", "(Gathered a)", "(InsideOf a box)"]);
+    let s1 = state(&[
+        "(GripperClosed)",
+        "(GripperHolding a)",
+        "(FingerGripper)",
+        "(Gathered a)",
+    ]);
+    let s2 = state(&[
+        "(GripperClosed)",
+        "(GripperHolding a)",
+        "(FingerGripper)",
+        "(Gathered a)",
+        "(InsideOf a box)",
+    ]);
     let mut v = Vocabulary::new();
-    v.declare("Gathered", &["x"], crate::predicates::Category::Physics, "gathered").unwrap();
+    v.declare(
+        "Gathered",
+        &["x"],
+        crate::predicates::Category::Physics,
+        "gathered",
+    )
+    .unwrap();
     let g = derive_goal(&[s0, s1, s2], &v);
     assert_eq!(g.to_string(), "(and (Gathered a) (InsideOf a box))");
 }

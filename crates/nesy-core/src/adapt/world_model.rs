@@ -3,7 +3,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::reasoner::{Feedback, InductionRequest, Problem, Reasoner};
-use super::{AdaptConfig, AdaptError, Demonstration, Trace, TraceEvent, TransitionCheck, Verdict, derive_goal};
+use super::{
+    AdaptConfig, AdaptError, Demonstration, Trace, TraceEvent, TransitionCheck, Verdict, derive_goal,
+};
 use crate::exec::{ExecError, apply_in, format_unmet, implicit_universe};
 use crate::formula::Formula;
 use crate::operator::Operator;
@@ -32,7 +34,12 @@ impl WorldModel {
 
 /// Checks an induced operator against its transition: preconditions in `prev`, and the
 /// successor against `next` under `check`. Returns the problem if it fails.
-pub fn check_transition(prev: &State, next: &State, op: &Operator, check: TransitionCheck) -> Result<(), Problem> {
+pub fn check_transition(
+    prev: &State,
+    next: &State,
+    op: &Operator,
+    check: TransitionCheck,
+) -> Result<(), Problem> {
     let universe = implicit_universe(prev, std::slice::from_ref(op), None);
     let mut universe = universe;
     for o in next.objects() {
@@ -50,8 +57,18 @@ pub fn check_transition(prev: &State, next: &State, op: &Operator, check: Transi
         }
         TransitionCheck::ChangedAtoms => {
             let demo = prev.diff(next);
-            let missing = demo.added.iter().filter(|a| !produced.contains(a)).copied().collect();
-            let unexpected = demo.removed.iter().filter(|a| produced.contains(a)).copied().collect();
+            let missing = demo
+                .added
+                .iter()
+                .filter(|a| !produced.contains(a))
+                .copied()
+                .collect();
+            let unexpected = demo
+                .removed
+                .iter()
+                .filter(|a| produced.contains(a))
+                .copied()
+                .collect();
             (missing, unexpected)
         }
     };
@@ -73,15 +90,25 @@ fn describe(problem: &Problem) -> String {
         Problem::Unparsable { error } => format!("The reply could not be parsed: {error}."),
         Problem::Ungroundable { error } => format!("The operator could not be grounded: {error}."),
         Problem::PreconditionsUnmet { unmet } => {
-            format!("These preconditions do not hold in the previous state:\n{}", format_unmet(unmet))
+            format!(
+                "These preconditions do not hold in the previous state:\n{}",
+                format_unmet(unmet)
+            )
         }
         Problem::EffectMismatch { missing, unexpected } => {
-            let mut s = String::from("Applying the operator to the previous state does not give the current state.");
+            let mut s =
+                String::from("Applying the operator to the previous state does not give the current state.");
             if !missing.is_empty() {
-                s.push_str(&format!("\nThe current state holds these atoms, which the effects do not produce:\n{}", atoms(missing)));
+                s.push_str(&format!(
+                    "\nThe current state holds these atoms, which the effects do not produce:\n{}",
+                    atoms(missing)
+                ));
             }
             if !unexpected.is_empty() {
-                s.push_str(&format!("\nThe effects produce these atoms, which the current state does not hold:\n{}", atoms(unexpected)));
+                s.push_str(&format!(
+                    "\nThe effects produce these atoms, which the current state does not hold:\n{}",
+                    atoms(unexpected)
+                ));
             }
             s
         }
@@ -126,9 +153,16 @@ pub async fn construct_world_model<R: Reasoner>(
                 Ok(r) => check_transition(prev, next, &r.operator, config.transition_check).err(),
             };
             let verdict = match &problem {
-                None => Verdict::Accepted { checked: config.ablation.world_model },
+                None => Verdict::Accepted {
+                    checked: config.ablation.world_model,
+                },
                 Some(p) => {
-                    let fb = Feedback { attempt, reply: reply.clone(), problem: p.clone(), message: describe(p) };
+                    let fb = Feedback {
+                        attempt,
+                        reply: reply.clone(),
+                        problem: p.clone(),
+                        message: describe(p),
+                    };
                     feedback.push(fb.clone());
                     Verdict::Rejected { feedback: fb }
                 }
@@ -138,7 +172,13 @@ pub async fn construct_world_model<R: Reasoner>(
                 last_parsed = Some(r.operator.clone());
             }
             let done = problem.is_none();
-            trace.events.push(TraceEvent::Induction { step, attempt, reply, parsed: parsed_ok.clone(), verdict });
+            trace.events.push(TraceEvent::Induction {
+                step,
+                attempt,
+                reply,
+                parsed: parsed_ok.clone(),
+                verdict,
+            });
             if done {
                 accepted = parsed_ok.map(|r| r.operator);
                 break;
@@ -150,11 +190,21 @@ pub async fn construct_world_model<R: Reasoner>(
                 unverified_steps.push(step);
                 procedure.push(op);
             }
-            (None, None) => return Err(AdaptError::NoOperator { step, attempts: tries }),
+            (None, None) => {
+                return Err(AdaptError::NoOperator {
+                    step,
+                    attempts: tries,
+                });
+            }
         }
     }
     let goal = derive_goal(&demo.states, &demo.task.vocabulary);
-    let wm = WorldModel { procedure, states: demo.states.clone(), goal, unverified_steps };
+    let wm = WorldModel {
+        procedure,
+        states: demo.states.clone(),
+        goal,
+        unverified_steps,
+    };
     trace.events.push(TraceEvent::WorldModel {
         procedure: wm.procedure.clone(),
         goal: wm.goal.clone(),

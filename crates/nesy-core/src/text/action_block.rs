@@ -3,11 +3,11 @@
 //! ```text
 //! OpenGripperToDropOrangeIntoHingeBody
 //! - Preconditions:
-//! 	(GripperHolding orange)
-//! 	(not (Closed hinge_lid))
+//!     (GripperHolding orange)
+//!     (not (Closed hinge_lid))
 //! - Effects:
-//! 	(InsideOf orange hinge_body)
-//! 	(not (GripperHolding orange))
+//!     (InsideOf orange hinge_body)
+//!     (not (GripperHolding orange))
 //! ```
 //!
 //! Section bodies may use tabs, `-`/`*`/numbered bullets or bare formulas, formulas may
@@ -34,11 +34,21 @@ struct SectionSpan {
 /// continues over the following content lines. Returns the span and the index of the first
 /// line after it. With `allow_blank`, blank lines inside the body are skipped (used for
 /// preconditions, which must be followed by the effects header anyway).
-fn section(lines: &[Line<'_>], header_idx: usize, inline: usize, stop: &[&str], allow_blank: bool) -> (SectionSpan, usize) {
+fn section(
+    lines: &[Line<'_>],
+    header_idx: usize,
+    inline: usize,
+    stop: &[&str],
+    allow_blank: bool,
+) -> (SectionSpan, usize) {
     let header_line = &lines[header_idx];
     let inline_text = &header_line.text[inline - header_line.start..];
     let mut depth = paren_delta(inline_text);
-    let mut end = if inline_text.trim().is_empty() { inline } else { header_line.end() };
+    let mut end = if inline_text.trim().is_empty() {
+        inline
+    } else {
+        header_line.end()
+    };
     let mut i = header_idx + 1;
     while i < lines.len() {
         let l = &lines[i];
@@ -68,7 +78,13 @@ fn section(lines: &[Line<'_>], header_idx: usize, inline: usize, stop: &[&str], 
         end = l.end();
         i += 1;
     }
-    (SectionSpan { start: inline, end: end.max(inline) }, i)
+    (
+        SectionSpan {
+            start: inline,
+            end: end.max(inline),
+        },
+        i,
+    )
 }
 
 /// Parses the formulas of a precondition body (`None` or formulas).
@@ -84,7 +100,12 @@ pub(crate) fn precondition_items(doc: &str, start: usize, end: usize) -> Result<
         }
     }
     if let (Some(at), false) = (none_at, out.is_empty()) {
-        return Err(ParseError::at(doc, at, ParseErrorKind::Syntax, "either `None` or formulas, not both"));
+        return Err(ParseError::at(
+            doc,
+            at,
+            ParseErrorKind::Syntax,
+            "either `None` or formulas, not both",
+        ));
     }
     Ok(out)
 }
@@ -102,7 +123,12 @@ pub(crate) fn effect_items(doc: &str, start: usize, end: usize) -> Result<Vec<Ef
         }
     }
     if let (Some(at), false) = (none_at, out.is_empty()) {
-        return Err(ParseError::at(doc, at, ParseErrorKind::Syntax, "either `None` or effects, not both"));
+        return Err(ParseError::at(
+            doc,
+            at,
+            ParseErrorKind::Syntax,
+            "either `None` or effects, not both",
+        ));
     }
     Ok(out)
 }
@@ -142,7 +168,12 @@ pub(crate) fn parse_blocks(doc: &str, lines: &[Line<'_>], strict: bool) -> Resul
                 } else {
                     "an action name followed by a `- Preconditions:` line"
                 };
-                return Err(ParseError::at(doc, l.content_start(), ParseErrorKind::Syntax, expected));
+                return Err(ParseError::at(
+                    doc,
+                    l.content_start(),
+                    ParseErrorKind::Syntax,
+                    expected,
+                ));
             }
             if !ops.is_empty() && prose_after.is_none() {
                 prose_after = Some(l.content_start());
@@ -159,10 +190,17 @@ pub(crate) fn parse_blocks(doc: &str, lines: &[Line<'_>], strict: bool) -> Resul
             ));
         }
         let Some(name) = normalize_action_name(l.text) else {
-            return Err(ParseError::at(doc, l.content_start(), ParseErrorKind::Syntax, "an action name"));
+            return Err(ParseError::at(
+                doc,
+                l.content_start(),
+                ParseErrorKind::Syntax,
+                "an action name",
+            ));
         };
         let (pre_span, after_pre) = section(lines, pre_idx, pre_inline, EFF_LABELS, true);
-        let eff_header = (after_pre < lines.len()).then(|| header(&lines[after_pre], EFF_LABELS)).flatten();
+        let eff_header = (after_pre < lines.len())
+            .then(|| header(&lines[after_pre], EFF_LABELS))
+            .flatten();
         let Some(eff_inline) = eff_header else {
             let at = lines.get(after_pre).map_or(doc.len(), |l| l.content_start());
             return Err(ParseError::at(
@@ -203,7 +241,12 @@ pub fn parse_action_block(text: &str) -> Result<Operator, ParseError> {
             ParseErrorKind::Empty,
             "an action block: a name line, `- Preconditions:` and `- Effects:`",
         )),
-        n => Err(ParseError::at(text, 0, ParseErrorKind::Syntax, format!("exactly one action block, found {n}"))),
+        n => Err(ParseError::at(
+            text,
+            0,
+            ParseErrorKind::Syntax,
+            format!("exactly one action block, found {n}"),
+        )),
     }
 }
 
@@ -230,7 +273,10 @@ mod tests {
         assert_eq!(ops.len(), 2);
         assert_eq!(ops[0].name, "GraspOrange");
         assert!(ops[0].pre.is_empty());
-        assert_eq!(ops[1].pre[0].to_string(), "(forall (?y - thing) (not (OnTopOf ?y orange)))");
+        assert_eq!(
+            ops[1].pre[0].to_string(),
+            "(forall (?y - thing) (not (OnTopOf ?y orange)))"
+        );
         assert_eq!(parse_procedure(&format_procedure(&ops)).unwrap(), ops);
         assert_eq!(parse_procedure("None").unwrap(), vec![]);
     }
@@ -241,7 +287,10 @@ mod tests {
         assert_eq!(err.kind, ParseErrorKind::MissingSection);
         assert_eq!(err.line, 4);
         let err = parse_procedure("A\n- Preconditions:\n\t(X ?v)\n- Effects:\n\t(Y)").unwrap_err();
-        assert_eq!((err.line, err.column, err.kind), (3, 5, ParseErrorKind::UnboundVariable));
+        assert_eq!(
+            (err.line, err.column, err.kind),
+            (3, 5, ParseErrorKind::UnboundVariable)
+        );
         let err = parse_procedure("A\n- Preconditions:\n\t(X)\n- Effects:\n\t(Y)\nprose\nB\n- Preconditions:\n\tNone\n- Effects:\n\t(Z)")
             .unwrap_err();
         assert_eq!(err.line, 6);

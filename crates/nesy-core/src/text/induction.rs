@@ -49,14 +49,24 @@ fn find(lines: &[Line<'_>], from: usize, labels: &[&str]) -> Option<(usize, usiz
 }
 
 fn missing(doc: &str, at: usize, what: &str) -> ParseError {
-    ParseError::at(doc, at, ParseErrorKind::MissingSection, format!("a `{what}:` section"))
+    ParseError::at(
+        doc,
+        at,
+        ParseErrorKind::MissingSection,
+        format!("a `{what}:` section"),
+    )
 }
 
 /// Parses an induction reply into an operator.
 pub fn parse_induction_reply(text: &str) -> Result<InductionReply, ParseError> {
     let lines = split_lines(text);
     if lines.iter().all(|l| l.is_blank() || l.is_fence()) {
-        return Err(ParseError::at(text, 0, ParseErrorKind::Empty, "an induction reply with an `Action Semantic:` section"));
+        return Err(ParseError::at(
+            text,
+            0,
+            ParseErrorKind::Empty,
+            "an induction reply with an `Action Semantic:` section",
+        ));
     }
     let rationale_hdr = find(&lines, 0, RATIONALE);
     let Some((sem_idx, sem_inline)) = find(&lines, 0, SEMANTIC) else {
@@ -76,7 +86,12 @@ pub fn parse_induction_reply(text: &str) -> Result<InductionReply, ParseError> {
         if !first.is_empty() {
             parts.push(first);
         }
-        parts.extend(lines[i + 1..end].iter().filter(|l| !l.is_fence()).map(|l| l.text.trim()));
+        parts.extend(
+            lines[i + 1..end]
+                .iter()
+                .filter(|l| !l.is_fence())
+                .map(|l| l.text.trim()),
+        );
         parts.join("\n").trim().to_string()
     });
 
@@ -100,7 +115,12 @@ pub fn parse_induction_reply(text: &str) -> Result<InductionReply, ParseError> {
     };
     let semantic = strip_bullet(sem_text).trim().to_string();
     let Some(name) = normalize_action_name(&semantic) else {
-        return Err(ParseError::at(text, sem_at, ParseErrorKind::Syntax, "an action name"));
+        return Err(ParseError::at(
+            text,
+            sem_at,
+            ParseErrorKind::Syntax,
+            "an action name",
+        ));
     };
 
     // Preconditions: everything between the two headers (blank lines and fences skipped).
@@ -111,7 +131,10 @@ pub fn parse_induction_reply(text: &str) -> Result<InductionReply, ParseError> {
     let mut end = lines[eff_idx].end();
     let mut depth = super::lines::paren_delta(&text[eff_inline..lines[eff_idx].end()]);
     for l in &lines[eff_idx + 1..] {
-        if depth <= 0 && (l.is_fence() || (!l.is_blank() && !super::lines::is_content_line(l.text))) {
+        if l.is_fence() {
+            continue; // fences around or inside the section are transparent
+        }
+        if depth <= 0 && !l.is_blank() && !super::lines::is_content_line(l.text) {
             break;
         }
         depth += super::lines::paren_delta(l.text);
@@ -128,7 +151,11 @@ pub fn parse_induction_reply(text: &str) -> Result<InductionReply, ParseError> {
             "at least one effect (an action that changes nothing explains no transition)",
         ));
     }
-    Ok(InductionReply { rationale, semantic, operator: Operator::new(name, pre, eff) })
+    Ok(InductionReply {
+        rationale,
+        semantic,
+        operator: Operator::new(name, pre, eff),
+    })
 }
 
 #[cfg(test)]
@@ -162,7 +189,10 @@ I hope this helps.";
         assert_eq!(r.operator.name, "MoveGripperToSurroundOrange");
         assert_eq!(r.semantic, "Move gripper to surround orange");
         assert_eq!(r.operator.pre.len(), 3);
-        assert_eq!(r.operator.pre[2].to_string(), "(forall (?y - thing) (not (GripperHolding ?y)))");
+        assert_eq!(
+            r.operator.pre[2].to_string(),
+            "(forall (?y - thing) (not (GripperHolding ?y)))"
+        );
         assert_eq!(r.operator.eff.len(), 4);
         assert!(r.rationale.unwrap().contains("holding it"));
     }
@@ -170,10 +200,17 @@ I hope this helps.";
     #[test]
     fn typed_errors() {
         let no_effect = PAPER_EXAMPLE.replace("Effect:", "Result:");
-        assert_eq!(parse_induction_reply(&no_effect).unwrap_err().kind, ParseErrorKind::MissingSection);
+        assert_eq!(
+            parse_induction_reply(&no_effect).unwrap_err().kind,
+            ParseErrorKind::MissingSection
+        );
         let empty = "Action Semantic:\n- Wait\nPrecondition:\nNone\nEffect:\nNone\n";
-        assert_eq!(parse_induction_reply(empty).unwrap_err().kind, ParseErrorKind::EmptyEffects);
-        let none_pre = "**Action Semantic:** - Wait here\n**Preconditions:** None\n**Effects:**\n- (Waited)\n";
+        assert_eq!(
+            parse_induction_reply(empty).unwrap_err().kind,
+            ParseErrorKind::EmptyEffects
+        );
+        let none_pre =
+            "**Action Semantic:** - Wait here\n**Preconditions:** None\n**Effects:**\n- (Waited)\n";
         let r = parse_induction_reply(none_pre).unwrap();
         assert_eq!(r.operator.name, "WaitHere");
         assert!(r.operator.pre.is_empty());

@@ -91,8 +91,16 @@ pub(crate) fn strip_bullet(text: &str) -> &str {
 
 /// Normalises a header label: lower case, emphasis and hyphens removed, whitespace collapsed.
 fn normalize_label(label: &str) -> String {
-    let cleaned: String = label.chars().filter(|c| !matches!(c, '*' | '_' | '`' | '#')).collect();
-    cleaned.replace('-', "").split_whitespace().collect::<Vec<_>>().join(" ").to_lowercase()
+    let cleaned: String = label
+        .chars()
+        .filter(|c| !matches!(c, '*' | '_' | '`' | '#'))
+        .collect();
+    cleaned
+        .replace('-', "")
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+        .to_lowercase()
 }
 
 /// If `line` is a section header whose label is one of `labels` (already normalised,
@@ -131,12 +139,13 @@ pub(crate) fn is_content_line(text: &str) -> bool {
 
 /// Net parenthesis depth change of a line.
 pub(crate) fn paren_delta(text: &str) -> isize {
-    text.chars().map(|c| match c {
-        '(' => 1,
-        ')' => -1,
-        _ => 0,
-    })
-    .sum()
+    text.chars()
+        .map(|c| match c {
+            '(' => 1,
+            ')' => -1,
+            _ => 0,
+        })
+        .sum()
 }
 
 /// Turns an action name as a model writes it into a CamelCase identifier:
@@ -163,10 +172,22 @@ mod tests {
 
     #[test]
     fn names() {
-        assert_eq!(normalize_action_name("Move gripper to surround orange").unwrap(), "MoveGripperToSurroundOrange");
-        assert_eq!(normalize_action_name("- **MoveGripperToSurroundOrange**").unwrap(), "MoveGripperToSurroundOrange");
-        assert_eq!(normalize_action_name("open_gripper_to_drop_orange.").unwrap(), "OpenGripperToDropOrange");
-        assert_eq!(normalize_action_name("1. `CloseHingeLid`").unwrap(), "CloseHingeLid");
+        assert_eq!(
+            normalize_action_name("Move gripper to surround orange").unwrap(),
+            "MoveGripperToSurroundOrange"
+        );
+        assert_eq!(
+            normalize_action_name("- **MoveGripperToSurroundOrange**").unwrap(),
+            "MoveGripperToSurroundOrange"
+        );
+        assert_eq!(
+            normalize_action_name("open_gripper_to_drop_orange.").unwrap(),
+            "OpenGripperToDropOrange"
+        );
+        assert_eq!(
+            normalize_action_name("1. `CloseHingeLid`").unwrap(),
+            "CloseHingeLid"
+        );
         assert!(normalize_action_name("- **").is_none());
     }
 

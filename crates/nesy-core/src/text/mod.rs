@@ -86,7 +86,13 @@ impl ParseError {
     pub(crate) fn at(doc: &str, offset: usize, kind: ParseErrorKind, expected: impl Into<String>) -> Self {
         let offset = floor_char_boundary(doc, offset.min(doc.len()));
         let (line, column) = line_col(doc, offset);
-        ParseError { kind, line, column, expected: expected.into(), found: excerpt(&doc[offset..]) }
+        ParseError {
+            kind,
+            line,
+            column,
+            expected: expected.into(),
+            found: excerpt(&doc[offset..]),
+        }
     }
 }
 
@@ -133,7 +139,12 @@ pub fn parse_formula(text: &str) -> Result<Formula, ParseError> {
 pub fn parse_effect(text: &str) -> Result<Effect, ParseError> {
     let mut effects = parse_effects(text)?;
     if effects.len() != 1 {
-        return Err(ParseError::at(text, 0, ParseErrorKind::Syntax, "exactly one effect"));
+        return Err(ParseError::at(
+            text,
+            0,
+            ParseErrorKind::Syntax,
+            "exactly one effect",
+        ));
     }
     Ok(effects.remove(0))
 }

@@ -74,7 +74,10 @@ pub fn parse_refinement_reply(text: &str) -> Result<RefinementReply, ParseError>
                         text,
                         at,
                         ParseErrorKind::UnterminatedPatch,
-                        format!("a `=======` line ending the SEARCH section opened on line {}", search_at + 1),
+                        format!(
+                            "a `=======` line ending the SEARCH section opened on line {}",
+                            search_at + 1
+                        ),
                     ));
                 };
                 let end = (d + 1..lines.len()).find(|&j| marker(&lines[j]).is_some());
@@ -84,7 +87,10 @@ pub fn parse_refinement_reply(text: &str) -> Result<RefinementReply, ParseError>
                         text,
                         at,
                         ParseErrorKind::UnterminatedPatch,
-                        format!("a `>>>>>>> REPLACE` line closing the block opened on line {}", search_at + 1),
+                        format!(
+                            "a `>>>>>>> REPLACE` line closing the block opened on line {}",
+                            search_at + 1
+                        ),
                     ));
                 };
                 let search = parse_blocks(text, &lines[search_at + 1..d], true)?;
@@ -98,16 +104,27 @@ pub fn parse_refinement_reply(text: &str) -> Result<RefinementReply, ParseError>
                 }
                 let replace_lines = &lines[d + 1..r];
                 let only_none = {
-                    let sig: Vec<_> = replace_lines.iter().filter(|l| !l.is_blank() && !l.is_fence()).collect();
+                    let sig: Vec<_> = replace_lines
+                        .iter()
+                        .filter(|l| !l.is_blank() && !l.is_fence())
+                        .collect();
                     sig.len() == 1 && sig[0].text.trim().eq_ignore_ascii_case("none")
                 };
-                let replace = if only_none { Vec::new() } else { parse_blocks(text, replace_lines, true)? };
+                let replace = if only_none {
+                    Vec::new()
+                } else {
+                    parse_blocks(text, replace_lines, true)?
+                };
                 patches.push(Patch { search, replace });
                 patch_lines.push(search_at + 1);
                 i = r + 1;
             }
             Some(m) => {
-                let what = if m == Marker::Divider { "`=======`" } else { "`>>>>>>> REPLACE`" };
+                let what = if m == Marker::Divider {
+                    "`=======`"
+                } else {
+                    "`>>>>>>> REPLACE`"
+                };
                 return Err(ParseError::at(
                     text,
                     lines[i].content_start(),
@@ -125,13 +142,26 @@ pub fn parse_refinement_reply(text: &str) -> Result<RefinementReply, ParseError>
             "a `<<<<<<< SEARCH` / `=======` / `>>>>>>> REPLACE` block",
         ));
     };
-    let rationale = (0..first_marker).find_map(|i| header(&lines[i], RATIONALE).map(|at| (i, at))).map(|(i, at)| {
-        let end = (i + 1..first_marker).find(|&j| header(&lines[j], PATCH).is_some()).unwrap_or(first_marker);
-        let mut parts = vec![text[at..lines[i].end()].trim()];
-        parts.extend(lines[i + 1..end].iter().filter(|l| !l.is_fence()).map(|l| l.text.trim()));
-        parts.join("\n").trim().to_string()
-    });
-    Ok(RefinementReply { rationale, patches, patch_lines })
+    let rationale = (0..first_marker)
+        .find_map(|i| header(&lines[i], RATIONALE).map(|at| (i, at)))
+        .map(|(i, at)| {
+            let end = (i + 1..first_marker)
+                .find(|&j| header(&lines[j], PATCH).is_some())
+                .unwrap_or(first_marker);
+            let mut parts = vec![text[at..lines[i].end()].trim()];
+            parts.extend(
+                lines[i + 1..end]
+                    .iter()
+                    .filter(|l| !l.is_fence())
+                    .map(|l| l.text.trim()),
+            );
+            parts.join("\n").trim().to_string()
+        });
+    Ok(RefinementReply {
+        rationale,
+        patches,
+        patch_lines,
+    })
 }
 
 #[cfg(test)]
@@ -143,7 +173,10 @@ mod tests {
         let reply = "* Refinement rationale:\n- The lid is closed, so the orange cannot be dropped.\n\n* Refinement patch:\n```\n<<<<<<< SEARCH\nOpenGripperToDropOrangeIntoHingeBody\n- Preconditions:\n\t(GripperHolding orange)\n\t(not (Closed hinge_lid))\n- Effects:\n\t(InsideOf orange hinge_body)\n=======\nMoveHeldOrangeOverFloor\n- Preconditions:\n\t(GripperHolding orange)\n- Effects:\n\t(OverOf orange floor)\n>>>>>>> REPLACE\n```\n";
         let r = parse_refinement_reply(reply).unwrap();
         assert_eq!(r.patches.len(), 1);
-        assert_eq!(r.patches[0].search[0].name, "OpenGripperToDropOrangeIntoHingeBody");
+        assert_eq!(
+            r.patches[0].search[0].name,
+            "OpenGripperToDropOrangeIntoHingeBody"
+        );
         assert_eq!(r.patches[0].replace[0].name, "MoveHeldOrangeOverFloor");
         assert!(r.rationale.unwrap().contains("lid is closed"));
         let again = parse_refinement_reply(&r.patches[0].to_string()).unwrap();
@@ -152,13 +185,24 @@ mod tests {
 
     #[test]
     fn errors() {
-        assert_eq!(parse_refinement_reply("no patch here").unwrap_err().kind, ParseErrorKind::NoPatch);
+        assert_eq!(
+            parse_refinement_reply("no patch here").unwrap_err().kind,
+            ParseErrorKind::NoPatch
+        );
         let open = "<<<<<<< SEARCH\nA\n- Preconditions:\n\tNone\n- Effects:\n\t(B)\n=======\n";
         let err = parse_refinement_reply(open).unwrap_err();
         assert_eq!(err.kind, ParseErrorKind::UnterminatedPatch);
         let empty = "<<<<<<< SEARCH\n=======\n>>>>>>> REPLACE";
-        assert_eq!(parse_refinement_reply(empty).unwrap_err().kind, ParseErrorKind::EmptySearch);
-        let removal = "<<<<<<< SEARCH\nA\n- Preconditions:\n\tNone\n- Effects:\n\t(B)\n=======\nNone\n>>>>>>> REPLACE";
-        assert!(parse_refinement_reply(removal).unwrap().patches[0].replace.is_empty());
+        assert_eq!(
+            parse_refinement_reply(empty).unwrap_err().kind,
+            ParseErrorKind::EmptySearch
+        );
+        let removal =
+            "<<<<<<< SEARCH\nA\n- Preconditions:\n\tNone\n- Effects:\n\t(B)\n=======\nNone\n>>>>>>> REPLACE";
+        assert!(
+            parse_refinement_reply(removal).unwrap().patches[0]
+                .replace
+                .is_empty()
+        );
     }
 }

@@ -7,7 +7,7 @@ use std::ops::Range;
 
 use winnow::error::{ContextError, ErrMode};
 use winnow::prelude::*;
-use winnow::stream::{Location, LocatingSlice, Stream};
+use winnow::stream::{LocatingSlice, Location, Stream};
 use winnow::token::{any, take_while};
 
 use super::{ParseError, ParseErrorKind};
@@ -90,8 +90,15 @@ fn list<'a>(i: &mut In<'a>) -> ModalResult<Vec<SExpr<'a>>> {
 
 fn sexpr<'a>(i: &mut In<'a>) -> ModalResult<SExpr<'a>> {
     let start = i.current_token_start();
-    let kind = if i.starts_with('(') { SKind::List(list(i)?) } else { SKind::Token(token(i)?) };
-    Ok(SExpr { kind, span: start..i.previous_token_end() })
+    let kind = if i.starts_with('(') {
+        SKind::List(list(i)?)
+    } else {
+        SKind::Token(token(i)?)
+    };
+    Ok(SExpr {
+        kind,
+        span: start..i.previous_token_end(),
+    })
 }
 
 /// Checks balance and depth of `doc[start..end]`, honouring `;` comments.
@@ -115,15 +122,13 @@ fn prescan(doc: &str, start: usize, end: usize) -> Result<(), ParseError> {
                     ));
                 }
             }
-            ')' => {
-                if open.pop().is_none() {
-                    return Err(ParseError::at(
-                        doc,
-                        at,
-                        ParseErrorKind::Unbalanced,
-                        "no `)` here: it closes nothing",
-                    ));
-                }
+            ')' if open.pop().is_none() => {
+                return Err(ParseError::at(
+                    doc,
+                    at,
+                    ParseErrorKind::Unbalanced,
+                    "no `)` here: it closes nothing",
+                ));
             }
             _ => {}
         }
@@ -174,10 +179,20 @@ pub(crate) fn parse_single<'a>(doc: &'a str, start: usize, end: usize) -> Result
         Ok((Some(e), i.current_token_start()))
     })?;
     let Some(mut expr) = e.take() else {
-        return Err(ParseError::at(doc, end, ParseErrorKind::Empty, "an expression in parentheses"));
+        return Err(ParseError::at(
+            doc,
+            end,
+            ParseErrorKind::Empty,
+            "an expression in parentheses",
+        ));
     };
     if start + rest < end {
-        return Err(ParseError::at(doc, start + rest, ParseErrorKind::Syntax, "end of input after one expression"));
+        return Err(ParseError::at(
+            doc,
+            start + rest,
+            ParseErrorKind::Syntax,
+            "end of input after one expression",
+        ));
     }
     shift(&mut expr, start);
     Ok(expr)
@@ -297,7 +312,10 @@ mod tests {
         let err = parse_single("(a) (b)", 0, 7).unwrap_err();
         assert_eq!((err.line, err.column), (1, 5));
         let deep = "(".repeat(1000) + &")".repeat(1000);
-        assert_eq!(parse_single(&deep, 0, deep.len()).unwrap_err().kind, ParseErrorKind::TooDeep);
+        assert_eq!(
+            parse_single(&deep, 0, deep.len()).unwrap_err().kind,
+            ParseErrorKind::TooDeep
+        );
     }
 
     #[test]

@@ -18,7 +18,12 @@ pub fn parse_state_list(text: &str) -> Result<State, ParseError> {
     let first = relevant.iter().position(|l| is_content_line(l.text));
     let Some(first) = first else {
         let at = relevant.first().map_or(text.len(), |l| l.content_start());
-        return Err(ParseError::at(text, at, ParseErrorKind::Empty, "a list of `- (Atom ...)` lines or `None`"));
+        return Err(ParseError::at(
+            text,
+            at,
+            ParseErrorKind::Empty,
+            "a list of `- (Atom ...)` lines or `None`",
+        ));
     };
     // The list runs from the first content line to the last one; formulas may continue
     // over several lines while parentheses are open. Prose in between is an error.
@@ -67,10 +72,15 @@ pub fn parse_state_list(text: &str) -> Result<State, ParseError> {
             }
         }
     }
-    if let Some(at) = saw_none {
-        if !atoms.is_empty() {
-            return Err(ParseError::at(text, at, ParseErrorKind::Syntax, "either `None` or atoms, not both"));
-        }
+    if let Some(at) = saw_none
+        && !atoms.is_empty()
+    {
+        return Err(ParseError::at(
+            text,
+            at,
+            ParseErrorKind::Syntax,
+            "either `None` or atoms, not both",
+        ));
     }
     Ok(State::from_atoms(atoms.into_iter().collect::<Vec<Atom>>()))
 }

@@ -24,7 +24,11 @@ fn is_name(t: &str) -> bool {
 
 impl<'d> Converter<'d> {
     pub fn new(doc: &'d str, lowercase: bool) -> Self {
-        Converter { doc, lowercase, predicates: None }
+        Converter {
+            doc,
+            lowercase,
+            predicates: None,
+        }
     }
 
     /// Checks every atom against declared predicates (PDDL's `:predicates`).
@@ -38,7 +42,11 @@ impl<'d> Converter<'d> {
     }
 
     pub fn name(&self, t: &str) -> Symbol {
-        if self.lowercase { Symbol::new(&t.to_lowercase()) } else { Symbol::new(t) }
+        if self.lowercase {
+            Symbol::new(&t.to_lowercase())
+        } else {
+            Symbol::new(t)
+        }
     }
 
     /// A name token (not a variable, not a list).
@@ -68,11 +76,20 @@ impl<'d> Converter<'d> {
                 }
             }
             SKind::Token(t) if is_name(t) => Ok(Term::Const(self.name(t))),
-            _ => Err(self.err(e.span.start, ParseErrorKind::Syntax, "an object name or a `?variable`")),
+            _ => Err(self.err(
+                e.span.start,
+                ParseErrorKind::Syntax,
+                "an object name or a `?variable`",
+            )),
         }
     }
 
-    fn atom(&self, head: &SExpr<'_>, args: &[SExpr<'_>], scope: &[Symbol]) -> Result<AtomPattern, ParseError> {
+    fn atom(
+        &self,
+        head: &SExpr<'_>,
+        args: &[SExpr<'_>],
+        scope: &[Symbol],
+    ) -> Result<AtomPattern, ParseError> {
         let pred = self.expect_name(head, "a predicate name")?;
         if let Some(declared) = &self.predicates {
             match declared.iter().find(|(p, _)| *p == pred) {
@@ -87,18 +104,28 @@ impl<'d> Converter<'d> {
                     return Err(self.err(
                         head.span.start,
                         ParseErrorKind::Reference,
-                        format!("{arity} argument(s) for `{pred}`, as declared (found {})", args.len()),
+                        format!(
+                            "{arity} argument(s) for `{pred}`, as declared (found {})",
+                            args.len()
+                        ),
                     ));
                 }
                 Some(_) => {}
             }
         }
-        let args: SmallVec<[Term; 3]> = args.iter().map(|a| self.term(a, scope)).collect::<Result<_, _>>()?;
+        let args: SmallVec<[Term; 3]> = args
+            .iter()
+            .map(|a| self.term(a, scope))
+            .collect::<Result<_, _>>()?;
         Ok(AtomPattern { pred, args })
     }
 
     /// Parses `?a ?b - type ?c` (untyped variables are `thing`).
-    pub fn typed_list(&self, items: &[SExpr<'_>], variables: bool) -> Result<Vec<(Symbol, Symbol, usize)>, ParseError> {
+    pub fn typed_list(
+        &self,
+        items: &[SExpr<'_>],
+        variables: bool,
+    ) -> Result<Vec<(Symbol, Symbol, usize)>, ParseError> {
         let mut out: Vec<(Symbol, Symbol, usize)> = Vec::new();
         let mut pending: Vec<(Symbol, usize)> = Vec::new();
         let mut i = 0;
@@ -109,9 +136,20 @@ impl<'d> Converter<'d> {
                     return Err(self.err(e.span.end, ParseErrorKind::Syntax, "a type name after `-`"));
                 };
                 if let Some(list) = ty.list() {
-                    let either = list.first().and_then(|h| h.token()).is_some_and(|h| h.eq_ignore_ascii_case("either"));
-                    let what = if either { "a single type name (`either` types are not supported)" } else { "a type name" };
-                    let kind = if either { ParseErrorKind::Unsupported } else { ParseErrorKind::Syntax };
+                    let either = list
+                        .first()
+                        .and_then(|h| h.token())
+                        .is_some_and(|h| h.eq_ignore_ascii_case("either"));
+                    let what = if either {
+                        "a single type name (`either` types are not supported)"
+                    } else {
+                        "a type name"
+                    };
+                    let kind = if either {
+                        ParseErrorKind::Unsupported
+                    } else {
+                        ParseErrorKind::Syntax
+                    };
                     return Err(self.err(ty.span.start, kind, what));
                 }
                 let ty_sym = self.expect_name(ty, "a type name")?;
@@ -143,17 +181,32 @@ impl<'d> Converter<'d> {
 
     fn quantifier_vars(&self, e: &SExpr<'_>) -> Result<Vec<TypedVar>, ParseError> {
         let Some(items) = e.list() else {
-            return Err(self.err(e.span.start, ParseErrorKind::Syntax, "a parenthesised variable list like `(?x - thing)`"));
+            return Err(self.err(
+                e.span.start,
+                ParseErrorKind::Syntax,
+                "a parenthesised variable list like `(?x - thing)`",
+            ));
         };
         let vars = self.typed_list(items, true)?;
         if vars.is_empty() {
-            return Err(self.err(e.span.start, ParseErrorKind::Syntax, "at least one quantified variable"));
+            return Err(self.err(
+                e.span.start,
+                ParseErrorKind::Syntax,
+                "at least one quantified variable",
+            ));
         }
-        Ok(vars.into_iter().map(|(name, ty, _)| TypedVar { name, ty }).collect())
+        Ok(vars
+            .into_iter()
+            .map(|(name, ty, _)| TypedVar { name, ty })
+            .collect())
     }
 
     fn arity_error(&self, e: &SExpr<'_>, kw: &str, expected: &str) -> ParseError {
-        self.err(e.span.start, ParseErrorKind::Syntax, format!("`({kw} ...)` with {expected}"))
+        self.err(
+            e.span.start,
+            ParseErrorKind::Syntax,
+            format!("`({kw} ...)` with {expected}"),
+        )
     }
 
     /// A formula; `scope` holds the variables bound around it.
@@ -162,20 +215,34 @@ impl<'d> Converter<'d> {
             return Err(self.err(e.span.start, ParseErrorKind::Syntax, "a formula in parentheses"));
         };
         let Some((head, rest)) = items.split_first() else {
-            return Err(self.err(e.span.start, ParseErrorKind::Syntax, "a predicate or connective after `(`"));
+            return Err(self.err(
+                e.span.start,
+                ParseErrorKind::Syntax,
+                "a predicate or connective after `(`",
+            ));
         };
         let kw = self.keyword(head);
         match kw.as_deref() {
             Some("and") | Some("or") => {
-                let parts = rest.iter().map(|x| self.formula(x, scope)).collect::<Result<Vec<_>, _>>()?;
-                Ok(if kw.as_deref() == Some("and") { Formula::And(parts) } else { Formula::Or(parts) })
+                let parts = rest
+                    .iter()
+                    .map(|x| self.formula(x, scope))
+                    .collect::<Result<Vec<_>, _>>()?;
+                Ok(if kw.as_deref() == Some("and") {
+                    Formula::And(parts)
+                } else {
+                    Formula::Or(parts)
+                })
             }
             Some("not") => match rest {
                 [x] => Ok(Formula::Not(Box::new(self.formula(x, scope)?))),
                 _ => Err(self.arity_error(e, "not", "exactly one formula")),
             },
             Some("imply") => match rest {
-                [a, b] => Ok(Formula::Imply(Box::new(self.formula(a, scope)?), Box::new(self.formula(b, scope)?))),
+                [a, b] => Ok(Formula::Imply(
+                    Box::new(self.formula(a, scope)?),
+                    Box::new(self.formula(b, scope)?),
+                )),
                 _ => Err(self.arity_error(e, "imply", "exactly two formulas")),
             },
             Some("forall") | Some("exists") => match rest {
@@ -186,15 +253,27 @@ impl<'d> Converter<'d> {
                     let body = self.formula(body, scope);
                     scope.truncate(depth);
                     let body = Box::new(body?);
-                    Ok(if kw.as_deref() == Some("forall") { Formula::Forall(vars, body) } else { Formula::Exists(vars, body) })
+                    Ok(if kw.as_deref() == Some("forall") {
+                        Formula::Forall(vars, body)
+                    } else {
+                        Formula::Exists(vars, body)
+                    })
                 }
-                _ => Err(self.arity_error(e, kw.as_deref().unwrap_or_default(), "a variable list and one formula")),
+                _ => Err(self.arity_error(
+                    e,
+                    kw.as_deref().unwrap_or_default(),
+                    "a variable list and one formula",
+                )),
             },
             Some("=") => match rest {
                 [a, b] => Ok(Formula::Eq(self.term(a, scope)?, self.term(b, scope)?)),
                 _ => Err(self.arity_error(e, "=", "exactly two terms")),
             },
-            Some("when") => Err(self.err(head.span.start, ParseErrorKind::Syntax, "a formula (`when` is only allowed in effects)")),
+            Some("when") => Err(self.err(
+                head.span.start,
+                ParseErrorKind::Syntax,
+                "a formula (`when` is only allowed in effects)",
+            )),
             _ => Ok(Formula::Atom(self.atom(head, rest, scope)?)),
         }
     }
@@ -205,7 +284,11 @@ impl<'d> Converter<'d> {
             return Err(self.err(e.span.start, ParseErrorKind::Syntax, "an effect in parentheses"));
         };
         let Some((head, rest)) = items.split_first() else {
-            return Err(self.err(e.span.start, ParseErrorKind::Syntax, "an atom, `not`, `and`, `forall` or `when` after `(`"));
+            return Err(self.err(
+                e.span.start,
+                ParseErrorKind::Syntax,
+                "an atom, `not`, `and`, `forall` or `when` after `(`",
+            ));
         };
         let kw = self.keyword(head);
         match kw.as_deref() {
@@ -228,7 +311,11 @@ impl<'d> Converter<'d> {
                         {
                             Ok(vec![Effect::Del(self.atom(h, args, scope)?)])
                         }
-                        _ => Err(self.err(x.span.start, ParseErrorKind::Syntax, "an atom to delete after `not`")),
+                        _ => Err(self.err(
+                            x.span.start,
+                            ParseErrorKind::Syntax,
+                            "an atom to delete after `not`",
+                        )),
                     }
                 }
                 _ => Err(self.arity_error(e, "not", "exactly one atom")),
@@ -245,7 +332,10 @@ impl<'d> Converter<'d> {
                 _ => Err(self.arity_error(e, "forall", "a variable list and one effect")),
             },
             Some("when") => match rest {
-                [cond, body] => Ok(vec![Effect::When(self.formula(cond, scope)?, self.effects(body, scope)?)]),
+                [cond, body] => Ok(vec![Effect::When(
+                    self.formula(cond, scope)?,
+                    self.effects(body, scope)?,
+                )]),
                 _ => Err(self.arity_error(e, "when", "a condition and one effect")),
             },
             Some("or" | "exists" | "imply" | "=") => Err(self.err(
@@ -282,9 +372,13 @@ mod tests {
 
     #[test]
     fn effects_flatten() {
-        let es = parse_effects("(and (A) (not (B)) (forall (?x - thing) (when (C ?x) (not (D ?x)))))").unwrap();
+        let es =
+            parse_effects("(and (A) (not (B)) (forall (?x - thing) (when (C ?x) (not (D ?x)))))").unwrap();
         assert_eq!(es.len(), 3);
-        assert_eq!(es[2].to_string(), "(forall (?x - thing) (when (C ?x) (not (D ?x))))");
+        assert_eq!(
+            es[2].to_string(),
+            "(forall (?x - thing) (when (C ?x) (not (D ?x))))"
+        );
         assert!(parse_effects("(not (or (A) (B)))").is_err());
     }
 }

@@ -1,0 +1,70 @@
+//! The four figures of the issue: apply, verify, parse, plan.
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use nesy_core::exec::{implicit_universe, verify_compiled, verify_procedure};
+use nesy_core::operator::format_procedure;
+use nesy_core::planner::{PlannerConfig, plan};
+use nesy_core::text::parse_procedure;
+use nesy_core::{Universe, apply_in};
+
+mod workload;
+
+fn bench(c: &mut Criterion) {
+    let state = workload::state_200();
+    let op = workload::operator_20();
+    let universe = implicit_universe(&state, std::slice::from_ref(&op), None);
+    let compiled = op.compile(&universe).unwrap();
+    c.bench_function("apply_20_literals_200_atoms/compiled", |b| {
+        b.iter(|| black_box(compiled.apply(black_box(&state), &op).unwrap()))
+    });
+    c.bench_function("apply_20_literals_200_atoms/from_operator", |b| {
+        b.iter(|| black_box(apply_in(&universe, black_box(&state), &op).unwrap()))
+    });
+
+    let ops = workload::procedure_116();
+    let goal = workload::goal_116();
+    assert!(verify_procedure(&state, &ops, Some(&goal)).is_valid());
+    let universe: Universe = implicit_universe(&state, &ops, Some(&goal));
+    let compiled: Vec<_> = ops.iter().map(|o| o.compile(&universe)).collect();
+    c.bench_function("verify_116_steps/compiled", |b| {
+        b.iter(|| {
+            black_box(verify_compiled(
+                &universe,
+                black_box(&state),
+                &ops,
+                &compiled,
+                Some(&goal),
+            ))
+        })
+    });
+    c.bench_function("verify_116_steps/from_operators", |b| {
+        b.iter(|| black_box(verify_procedure(black_box(&state), &ops, Some(&goal))))
+    });
+
+    let text = format_procedure(&ops);
+    assert_eq!(parse_procedure(&text).unwrap().len(), 116);
+    c.bench_function("parse_116_action_procedure", |b| {
+        b.iter(|| black_box(parse_procedure(black_box(&text)).unwrap()))
+    });
+
+    let (domain, problem) = workload::blocksworld_10();
+    let u = domain.universe(&problem).unwrap();
+    let cfg = PlannerConfig::default();
+    let found = plan(&domain.actions, &u, &problem.init, &problem.goal, &cfg).unwrap();
+    eprintln!(
+        "blocksworld-10: plan of {} steps, {} states expanded",
+        found.steps.len(),
+        found.expanded
+    );
+    let mut group = c.benchmark_group("plan_blocksworld_10");
+    group.sample_size(10);
+    group.bench_function("gbfs_hff", |b| {
+        b.iter(|| black_box(plan(&domain.actions, &u, &problem.init, &problem.goal, &cfg).unwrap()))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

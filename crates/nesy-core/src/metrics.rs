@@ -1,0 +1,232 @@
+//! The benchmark's metrics, exactly as benchmark spec §7 defines them:
+//!
+//! - **SR** per episode is 1 iff every subtask ended in `full_success` or
+//!   `partial_success` (partial success — everything placed, in another order — counts).
+//! - **GC** per episode is the fraction of subtasks that succeeded (full or partial).
+//! - **PD** per episode is the Levenshtein distance between the goal-sequence label and
+//!   the achieved sequence, over name tokens, divided by `max(|label|, |achieved|, 1)`. By
+//!   default PD averages over all episodes; [`PdScope::SuccessfulOnly`] averages over SR = 1
+//!   episodes only, as the paper's formula writes it.
+//! - Aggregates are mean ± standard error, SE = std(ddof = 1) / √n. With fewer than two
+//!   values the SE is NaN (as numpy gives), and the mean of no values is NaN.
+
+use serde::{Deserialize, Serialize};
+
+/// How one subtask ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SubtaskResult {
+    /// Achieved, in the demonstrated order.
+    FullSuccess,
+    /// Achieved, in another order (counts as success).
+    PartialSuccess,
+    /// Not achieved.
+    Fail,
+}
+
+impl SubtaskResult {
+    /// True for full and partial success.
+    pub fn is_success(self) -> bool {
+        self != SubtaskResult::Fail
+    }
+}
+
+/// What an episode produced.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct EpisodeResult {
+    /// One result per subtask.
+    pub subtasks: Vec<SubtaskResult>,
+    /// The goal-sequence label (expected order of achievements).
+    pub label: Vec<String>,
+    /// The achieved sequence.
+    pub achieved: Vec<String>,
+}
+
+impl EpisodeResult {
+    /// SR of this episode: 1 if every subtask succeeded, else 0.
+    pub fn success(&self) -> f64 {
+        if !self.subtasks.is_empty() && self.subtasks.iter().all(|s| s.is_success()) {
+            1.0
+        } else {
+            0.0
+        }
+    }
+
+    /// GC of this episode: the fraction of subtasks that succeeded (0 for no subtasks).
+    pub fn goal_condition(&self) -> f64 {
+        if self.subtasks.is_empty() {
+            return 0.0;
+        }
+        self.subtasks.iter().filter(|s| s.is_success()).count() as f64 / self.subtasks.len() as f64
+    }
+
+    /// PD of this episode: normalised edit distance between label and achieved sequence.
+    pub fn procedure_deviation(&self) -> f64 {
+        let denom = self.label.len().max(self.achieved.len()).max(1);
+        levenshtein(&self.label, &self.achieved) as f64 / denom as f64
+    }
+}
+
+/// Edit distance (insertions, deletions, substitutions) between two token sequences.
+pub fn levenshtein<T: PartialEq>(a: &[T], b: &[T]) -> usize {
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    let mut cur = vec![0; b.len() + 1];
+    for (i, x) in a.iter().enumerate() {
+        cur[0] = i + 1;
+        for (j, y) in b.iter().enumerate() {
+            let sub = prev[j] + usize::from(x != y);
+            cur[j + 1] = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        std::mem::swap(&mut prev, &mut cur);
+    }
+    prev[b.len()]
+}
+
+/// A mean with its standard error.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MeanSe {
+    /// The mean.
+    pub mean: f64,
+    /// Standard error: sample standard deviation (ddof 1) over √n.
+    pub se: f64,
+    /// Number of values.
+    pub n: usize,
+}
+
+impl MeanSe {
+    /// Mean and SE of `values`.
+    pub fn of(values: &[f64]) -> Self {
+        let n = values.len();
+        if n == 0 {
+            return MeanSe {
+                mean: f64::NAN,
+                se: f64::NAN,
+                n,
+            };
+        }
+        let mean = values.iter().sum::<f64>() / n as f64;
+        let se = if n < 2 {
+            f64::NAN
+        } else {
+            let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+            var.sqrt() / (n as f64).sqrt()
+        };
+        MeanSe { mean, se, n }
+    }
+
+    /// Scaled to percent (mean × 100 ± SE × 100), as the tables report.
+    pub fn percent(self) -> MeanSe {
+        MeanSe {
+            mean: self.mean * 100.0,
+            se: self.se * 100.0,
+            n: self.n,
+        }
+    }
+}
+
+impl std::fmt::Display for MeanSe {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:.2}±{:.2}", self.mean, self.se)
+    }
+}
+
+/// Which episodes PD averages over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PdScope {
+    /// Every episode (the authors' aggregation script's default).
+    #[default]
+    AllEpisodes,
+    /// Only episodes with SR = 1 (the paper's formula; `--pd_success`).
+    SuccessfulOnly,
+}
+
+/// SR, GC and PD over a set of episodes, in percent.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Success rate.
+    pub sr: MeanSe,
+    /// Goal condition.
+    pub gc: MeanSe,
+    /// Procedure deviation.
+    pub pd: MeanSe,
+}
+
+/// Aggregates episodes into SR, GC and PD (percent, mean ± SE).
+pub fn summarize(episodes: &[EpisodeResult], pd_scope: PdScope) -> Summary {
+    let sr: Vec<f64> = episodes.iter().map(|e| e.success()).collect();
+    let gc: Vec<f64> = episodes.iter().map(|e| e.goal_condition()).collect();
+    let pd: Vec<f64> = episodes
+        .iter()
+        .filter(|e| pd_scope == PdScope::AllEpisodes || e.success() == 1.0)
+        .map(|e| e.procedure_deviation())
+        .collect();
+    Summary {
+        sr: MeanSe::of(&sr).percent(),
+        gc: MeanSe::of(&gc).percent(),
+        pd: MeanSe::of(&pd).percent(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use SubtaskResult::*;
+
+    fn ep(subtasks: &[SubtaskResult], label: &[&str], achieved: &[&str]) -> EpisodeResult {
+        EpisodeResult {
+            subtasks: subtasks.to_vec(),
+            label: label.iter().map(|s| s.to_string()).collect(),
+            achieved: achieved.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    #[test]
+    fn per_episode_values() {
+        let partial = ep(
+            &[FullSuccess, PartialSuccess],
+            &["a", "b", "hinge"],
+            &["b", "a", "hinge"],
+        );
+        assert_eq!(partial.success(), 1.0);
+        assert_eq!(partial.goal_condition(), 1.0);
+        // b a hinge vs a b hinge: two substitutions over max length 3.
+        assert!((partial.procedure_deviation() - 2.0 / 3.0).abs() < 1e-12);
+        let failed = ep(&[FullSuccess, Fail, Fail, FullSuccess], &["a", "b"], &[]);
+        assert_eq!(failed.success(), 0.0);
+        assert_eq!(failed.goal_condition(), 0.5);
+        assert_eq!(failed.procedure_deviation(), 1.0);
+        assert_eq!(ep(&[], &[], &[]).procedure_deviation(), 0.0);
+        assert_eq!(
+            levenshtein(
+                &["k", "i", "t", "t", "e", "n"],
+                &["s", "i", "t", "t", "i", "n", "g"]
+            ),
+            3
+        );
+    }
+
+    #[test]
+    fn aggregates_by_hand() {
+        let episodes = vec![
+            ep(&[FullSuccess, FullSuccess], &["a", "b"], &["a", "b"]),
+            ep(&[FullSuccess, Fail], &["a", "b"], &["a"]),
+            ep(&[PartialSuccess, FullSuccess], &["a", "b"], &["b", "a"]),
+            ep(&[Fail, Fail], &["a", "b"], &[]),
+        ];
+        let s = summarize(&episodes, PdScope::AllEpisodes);
+        // SR values 1,0,1,0: mean .5, sd = sqrt(1/3), se = sd/2.
+        assert!((s.sr.mean - 50.0).abs() < 1e-9);
+        assert!((s.sr.se - 100.0 * (1.0f64 / 3.0).sqrt() / 2.0).abs() < 1e-9);
+        // GC values 1, .5, 1, 0: mean .625.
+        assert!((s.gc.mean - 62.5).abs() < 1e-9);
+        // PD values 0, .5, 1, 1: mean .625.
+        assert!((s.pd.mean - 62.5).abs() < 1e-9);
+        let s = summarize(&episodes, PdScope::SuccessfulOnly);
+        // PD over episodes 1 and 3: 0 and 1.
+        assert!((s.pd.mean - 50.0).abs() < 1e-9);
+        assert_eq!(s.pd.n, 2);
+        assert!(MeanSe::of(&[0.3]).se.is_nan());
+        assert!(MeanSe::of(&[]).mean.is_nan());
+    }
+}
