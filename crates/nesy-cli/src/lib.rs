@@ -24,6 +24,8 @@ pub struct Cli {
 /// The subcommands. Each lives in its own module under [`commands`].
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Inspect, prune or verify VLM cassettes (recorded model calls for offline replay).
+    Cassette(commands::cassette::CassetteArgs),
     /// Render a scene's top, front and back views as PNG (plain and labelled).
     Render(commands::render::RenderArgs),
     /// Verify a plan against a PDDL domain and problem, like VAL.
@@ -46,6 +48,7 @@ pub fn main() -> ExitCode {
 /// Runs a parsed command line and maps errors to exit code 2 with their full context.
 pub fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
+        Command::Cassette(args) => commands::cassette::run(args),
         Command::Render(args) => commands::render::run(args),
         Command::Verify(args) => commands::verify::run(args),
     };

@@ -154,9 +154,15 @@ pub struct RunUsage {
 impl RunUsage {
     /// Adds one call, priced with `prices`.
     pub fn record(&mut self, record: &CallRecord, prices: &PriceTable) {
-        let cost = record.usage.as_ref().and_then(|usage| prices.cost(&record.model, usage));
+        let cost = record
+            .usage
+            .as_ref()
+            .and_then(|usage| prices.cost(&record.model, usage));
         self.total.add(record, cost);
-        self.by_model.entry(record.model.clone()).or_default().add(record, cost);
+        self.by_model
+            .entry(record.model.clone())
+            .or_default()
+            .add(record, cost);
         let purpose = record.purpose.clone().unwrap_or_else(|| "-".to_string());
         self.by_purpose.entry(purpose).or_default().add(record, cost);
     }
@@ -169,9 +175,28 @@ mod tests {
     #[test]
     fn prices_match_by_longest_prefix_and_cached_tokens_are_cheaper() {
         let mut table = PriceTable::default();
-        table.0.insert("gpt-5".into(), ModelPrice { input_per_mtok: 1.0, cached_input_per_mtok: Some(0.1), output_per_mtok: 10.0 });
-        table.0.insert("gpt-5-mini".into(), ModelPrice { input_per_mtok: 0.5, cached_input_per_mtok: None, output_per_mtok: 2.0 });
-        let usage = Usage { prompt_tokens: 1_000_000, completion_tokens: 100_000, reasoning_tokens: 50_000, cached_prompt_tokens: 500_000 };
+        table.0.insert(
+            "gpt-5".into(),
+            ModelPrice {
+                input_per_mtok: 1.0,
+                cached_input_per_mtok: Some(0.1),
+                output_per_mtok: 10.0,
+            },
+        );
+        table.0.insert(
+            "gpt-5-mini".into(),
+            ModelPrice {
+                input_per_mtok: 0.5,
+                cached_input_per_mtok: None,
+                output_per_mtok: 2.0,
+            },
+        );
+        let usage = Usage {
+            prompt_tokens: 1_000_000,
+            completion_tokens: 100_000,
+            reasoning_tokens: 50_000,
+            cached_prompt_tokens: 500_000,
+        };
         let cost = table.cost("gpt-5-2025-08-07", &usage).unwrap();
         assert!((cost - (0.5 + 0.05 + 1.0)).abs() < 1e-9, "{cost}");
         let mini = table.cost("gpt-5-mini-2025", &usage).unwrap();
@@ -183,7 +208,12 @@ mod tests {
     fn run_usage_groups_calls() {
         let mut run = RunUsage::default();
         let prices = PriceTable::default();
-        let usage = Usage { prompt_tokens: 10, completion_tokens: 5, reasoning_tokens: 2, cached_prompt_tokens: 0 };
+        let usage = Usage {
+            prompt_tokens: 10,
+            completion_tokens: 5,
+            reasoning_tokens: 2,
+            cached_prompt_tokens: 0,
+        };
         let call = |purpose: &str, attempts, origin, ok| CallRecord {
             model: "m".into(),
             purpose: Some(purpose.into()),

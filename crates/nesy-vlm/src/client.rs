@@ -57,8 +57,11 @@ impl VlmClient {
                 CassetteMode::NewEpisodes | CassetteMode::All => true,
             },
         };
-        let live: Option<Arc<dyn Transport>> =
-            if needs_live { Some(Arc::new(Self::http_transport(config)?)) } else { None };
+        let live: Option<Arc<dyn Transport>> = if needs_live {
+            Some(Arc::new(Self::http_transport(config)?))
+        } else {
+            None
+        };
         let transport: Arc<dyn Transport> = match &config.cassette {
             Some(cassette) => Arc::new(CassetteTransport::open(
                 &cassette.path,
@@ -89,7 +92,10 @@ impl VlmClient {
             };
             return Err(ConfigError::Missing {
                 what: "API key",
-                hint: format!("the {} backend needs one: set {var} or NESY_VLM_API_KEY", config.backend),
+                hint: format!(
+                    "the {} backend needs one: set {var} or NESY_VLM_API_KEY",
+                    config.backend
+                ),
             }
             .into());
         }
@@ -98,9 +104,19 @@ impl VlmClient {
             (Some(key), AuthScheme::Bearer) => Auth::Bearer(key),
             (Some(key), AuthScheme::ApiKeyHeader) => Auth::ApiKeyHeader(key),
         };
-        HttpTransport::new(&config.base_url, auth, &config.timeouts, format!("http {}", config.backend)).map_err(
-            |message| ConfigError::Invalid { origin: "base URL".into(), message }.into(),
+        HttpTransport::new(
+            &config.base_url,
+            auth,
+            &config.timeouts,
+            format!("http {}", config.backend),
         )
+        .map_err(|message| {
+            ConfigError::Invalid {
+                origin: "base URL".into(),
+                message,
+            }
+            .into()
+        })
     }
 
     /// A client over any transport (a cassette, an offline responder, a test double).
@@ -144,7 +160,9 @@ impl VlmClient {
     /// and records usage, latency and attempts whatever the outcome.
     pub async fn chat(&self, request: ChatRequest) -> Result<ChatResponse, VlmError> {
         if request.messages.is_empty() {
-            return Err(VlmError::InvalidRequest("a chat request needs at least one message".into()));
+            return Err(VlmError::InvalidRequest(
+                "a chat request needs at least one message".into(),
+            ));
         }
         let wire = self.wire_request(&request);
         let started = Instant::now();
@@ -162,14 +180,21 @@ impl VlmClient {
             origin,
             succeeded: outcome.is_ok(),
         };
-        self.inner.usage.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).record(&record, &self.inner.prices);
+        self.inner
+            .usage
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+            .record(&record, &self.inner.prices);
         outcome.map(|mut response| {
             response.latency = record.latency;
             response
         })
     }
 
-    async fn send_with_retries(&self, wire: &WireRequest) -> (Result<WireResponse, VlmError>, u32, Option<Origin>) {
+    async fn send_with_retries(
+        &self,
+        wire: &WireRequest,
+    ) -> (Result<WireResponse, VlmError>, u32, Option<Origin>) {
         let policy = &self.inner.retry;
         let mut attempts = 0;
         loop {
@@ -177,7 +202,11 @@ impl VlmClient {
             let sent = {
                 // Held for the attempt only, not the back-off, so waiting calls do not block others.
                 let Ok(_permit) = self.inner.concurrency.acquire().await else {
-                    return (Err(VlmError::InvalidRequest("the client was shut down".into())), attempts, None);
+                    return (
+                        Err(VlmError::InvalidRequest("the client was shut down".into())),
+                        attempts,
+                        None,
+                    );
                 };
                 self.inner.transport.send(wire).await
             };
@@ -191,7 +220,12 @@ impl VlmClient {
                     let provider = ProviderError::from_body(&response.body);
                     if can_retry && status_is_retryable(&response, &provider) {
                         let delay = policy.delay(attempts, Some(&response));
-                        tracing::warn!(status = response.status, attempt = attempts, ?delay, "retrying: {provider}");
+                        tracing::warn!(
+                            status = response.status,
+                            attempt = attempts,
+                            ?delay,
+                            "retrying: {provider}"
+                        );
                         // A replayed failure is not waited for: the recording already waited.
                         if response.origin == Origin::Live {
                             tokio::time::sleep(delay).await;
@@ -202,7 +236,7 @@ impl VlmClient {
                         status: response.status,
                         path: wire.path.clone(),
                         request_id: response.request_id().map(str::to_string),
-                        provider,
+                        provider: Box::new(provider),
                         attempts,
                     };
                     return (Err(error), attempts, Some(response.origin));
@@ -210,11 +244,22 @@ impl VlmClient {
                 Err(err) => {
                     if can_retry && err.is_retryable() {
                         let delay = policy.delay(attempts, None);
-                        tracing::warn!(attempt = attempts, ?delay, "retrying after transport error: {err}");
+                        tracing::warn!(
+                            attempt = attempts,
+                            ?delay,
+                            "retrying after transport error: {err}"
+                        );
                         tokio::time::sleep(delay).await;
                         continue;
                     }
-                    return (Err(VlmError::Transport { source: err, attempts }), attempts, None);
+                    return (
+                        Err(VlmError::Transport {
+                            source: err,
+                            attempts,
+                        }),
+                        attempts,
+                        None,
+                    );
                 }
             }
         }
@@ -250,7 +295,11 @@ impl VlmClient {
 
     /// Usage of the run so far.
     pub fn usage(&self) -> RunUsage {
-        self.inner.usage.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).clone()
+        self.inner
+            .usage
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+            .clone()
     }
 
     /// Ends the run: lets the transport finish (a cassette writes its usage report and, in

@@ -90,6 +90,9 @@ pub struct Timeouts {
     pub read: Option<Duration>,
     /// One attempt from connecting to the end of the body.
     pub total: Option<Duration>,
+    /// How long an idle keep-alive connection is kept for reuse. A connection silently
+    /// dropped by a NAT would otherwise hang the next call until the read timeout.
+    pub pool_idle: Option<Duration>,
 }
 
 impl Default for Timeouts {
@@ -98,6 +101,7 @@ impl Default for Timeouts {
             connect: Some(Duration::from_secs(10)),
             read: Some(Duration::from_secs(300)),
             total: Some(Duration::from_secs(600)),
+            pool_idle: Some(Duration::from_secs(60)),
         }
     }
 }
@@ -157,7 +161,10 @@ impl VlmConfig {
             azure_deployment: None,
             azure_api_version: DEFAULT_AZURE_API_VERSION.to_string(),
             reasoning: ReasoningMode::Auto,
-            defaults: BodyDefaults { max_output_tokens: Some(4096), ..BodyDefaults::default() },
+            defaults: BodyDefaults {
+                max_output_tokens: Some(4096),
+                ..BodyDefaults::default()
+            },
             timeouts: Timeouts::default(),
             retry: RetryPolicy::default(),
             max_concurrency: 8,
@@ -186,7 +193,10 @@ impl VlmConfig {
     /// Resolves a configuration: flags override environment variables, which override the
     /// TOML file (`--vlm-config` or `NESY_VLM_CONFIG`), which overrides defaults.
     pub fn resolve(flags: &ConfigOverrides, env: &dyn EnvSource) -> Result<Self, ConfigError> {
-        let file_path = flags.config.clone().or_else(|| env.var("NESY_VLM_CONFIG").map(PathBuf::from));
+        let file_path = flags
+            .config
+            .clone()
+            .or_else(|| env.var("NESY_VLM_CONFIG").map(PathBuf::from));
         let file = match &file_path {
             Some(path) => FileConfig::load(path)?,
             None => FileConfig::default(),
@@ -203,12 +213,15 @@ impl VlmConfig {
             (None, None, Some(value)) => parse(value, &file_origin("backend"))?,
             (None, None, None) => BackendKind::OpenAi,
         };
-        let model = flags.model.clone().or_else(|| env.var("NESY_VLM_MODEL")).or(file.model.clone()).ok_or_else(
-            || ConfigError::Missing {
+        let model = flags
+            .model
+            .clone()
+            .or_else(|| env.var("NESY_VLM_MODEL"))
+            .or(file.model.clone())
+            .ok_or_else(|| ConfigError::Missing {
                 what: "model",
                 hint: "set NESY_VLM_MODEL, pass --vlm-model, or put `model` in the config file".into(),
-            },
-        )?;
+            })?;
         let mut config = Self::new(backend, model);
 
         let azure = file.azure.unwrap_or_default();
@@ -217,7 +230,11 @@ impl VlmConfig {
             .clone()
             .or_else(|| env.var("NESY_VLM_BASE_URL"))
             .or(file.base_url.clone())
-            .or_else(|| matches!(backend, BackendKind::Azure | BackendKind::AzureV1).then(|| env.var("AZURE_OPENAI_ENDPOINT")).flatten())
+            .or_else(|| {
+                matches!(backend, BackendKind::Azure | BackendKind::AzureV1)
+                    .then(|| env.var("AZURE_OPENAI_ENDPOINT"))
+                    .flatten()
+            })
             .or_else(|| backend.default_base_url().map(str::to_string))
             .ok_or_else(|| ConfigError::Missing {
                 what: "base URL",
@@ -240,10 +257,14 @@ impl VlmConfig {
             })
             .map(SecretString::new);
 
-        config.azure_deployment =
-            env.var("NESY_VLM_AZURE_DEPLOYMENT").or(azure.deployment).or(config.azure_deployment);
-        if let Some(version) =
-            env.var("NESY_VLM_AZURE_API_VERSION").or_else(|| env.var("OPENAI_API_VERSION")).or(azure.api_version)
+        config.azure_deployment = env
+            .var("NESY_VLM_AZURE_DEPLOYMENT")
+            .or(azure.deployment)
+            .or(config.azure_deployment);
+        if let Some(version) = env
+            .var("NESY_VLM_AZURE_API_VERSION")
+            .or_else(|| env.var("OPENAI_API_VERSION"))
+            .or(azure.api_version)
         {
             config.azure_api_version = version;
         }
@@ -261,26 +282,44 @@ impl VlmConfig {
         if let Some(mode) = setting!(flags.reasoning, "NESY_VLM_REASONING", file.reasoning, "reasoning") {
             config.reasoning = mode;
         }
-        if let Some(effort) =
-            setting!(flags.reasoning_effort, "NESY_VLM_REASONING_EFFORT", file.reasoning_effort, "reasoning_effort")
-        {
+        if let Some(effort) = setting!(
+            flags.reasoning_effort,
+            "NESY_VLM_REASONING_EFFORT",
+            file.reasoning_effort,
+            "reasoning_effort"
+        ) {
             config.defaults.reasoning_effort = Some(effort);
         }
-        if let Some(tokens) =
-            setting!(flags.max_output_tokens, "NESY_VLM_MAX_TOKENS", file.max_output_tokens, "max_output_tokens")
-        {
+        if let Some(tokens) = setting!(
+            flags.max_output_tokens,
+            "NESY_VLM_MAX_TOKENS",
+            file.max_output_tokens,
+            "max_output_tokens"
+        ) {
             config.defaults.max_output_tokens = Some(tokens);
         }
-        if let Some(temperature) = setting!(flags.temperature, "NESY_VLM_TEMPERATURE", file.temperature, "temperature")
-        {
+        if let Some(temperature) = setting!(
+            flags.temperature,
+            "NESY_VLM_TEMPERATURE",
+            file.temperature,
+            "temperature"
+        ) {
             config.defaults.temperature = Some(temperature);
         }
-        if let Some(detail) = setting!(flags.image_detail, "NESY_VLM_IMAGE_DETAIL", file.image_detail, "image_detail") {
+        if let Some(detail) = setting!(
+            flags.image_detail,
+            "NESY_VLM_IMAGE_DETAIL",
+            file.image_detail,
+            "image_detail"
+        ) {
             config.defaults.image_detail = Some(detail);
         }
-        if let Some(limit) =
-            setting!(flags.max_concurrency, "NESY_VLM_MAX_CONCURRENCY", file.max_concurrency, "max_concurrency")
-        {
+        if let Some(limit) = setting!(
+            flags.max_concurrency,
+            "NESY_VLM_MAX_CONCURRENCY",
+            file.max_concurrency,
+            "max_concurrency"
+        ) {
             if limit == 0 {
                 return Err(invalid("max_concurrency", "must be at least 1"));
             }
@@ -288,7 +327,12 @@ impl VlmConfig {
         }
 
         let retry = file.retry.unwrap_or_default();
-        if let Some(attempts) = setting!(flags.max_attempts, "NESY_VLM_MAX_ATTEMPTS", retry.max_attempts, "max_attempts") {
+        if let Some(attempts) = setting!(
+            flags.max_attempts,
+            "NESY_VLM_MAX_ATTEMPTS",
+            retry.max_attempts,
+            "max_attempts"
+        ) {
             if attempts == 0 {
                 return Err(invalid("max_attempts", "must be at least 1"));
             }
@@ -305,38 +349,69 @@ impl VlmConfig {
         }
 
         let timeouts = file.timeouts.unwrap_or_default();
-        let pick = |flag: Option<f64>, var: &'static str, file: Option<f64>, key: &str| -> Result<_, ConfigError> {
-            match (flag, env.var(var), file) {
-                (Some(v), _, _) => Ok(Some(seconds(v, "flag")?)),
-                (None, Some(v), _) => Ok(Some(seconds(parse(&v, var)?, var)?)),
-                (None, None, Some(v)) => Ok(Some(seconds(v, &file_origin(key))?)),
-                (None, None, None) => Ok(None),
-            }
-        };
-        if let Some(t) = pick(None, "NESY_VLM_TIMEOUT_CONNECT_SECS", timeouts.connect_secs, "timeouts.connect_secs")? {
+        let pick =
+            |flag: Option<f64>, var: &'static str, file: Option<f64>, key: &str| -> Result<_, ConfigError> {
+                match (flag, env.var(var), file) {
+                    (Some(v), _, _) => Ok(Some(seconds(v, "flag")?)),
+                    (None, Some(v), _) => Ok(Some(seconds(parse(&v, var)?, var)?)),
+                    (None, None, Some(v)) => Ok(Some(seconds(v, &file_origin(key))?)),
+                    (None, None, None) => Ok(None),
+                }
+            };
+        if let Some(t) = pick(
+            None,
+            "NESY_VLM_TIMEOUT_CONNECT_SECS",
+            timeouts.connect_secs,
+            "timeouts.connect_secs",
+        )? {
             config.timeouts.connect = Some(t);
         }
-        if let Some(t) = pick(None, "NESY_VLM_TIMEOUT_READ_SECS", timeouts.read_secs, "timeouts.read_secs")? {
+        if let Some(t) = pick(
+            None,
+            "NESY_VLM_TIMEOUT_READ_SECS",
+            timeouts.read_secs,
+            "timeouts.read_secs",
+        )? {
             config.timeouts.read = Some(t);
         }
-        if let Some(t) =
-            pick(flags.timeout_secs, "NESY_VLM_TIMEOUT_TOTAL_SECS", timeouts.total_secs, "timeouts.total_secs")?
-        {
+        if let Some(t) = pick(
+            flags.timeout_secs,
+            "NESY_VLM_TIMEOUT_TOTAL_SECS",
+            timeouts.total_secs,
+            "timeouts.total_secs",
+        )? {
             config.timeouts.total = Some(t);
         }
 
         let cassette = file.cassette.unwrap_or_default();
-        let cassette_path = flags.cassette.clone().or_else(|| env.var("NESY_CASSETTE").map(PathBuf::from)).or(cassette.path);
+        let cassette_path = flags
+            .cassette
+            .clone()
+            .or_else(|| env.var("NESY_CASSETTE").map(PathBuf::from))
+            .or(cassette.path);
         if let Some(path) = cassette_path {
-            let mode = setting!(flags.cassette_mode, "NESY_CASSETTE_MODE", cassette.mode, "cassette.mode")
-                .unwrap_or(CassetteMode::None);
+            let mode = setting!(
+                flags.cassette_mode,
+                "NESY_CASSETTE_MODE",
+                cassette.mode,
+                "cassette.mode"
+            )
+            .unwrap_or(CassetteMode::None);
             let strict = flags.cassette_strict
                 || match env.var("NESY_CASSETTE_STRICT") {
                     Some(v) => parse_bool(&v, "NESY_CASSETTE_STRICT")?,
                     None => cassette.strict.unwrap_or(false),
                 };
-            let usage_report = env.var("NESY_CASSETTE_USAGE").map(PathBuf::from).or(cassette.usage_report);
-            config.cassette = Some(CassetteSettings { path, mode, strict, usage_report });
+            let usage_report = env
+                .var("NESY_CASSETTE_USAGE")
+                .map(PathBuf::from)
+                .or(cassette.usage_report);
+            config.cassette = Some(CassetteSettings {
+                path,
+                mode,
+                strict,
+                usage_report,
+            });
         }
         config.prices = file.prices.unwrap_or_default();
         Ok(config)
@@ -357,7 +432,10 @@ fn parse<T: FromStr>(value: &str, origin: &str) -> Result<T, ConfigError>
 where
     T::Err: std::fmt::Display,
 {
-    value.trim().parse().map_err(|err: T::Err| invalid(origin, &err.to_string()))
+    value
+        .trim()
+        .parse()
+        .map_err(|err: T::Err| invalid(origin, &err.to_string()))
 }
 
 fn parse_bool(value: &str, origin: &str) -> Result<bool, ConfigError> {
@@ -369,12 +447,19 @@ fn parse_bool(value: &str, origin: &str) -> Result<bool, ConfigError> {
 }
 
 fn seconds(value: f64, origin: &str) -> Result<Duration, ConfigError> {
-    Duration::try_from_secs_f64(value)
-        .map_err(|_| invalid(origin, &format!("expected a non-negative number of seconds, got {value}")))
+    Duration::try_from_secs_f64(value).map_err(|_| {
+        invalid(
+            origin,
+            &format!("expected a non-negative number of seconds, got {value}"),
+        )
+    })
 }
 
 fn invalid(origin: &str, message: &str) -> ConfigError {
-    ConfigError::Invalid { origin: origin.to_string(), message: message.to_string() }
+    ConfigError::Invalid {
+        origin: origin.to_string(),
+        message: message.to_string(),
+    }
 }
 
 /// Flags that override the environment and the file; the CLI flattens these into its
@@ -487,9 +572,14 @@ struct FileCassette {
 
 impl FileConfig {
     fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| ConfigError::Io { path: path.to_path_buf(), source })?;
-        toml::from_str(&text).map_err(|err| ConfigError::File { path: path.to_path_buf(), message: err.to_string() })
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        toml::from_str(&text).map_err(|err| ConfigError::File {
+            path: path.to_path_buf(),
+            message: err.to_string(),
+        })
     }
 }
 
@@ -498,7 +588,10 @@ mod tests {
     use super::*;
 
     fn env(pairs: &[(&str, &str)]) -> HashMap<String, String> {
-        pairs.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+        pairs
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect()
     }
 
     #[test]
@@ -510,12 +603,18 @@ mod tests {
             ("NESY_CASSETTE", "c.json"),
             ("NESY_CASSETTE_MODE", "new_episodes"),
         ]);
-        let flags = ConfigOverrides { model: Some("gpt-5-mini".into()), ..Default::default() };
+        let flags = ConfigOverrides {
+            model: Some("gpt-5-mini".into()),
+            ..Default::default()
+        };
         let config = VlmConfig::resolve(&flags, &vars).unwrap();
         assert_eq!(config.backend, BackendKind::OpenAi);
         assert_eq!(config.base_url, "https://api.openai.com/v1");
         assert_eq!(config.model, "gpt-5-mini");
-        assert_eq!(config.api_key.as_ref().map(SecretString::expose), Some("sk-env-secret-123"));
+        assert_eq!(
+            config.api_key.as_ref().map(SecretString::expose),
+            Some("sk-env-secret-123")
+        );
         assert_eq!(config.defaults.reasoning_effort, Some(ReasoningEffort::Low));
         assert_eq!(config.cassette.as_ref().unwrap().mode, CassetteMode::NewEpisodes);
         assert!(config.profile().reasoning);
@@ -545,39 +644,97 @@ output_per_mtok = 10.0
 "#,
         )
         .unwrap();
-        let vars = env(&[("NESY_VLM_CONFIG", path.to_str().unwrap()), ("MY_AZURE_KEY", "azure-secret"), ("NESY_VLM_TEMPERATURE", "0.5")]);
+        let vars = env(&[
+            ("NESY_VLM_CONFIG", path.to_str().unwrap()),
+            ("MY_AZURE_KEY", "azure-secret"),
+            ("NESY_VLM_TEMPERATURE", "0.5"),
+        ]);
         let config = VlmConfig::resolve(&ConfigOverrides::default(), &vars).unwrap();
         assert_eq!(config.backend, BackendKind::Azure);
         assert_eq!(config.base_url, "https://res.openai.azure.com");
-        assert_eq!(config.api_key.as_ref().map(SecretString::expose), Some("azure-secret"));
+        assert_eq!(
+            config.api_key.as_ref().map(SecretString::expose),
+            Some("azure-secret")
+        );
         assert_eq!(config.defaults.temperature, Some(0.5));
         assert_eq!(config.timeouts.connect, Some(Duration::from_secs(3)));
-        assert_eq!(config.profile().path, "/openai/deployments/gpt-4o-deploy/chat/completions?api-version=2024-10-21");
+        assert_eq!(
+            config.profile().path,
+            "/openai/deployments/gpt-4o-deploy/chat/completions?api-version=2024-10-21"
+        );
         assert!(config.prices.lookup("gpt-4o").is_some());
     }
 
     #[test]
     fn errors_name_their_origin() {
-        let err = VlmConfig::resolve(&ConfigOverrides::default(), &env(&[])).unwrap_err().to_string();
+        let err = VlmConfig::resolve(&ConfigOverrides::default(), &env(&[]))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("NESY_VLM_MODEL"), "{err}");
         let vars = env(&[("NESY_VLM_MODEL", "m"), ("NESY_VLM_MAX_TOKENS", "lots")]);
-        let err = VlmConfig::resolve(&ConfigOverrides::default(), &vars).unwrap_err().to_string();
+        let err = VlmConfig::resolve(&ConfigOverrides::default(), &vars)
+            .unwrap_err()
+            .to_string();
         assert!(err.starts_with("NESY_VLM_MAX_TOKENS:"), "{err}");
         let vars = env(&[("NESY_VLM_MODEL", "m"), ("NESY_VLM_BACKEND", "azure")]);
-        let err = VlmConfig::resolve(&ConfigOverrides::default(), &vars).unwrap_err().to_string();
+        let err = VlmConfig::resolve(&ConfigOverrides::default(), &vars)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("AZURE_OPENAI_ENDPOINT"), "{err}");
 
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("bad.toml");
         std::fs::write(&path, "model = \"m\"\nmax_tokens = 5\n").unwrap();
         let vars = env(&[("NESY_VLM_CONFIG", path.to_str().unwrap())]);
-        let err = VlmConfig::resolve(&ConfigOverrides::default(), &vars).unwrap_err().to_string();
-        assert!(err.contains("bad.toml") && err.contains("max_tokens") && err.contains("line 2"), "{err}");
+        let err = VlmConfig::resolve(&ConfigOverrides::default(), &vars)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("bad.toml") && err.contains("max_tokens") && err.contains("line 2"),
+            "{err}"
+        );
+    }
+
+    #[cfg(feature = "clap")]
+    #[test]
+    fn flags_parse_through_clap() {
+        use clap::Parser as _;
+        #[derive(clap::Parser)]
+        struct Cli {
+            #[command(flatten)]
+            vlm: ConfigOverrides,
+        }
+        let cli = Cli::try_parse_from([
+            "nesy",
+            "--vlm-backend",
+            "llama.cpp",
+            "--vlm-model",
+            "local",
+            "--vlm-reasoning-effort",
+            "high",
+            "--cassette-mode",
+            "new_episodes",
+            "--cassette-strict",
+        ])
+        .unwrap();
+        assert_eq!(cli.vlm.backend, Some(BackendKind::LlamaCpp));
+        assert_eq!(cli.vlm.reasoning_effort, Some(ReasoningEffort::High));
+        assert_eq!(cli.vlm.cassette_mode, Some(CassetteMode::NewEpisodes));
+        assert!(cli.vlm.cassette_strict);
+        let err = Cli::try_parse_from(["nesy", "--vlm-backend", "bedrock"])
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(err.contains("expected openai"), "{err}");
     }
 
     #[test]
     fn local_backends_never_pick_up_cloud_keys_and_azure_v1_path_is_normalised() {
-        let vars = env(&[("NESY_VLM_MODEL", "qwen"), ("NESY_VLM_BACKEND", "vllm"), ("OPENAI_API_KEY", "sk-x")]);
+        let vars = env(&[
+            ("NESY_VLM_MODEL", "qwen"),
+            ("NESY_VLM_BACKEND", "vllm"),
+            ("OPENAI_API_KEY", "sk-x"),
+        ]);
         let config = VlmConfig::resolve(&ConfigOverrides::default(), &vars).unwrap();
         assert_eq!(config.api_key, None);
         assert_eq!(config.base_url, "http://localhost:8000/v1");

@@ -35,14 +35,17 @@ pub enum VlmError {
         /// The request path (relative to the base URL).
         path: String,
         /// The provider's error object, parsed tolerantly, with the raw body.
-        provider: ProviderError,
+        provider: Box<ProviderError>,
         /// `x-request-id` / `apim-request-id` of the failed response.
         request_id: Option<String>,
         /// Attempts made, including the last.
         attempts: u32,
     },
     /// A success status whose body is not a chat-completions response.
-    #[error("invalid response body (HTTP {status}{}): {detail}; body starts {excerpt:?}", request_id_suffix(request_id))]
+    #[error(
+        "invalid response body (HTTP {status}{}): {detail}; body starts {excerpt:?}",
+        request_id_suffix(request_id)
+    )]
     InvalidResponse {
         /// The HTTP status code.
         status: u16,
@@ -54,7 +57,10 @@ pub enum VlmError {
         request_id: Option<String>,
     },
     /// The model stopped at the token cap (`finish_reason == "length"`).
-    #[error("output truncated at the token cap (finish_reason \"length\"){}", request_id_suffix(request_id))]
+    #[error(
+        "output truncated at the token cap (finish_reason \"length\"){}",
+        request_id_suffix(request_id)
+    )]
     Truncated {
         /// The text produced before the cap.
         partial_text: String,
@@ -106,11 +112,18 @@ impl VlmError {
 }
 
 fn request_id_suffix(request_id: &Option<String>) -> String {
-    request_id.as_ref().map(|id| format!(" [request id {id}]")).unwrap_or_default()
+    request_id
+        .as_ref()
+        .map(|id| format!(" [request id {id}]"))
+        .unwrap_or_default()
 }
 
 fn attempts_suffix(attempts: u32) -> String {
-    if attempts > 1 { format!(" (after {attempts} attempts)") } else { String::new() }
+    if attempts > 1 {
+        format!(" (after {attempts} attempts)")
+    } else {
+        String::new()
+    }
 }
 
 /// The provider's error object (`{"error": {"message", "type", "code", "param"}}`), read
@@ -153,15 +166,28 @@ impl ProviderError {
             Some(other) => Some(other.to_string()),
         };
         match serde_json::from_slice::<Envelope>(body) {
-            Ok(Envelope { error: Some(inner), .. }) => Self {
+            Ok(Envelope {
+                error: Some(inner), ..
+            }) => Self {
                 message: inner.message.unwrap_or_default(),
                 error_type: as_string(inner.error_type),
                 code: as_string(inner.code),
                 param: as_string(inner.param),
                 body: raw,
             },
-            Ok(Envelope { message: Some(message), .. }) => Self { message, body: raw, ..Self::default() },
-            _ => Self { message: truncate_chars(text.trim(), 300), body: raw, ..Self::default() },
+            Ok(Envelope {
+                message: Some(message),
+                ..
+            }) => Self {
+                message,
+                body: raw,
+                ..Self::default()
+            },
+            _ => Self {
+                message: truncate_chars(text.trim(), 300),
+                body: raw,
+                ..Self::default()
+            },
         }
     }
 
@@ -174,11 +200,19 @@ impl ProviderError {
 
 impl fmt::Display for ProviderError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(if self.message.is_empty() { "(no error message)" } else { &self.message })?;
-        let tags: Vec<String> = [("type", &self.error_type), ("code", &self.code), ("param", &self.param)]
-            .iter()
-            .filter_map(|(name, value)| value.as_ref().map(|v| format!("{name}={v}")))
-            .collect();
+        f.write_str(if self.message.is_empty() {
+            "(no error message)"
+        } else {
+            &self.message
+        })?;
+        let tags: Vec<String> = [
+            ("type", &self.error_type),
+            ("code", &self.code),
+            ("param", &self.param),
+        ]
+        .iter()
+        .filter_map(|(name, value)| value.as_ref().map(|v| format!("{name}={v}")))
+        .collect();
         if !tags.is_empty() {
             write!(f, " ({})", tags.join(", "))?;
         }
@@ -264,7 +298,10 @@ mod tests {
 
     #[test]
     fn provider_error_tolerates_other_shapes() {
-        assert_eq!(ProviderError::from_body(b"upstream down").message, "upstream down");
+        assert_eq!(
+            ProviderError::from_body(b"upstream down").message,
+            "upstream down"
+        );
         assert_eq!(ProviderError::from_body(br#"{"message":"bad"}"#).message, "bad");
         let numeric = ProviderError::from_body(br#"{"error":{"message":"m","code":429}}"#);
         assert_eq!(numeric.code.as_deref(), Some("429"));

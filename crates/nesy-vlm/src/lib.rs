@@ -44,7 +44,9 @@ pub mod transport;
 pub use accounting::{CallRecord, ModelPrice, PriceTable, RunUsage, UsageTotals};
 pub use cassette::{CassetteError, CassetteMode, CassetteOptions, CassetteTransport};
 pub use client::VlmClient;
-pub use config::{CassetteSettings, ConfigError, ConfigOverrides, EnvSource, ProcessEnv, Timeouts, VlmConfig};
+pub use config::{
+    CassetteSettings, ConfigError, ConfigOverrides, EnvSource, ProcessEnv, Timeouts, VlmConfig,
+};
 pub use error::{ProviderError, TimeoutPhase, TransportError, VlmError};
 pub use profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, TokenCapField};
 pub use request::{ChatRequest, Image, ImageDetail, Message, Part, ReasoningEffort, Role, TaskContext};

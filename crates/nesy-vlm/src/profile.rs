@@ -104,7 +104,9 @@ impl FromStr for ReasoningMode {
             "auto" => Ok(Self::Auto),
             "on" | "true" | "yes" => Ok(Self::On),
             "off" | "false" | "no" => Ok(Self::Off),
-            other => Err(format!("unknown reasoning mode {other:?}; expected auto, on or off")),
+            other => Err(format!(
+                "unknown reasoning mode {other:?}; expected auto, on or off"
+            )),
         }
     }
 }
@@ -177,7 +179,10 @@ pub struct Profile {
 pub fn looks_like_reasoning_model(model: &str) -> bool {
     let name = model.rsplit('/').next().unwrap_or(model).to_ascii_lowercase();
     let o_series = ["o1", "o3", "o4"].iter().any(|prefix| {
-        name == *prefix || name.strip_prefix(prefix).is_some_and(|rest| rest.starts_with('-'))
+        name == *prefix
+            || name
+                .strip_prefix(prefix)
+                .is_some_and(|rest| rest.starts_with('-'))
     });
     (o_series || name.starts_with("gpt-5")) && !name.contains("-chat")
 }
@@ -197,8 +202,10 @@ impl Profile {
             ReasoningMode::On => true,
             ReasoningMode::Off => false,
             ReasoningMode::Auto => {
-                matches!(kind, BackendKind::OpenAi | BackendKind::Azure | BackendKind::AzureV1)
-                    && looks_like_reasoning_model(model)
+                matches!(
+                    kind,
+                    BackendKind::OpenAi | BackendKind::Azure | BackendKind::AzureV1
+                ) && looks_like_reasoning_model(model)
             }
         };
         let (path, sends_model) = match kind {
@@ -213,7 +220,9 @@ impl Profile {
             _ => ("/chat/completions".to_string(), true),
         };
         let token_cap_field = match kind {
-            BackendKind::OpenAi | BackendKind::Azure | BackendKind::AzureV1 => TokenCapField::MaxCompletionTokens,
+            BackendKind::OpenAi | BackendKind::Azure | BackendKind::AzureV1 => {
+                TokenCapField::MaxCompletionTokens
+            }
             BackendKind::Vllm | BackendKind::Ollama | BackendKind::LlamaCpp => TokenCapField::MaxTokens,
         };
         let auth = match kind {
@@ -257,7 +266,11 @@ impl Profile {
             let value: f64 = temperature.to_string().parse().unwrap_or(f64::from(temperature));
             body.insert("temperature".into(), Value::from(value));
         }
-        if let Some(effort) = request.reasoning_effort.or(self.defaults.reasoning_effort).filter(|_| self.reasoning) {
+        if let Some(effort) = request
+            .reasoning_effort
+            .or(self.defaults.reasoning_effort)
+            .filter(|_| self.reasoning)
+        {
             body.insert("reasoning_effort".into(), Value::from(effort.as_str()));
         }
         for (key, value) in &request.extra {
@@ -277,7 +290,11 @@ impl Profile {
                 base64::engine::general_purpose::STANDARD.encode_string(image.bytes(), &mut url);
                 let mut image_url = Map::new();
                 image_url.insert("url".into(), Value::String(url));
-                if let Some(detail) = image.detail().or(self.defaults.image_detail).filter(|_| self.sends_image_detail) {
+                if let Some(detail) = image
+                    .detail()
+                    .or(self.defaults.image_detail)
+                    .filter(|_| self.sends_image_detail)
+                {
                     image_url.insert("detail".into(), Value::from(detail.as_str()));
                 }
                 json!({ "type": "image_url", "image_url": image_url })
@@ -292,10 +309,24 @@ mod tests {
 
     #[test]
     fn reasoning_model_names() {
-        for name in ["o1", "o3-mini", "o4-mini-2025-04-16", "gpt-5", "gpt-5.2", "openai/gpt-5-mini"] {
+        for name in [
+            "o1",
+            "o3-mini",
+            "o4-mini-2025-04-16",
+            "gpt-5",
+            "gpt-5.2",
+            "openai/gpt-5-mini",
+        ] {
             assert!(looks_like_reasoning_model(name), "{name}");
         }
-        for name in ["gpt-4o", "gpt-4.1", "gpt-5-chat-latest", "qwen2.5-vl", "o1x", "llava:13b"] {
+        for name in [
+            "gpt-4o",
+            "gpt-4.1",
+            "gpt-5-chat-latest",
+            "qwen2.5-vl",
+            "o1x",
+            "llava:13b",
+        ] {
             assert!(!looks_like_reasoning_model(name), "{name}");
         }
     }
@@ -304,6 +335,11 @@ mod tests {
     fn backend_names_parse() {
         assert_eq!("llama.cpp".parse::<BackendKind>(), Ok(BackendKind::LlamaCpp));
         assert_eq!("AZURE_V1".parse::<BackendKind>(), Ok(BackendKind::AzureV1));
-        assert!("bedrock".parse::<BackendKind>().unwrap_err().contains("expected openai"));
+        assert!(
+            "bedrock"
+                .parse::<BackendKind>()
+                .unwrap_err()
+                .contains("expected openai")
+        );
     }
 }

@@ -65,7 +65,9 @@ impl FromStr for ImageDetail {
             "auto" => Ok(Self::Auto),
             "low" => Ok(Self::Low),
             "high" => Ok(Self::High),
-            other => Err(format!("unknown image detail {other:?}; expected auto, low or high")),
+            other => Err(format!(
+                "unknown image detail {other:?}; expected auto, low or high"
+            )),
         }
     }
 }
@@ -185,7 +187,11 @@ impl Image {
                 head.join(" ")
             ))
         })?;
-        Ok(Self { bytes, mime, detail: None })
+        Ok(Self {
+            bytes,
+            mime,
+            detail: None,
+        })
     }
 
     /// Sets this image's `detail`, overriding the client's default.
@@ -212,7 +218,13 @@ impl Image {
 
 impl fmt::Debug for Image {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "Image({}, {} bytes, detail {:?})", self.mime.as_str(), self.bytes.len(), self.detail)
+        write!(
+            f,
+            "Image({}, {} bytes, detail {:?})",
+            self.mime.as_str(),
+            self.bytes.len(),
+            self.detail
+        )
     }
 }
 
@@ -289,7 +301,10 @@ pub struct TaskContext {
 impl TaskContext {
     /// A task context of the given kind.
     pub fn new(kind: impl Into<String>, data: serde_json::Value) -> Self {
-        Self { kind: kind.into(), data: Arc::new(data) }
+        Self {
+            kind: kind.into(),
+            data: Arc::new(data),
+        }
     }
 }
 
@@ -368,8 +383,16 @@ mod tests {
 
     #[test]
     fn image_types_are_detected_and_junk_rejected() {
-        assert_eq!(Image::from_encoded(b"\x89PNG\r\n\x1a\n....".to_vec()).unwrap().mime(), ImageMime::Png);
-        assert_eq!(Image::from_encoded(vec![0xFF, 0xD8, 0xFF, 0xE0]).unwrap().mime(), ImageMime::Jpeg);
+        assert_eq!(
+            Image::from_encoded(b"\x89PNG\r\n\x1a\n....".to_vec())
+                .unwrap()
+                .mime(),
+            ImageMime::Png
+        );
+        assert_eq!(
+            Image::from_encoded(vec![0xFF, 0xD8, 0xFF, 0xE0]).unwrap().mime(),
+            ImageMime::Jpeg
+        );
         let err = Image::png(b"GIF89a....".to_vec()).unwrap_err().to_string();
         assert!(err.contains("47 49 46 38"), "{err}");
         let err = Image::png(vec![0xFF, 0xD8, 0xFF]).unwrap_err().to_string();
@@ -379,7 +402,12 @@ mod tests {
     #[test]
     fn enums_parse_with_helpful_errors() {
         assert_eq!("HIGH".parse::<ImageDetail>(), Ok(ImageDetail::High));
-        assert!("huge".parse::<ImageDetail>().unwrap_err().contains("auto, low or high"));
+        assert!(
+            "huge"
+                .parse::<ImageDetail>()
+                .unwrap_err()
+                .contains("auto, low or high")
+        );
         assert_eq!("minimal".parse::<ReasoningEffort>(), Ok(ReasoningEffort::Minimal));
     }
 }

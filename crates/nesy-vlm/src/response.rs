@@ -140,8 +140,16 @@ pub(crate) fn parse_completion(
         request_id: request_id.map(str::to_string),
     };
     let wire: WireCompletion = serde_json::from_slice(body).map_err(|err| {
-        let kind = if err.is_eof() { "truncated JSON" } else { "invalid JSON" };
-        invalid(format!("{kind} at line {} column {}: {err}", err.line(), err.column()))
+        let kind = if err.is_eof() {
+            "truncated JSON"
+        } else {
+            "invalid JSON"
+        };
+        invalid(format!(
+            "{kind} at line {} column {}: {err}",
+            err.line(),
+            err.column()
+        ))
     })?;
     let choice = wire
         .choices
@@ -151,7 +159,10 @@ pub(crate) fn parse_completion(
     let usage = wire.usage.map(|u| Usage {
         prompt_tokens: u.prompt_tokens.unwrap_or(0),
         completion_tokens: u.completion_tokens.unwrap_or(0),
-        reasoning_tokens: u.completion_tokens_details.and_then(|d| d.reasoning_tokens).unwrap_or(0),
+        reasoning_tokens: u
+            .completion_tokens_details
+            .and_then(|d| d.reasoning_tokens)
+            .unwrap_or(0),
         cached_prompt_tokens: u.prompt_tokens_details.and_then(|d| d.cached_tokens).unwrap_or(0),
     });
     let finish_reason = FinishReason::from_wire(choice.finish_reason.as_deref());
@@ -173,7 +184,11 @@ pub(crate) fn parse_completion(
         Some(VlmError::Refusal { reason, request_id })
     } else {
         match finish_reason {
-            FinishReason::Length => Some(VlmError::Truncated { partial_text: text, usage, request_id }),
+            FinishReason::Length => Some(VlmError::Truncated {
+                partial_text: text,
+                usage,
+                request_id,
+            }),
             FinishReason::ContentFilter => Some(VlmError::Refusal {
                 reason: "the provider's content filter stopped the output".to_string(),
                 request_id,
@@ -221,27 +236,39 @@ mod tests {
         assert_eq!(parsed.text, "ab");
         assert_eq!(
             parsed.usage,
-            Some(Usage { prompt_tokens: 10, completion_tokens: 7, reasoning_tokens: 5, cached_prompt_tokens: 4 })
+            Some(Usage {
+                prompt_tokens: 10,
+                completion_tokens: 7,
+                reasoning_tokens: 5,
+                cached_prompt_tokens: 4
+            })
         );
     }
 
     #[test]
     fn refusal_and_length_are_errors() {
-        let refusal = br#"{"choices":[{"message":{"content":null,"refusal":"I can't help"},"finish_reason":"stop"}]}"#;
+        let refusal =
+            br#"{"choices":[{"message":{"content":null,"refusal":"I can't help"},"finish_reason":"stop"}]}"#;
         let (_, error) = parse_completion(200, refusal, Some("req-1")).unwrap();
         assert!(matches!(error, Some(VlmError::Refusal { ref reason, .. }) if reason == "I can't help"));
         let length = br#"{"choices":[{"message":{"content":"(OnTop"},"finish_reason":"length"}]}"#;
         let (_, error) = parse_completion(200, length, None).unwrap();
-        assert!(matches!(error, Some(VlmError::Truncated { ref partial_text, .. }) if partial_text == "(OnTop"));
+        assert!(
+            matches!(error, Some(VlmError::Truncated { ref partial_text, .. }) if partial_text == "(OnTop")
+        );
     }
 
     #[test]
     fn bad_bodies_name_line_and_column() {
-        let err = parse_completion(200, br#"{"choices":[{"mess"#, Some("r")).unwrap_err().to_string();
+        let err = parse_completion(200, br#"{"choices":[{"mess"#, Some("r"))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("truncated JSON at line 1 column"), "{err}");
         let err = parse_completion(200, b"<html>", None).unwrap_err().to_string();
         assert!(err.contains("invalid JSON at line 1 column 1"), "{err}");
-        let err = parse_completion(200, br#"{"choices":[]}"#, None).unwrap_err().to_string();
+        let err = parse_completion(200, br#"{"choices":[]}"#, None)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("no `choices[0]`"), "{err}");
     }
 }

@@ -57,7 +57,10 @@ impl RetryPolicy {
             return requested;
         }
         let exponent = failed_attempts.saturating_sub(1).min(30);
-        let backoff = self.base_delay.saturating_mul(1u32 << exponent).min(self.max_delay);
+        let backoff = self
+            .base_delay
+            .saturating_mul(1u32 << exponent)
+            .min(self.max_delay);
         backoff.mul_f64(1.0 - 0.25 * unit_random())
     }
 }
@@ -65,7 +68,9 @@ impl RetryPolicy {
 /// `retry-after-ms` (milliseconds, may be fractional), else `retry-after` (seconds or an
 /// HTTP date).
 pub(crate) fn server_requested_delay(response: &WireResponse, now: SystemTime) -> Option<Duration> {
-    if let Some(ms) = response.header("retry-after-ms").and_then(|v| v.trim().parse::<f64>().ok())
+    if let Some(ms) = response
+        .header("retry-after-ms")
+        .and_then(|v| v.trim().parse::<f64>().ok())
         && ms.is_finite()
         && ms >= 0.0
     {
@@ -83,7 +88,11 @@ pub(crate) fn server_requested_delay(response: &WireResponse, now: SystemTime) -
 /// needs no cryptographic quality.
 fn unit_random() -> f64 {
     let mut hasher = std::collections::hash_map::RandomState::new().build_hasher();
-    hasher.write_u64(SystemTime::now().duration_since(SystemTime::UNIX_EPOCH).map_or(0, |d| d.as_nanos() as u64));
+    hasher.write_u64(
+        SystemTime::now()
+            .duration_since(SystemTime::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos() as u64),
+    );
     (hasher.finish() >> 11) as f64 / (1u64 << 53) as f64
 }
 
@@ -95,7 +104,10 @@ mod tests {
     fn response(status: u16, headers: &[(&str, &str)], body: &str) -> WireResponse {
         WireResponse {
             status,
-            headers: headers.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect(),
+            headers: headers
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect(),
             body: body.to_string().into(),
             origin: Origin::Live,
         }
@@ -105,28 +117,49 @@ mod tests {
     fn retryable_statuses() {
         let plain = ProviderError::default();
         for status in [408, 409, 429, 500, 502, 503] {
-            assert!(status_is_retryable(&response(status, &[], ""), &plain), "{status}");
+            assert!(
+                status_is_retryable(&response(status, &[], ""), &plain),
+                "{status}"
+            );
         }
         for status in [400, 401, 403, 404, 422] {
-            assert!(!status_is_retryable(&response(status, &[], ""), &plain), "{status}");
+            assert!(
+                !status_is_retryable(&response(status, &[], ""), &plain),
+                "{status}"
+            );
         }
         let quota = ProviderError::from_body(br#"{"error":{"code":"insufficient_quota","message":"no"}}"#);
         assert!(!status_is_retryable(&response(429, &[], ""), &quota));
-        assert!(!status_is_retryable(&response(500, &[("x-should-retry", "false")], ""), &plain));
-        assert!(status_is_retryable(&response(400, &[("x-should-retry", "true")], ""), &plain));
+        assert!(!status_is_retryable(
+            &response(500, &[("x-should-retry", "false")], ""),
+            &plain
+        ));
+        assert!(status_is_retryable(
+            &response(400, &[("x-should-retry", "true")], ""),
+            &plain
+        ));
     }
 
     #[test]
     fn server_delays_in_order_of_preference() {
         let now = SystemTime::UNIX_EPOCH + Duration::from_secs(1_700_000_000);
         let both = response(429, &[("retry-after", "7"), ("retry-after-ms", "1500.5")], "");
-        assert_eq!(server_requested_delay(&both, now), Some(Duration::from_micros(1_500_500)));
+        assert_eq!(
+            server_requested_delay(&both, now),
+            Some(Duration::from_micros(1_500_500))
+        );
         let seconds = response(429, &[("retry-after", "2")], "");
-        assert_eq!(server_requested_delay(&seconds, now), Some(Duration::from_secs(2)));
+        assert_eq!(
+            server_requested_delay(&seconds, now),
+            Some(Duration::from_secs(2))
+        );
         let date = httpdate::fmt_http_date(now + Duration::from_secs(30));
         let dated = response(429, &[("retry-after", date.as_str())], "");
         assert_eq!(server_requested_delay(&dated, now), Some(Duration::from_secs(30)));
-        assert_eq!(server_requested_delay(&response(429, &[("retry-after", "soon")], ""), now), None);
+        assert_eq!(
+            server_requested_delay(&response(429, &[("retry-after", "soon")], ""), now),
+            None
+        );
     }
 
     #[test]
@@ -134,7 +167,10 @@ mod tests {
         let policy = RetryPolicy::default();
         for (failed, nominal) in [(1, 500), (2, 1000), (3, 2000), (6, 8000), (40, 8000)] {
             let delay = policy.delay(failed, None).as_millis() as u64;
-            assert!(delay <= nominal && delay >= nominal * 3 / 4, "attempt {failed}: {delay} ms");
+            assert!(
+                delay <= nominal && delay >= nominal * 3 / 4,
+                "attempt {failed}: {delay} ms"
+            );
         }
         let too_long = response(429, &[("retry-after", "600")], "");
         assert!(policy.delay(1, Some(&too_long)) <= Duration::from_millis(500));

@@ -9,8 +9,8 @@ use std::sync::Arc;
 
 use nesy_vlm::cassette::{CassetteFile, tools};
 use nesy_vlm::{
-    BackendKind, CassetteError, CassetteMode, CassetteOptions, CassetteTransport, ChatRequest, Image, Message, Origin,
-    Part, SecretString, TaskContext, Transport, VlmClient, VlmConfig, VlmError,
+    BackendKind, CassetteError, CassetteMode, CassetteOptions, CassetteTransport, ChatRequest, Image,
+    Message, Origin, Part, SecretString, TaskContext, Transport, VlmClient, VlmConfig, VlmError,
 };
 use serde_json::json;
 use wiremock::matchers::method;
@@ -23,12 +23,19 @@ const ODD_BODY: &str = "{ \"id\":\"c-1\",\"model\":\"gpt-5\",  \"choices\":[{\"m
 
 fn request(prompt: &str, images: &[&[u8]]) -> ChatRequest {
     let mut parts = vec![Part::text(prompt)];
-    parts.extend(images.iter().map(|bytes| Part::from(Image::png(bytes.to_vec()).unwrap())));
+    parts.extend(
+        images
+            .iter()
+            .map(|bytes| Part::from(Image::png(bytes.to_vec()).unwrap())),
+    );
     ChatRequest::new()
         .message(Message::system("You are a careful planner."))
         .message(Message::user(parts))
         .purpose("induce")
-        .task(TaskContext::new("induce_operator", json!({"ground_truth": ["(OnTopOf a b)"]})))
+        .task(TaskContext::new(
+            "induce_operator",
+            json!({"ground_truth": ["(OnTopOf a b)"]}),
+        ))
 }
 
 fn openai(server: &MockServer) -> VlmConfig {
@@ -38,7 +45,12 @@ fn openai(server: &MockServer) -> VlmConfig {
 }
 
 fn with_cassette(mut cfg: VlmConfig, path: &Path, mode: CassetteMode) -> VlmConfig {
-    cfg.cassette = Some(nesy_vlm::CassetteSettings { path: path.to_path_buf(), mode, strict: false, usage_report: None });
+    cfg.cassette = Some(nesy_vlm::CassetteSettings {
+        path: path.to_path_buf(),
+        mode,
+        strict: false,
+        usage_report: None,
+    });
     cfg
 }
 
@@ -63,7 +75,8 @@ async fn record_then_replay_is_byte_identical_and_offline() {
     let path = dir.path().join("run.json");
     let image = png(32, 3);
 
-    let recorder = VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::Once)).unwrap();
+    let recorder =
+        VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::Once)).unwrap();
     let wire = recorder.wire_request(&request("first", &[&image]));
     let live = recorder.transport().send(&wire).await.unwrap();
     assert_eq!(live.origin, Origin::Live);
@@ -101,9 +114,21 @@ async fn record_then_replay_is_byte_identical_and_offline() {
     assert_eq!(file.meta.backend.as_deref(), Some("openai"));
     assert!(file.meta.recorder.starts_with("nesy-vlm "));
     assert_eq!(file.interactions[1].purpose.as_deref(), Some("induce"));
-    let headers: Vec<&str> = file.interactions[0].response.headers.keys().map(String::as_str).collect();
+    let headers: Vec<&str> = file.interactions[0]
+        .response
+        .headers
+        .keys()
+        .map(String::as_str)
+        .collect();
     assert_eq!(headers, ["content-type", "x-request-id"]);
-    for forbidden in ["set-cookie", "session=abc", "org-secret", "sk-test-cassette", "ground_truth", "base64,"] {
+    for forbidden in [
+        "set-cookie",
+        "session=abc",
+        "org-secret",
+        "sk-test-cassette",
+        "ground_truth",
+        "base64,",
+    ] {
         assert!(!text.contains(forbidden), "{forbidden} in cassette:\n{text}");
     }
     assert!(text.contains("blob:sha256:"));
@@ -126,26 +151,55 @@ async fn identical_requests_replay_in_recorded_order_then_miss() {
     for expected in ["first answer", "second answer"] {
         assert_eq!(recorder.chat(request("same", &[])).await.unwrap().text, expected);
     }
-    let replayer = VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::None)).unwrap();
-    assert_eq!(replayer.chat(request("same", &[])).await.unwrap().text, "first answer");
-    assert_eq!(replayer.chat(request("same", &[])).await.unwrap().text, "second answer");
+    let replayer =
+        VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::None)).unwrap();
+    assert_eq!(
+        replayer.chat(request("same", &[])).await.unwrap().text,
+        "first answer"
+    );
+    assert_eq!(
+        replayer.chat(request("same", &[])).await.unwrap().text,
+        "second answer"
+    );
     let err = replayer.chat(request("same", &[])).await.unwrap_err().to_string();
-    assert!(err.contains("recorded 2 time(s) and every recording was already replayed"), "{err}");
+    assert!(
+        err.contains("recorded 2 time(s) and every recording was already replayed"),
+        "{err}"
+    );
 }
 
 #[tokio::test]
 async fn a_miss_explains_itself_with_json_pointer_diffs_and_the_rerecord_command() {
     let server = MockServer::start().await;
-    Mock::given(method("POST")).respond_with(ResponseTemplate::new(200).set_body_json(completion("ok"))).mount(&server).await;
+    Mock::given(method("POST"))
+        .respond_with(ResponseTemplate::new(200).set_body_json(completion("ok")))
+        .mount(&server)
+        .await;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("miss.json");
     let recorder = VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::All)).unwrap();
-    recorder.chat(request("Put the red block on the tray.", &[])).await.unwrap();
-    recorder.chat(request("Something entirely different about drawers and lids.", &[&png(16, 1)])).await.unwrap();
+    recorder
+        .chat(request("Put the red block on the tray.", &[]))
+        .await
+        .unwrap();
+    recorder
+        .chat(request(
+            "Something entirely different about drawers and lids.",
+            &[&png(16, 1)],
+        ))
+        .await
+        .unwrap();
 
-    let replayer = VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::None)).unwrap();
-    let err = replayer.chat(request("Put the blue block on the tray.", &[])).await.unwrap_err();
-    let VlmError::Transport { source: nesy_vlm::TransportError::Cassette(CassetteError::Miss(miss)), attempts: 1 } = &err
+    let replayer =
+        VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::None)).unwrap();
+    let err = replayer
+        .chat(request("Put the blue block on the tray.", &[]))
+        .await
+        .unwrap_err();
+    let VlmError::Transport {
+        source: nesy_vlm::TransportError::Cassette(CassetteError::Miss(miss)),
+        attempts: 1,
+    } = &err
     else {
         panic!("expected a cassette miss, got {err:?}")
     };
@@ -171,15 +225,24 @@ async fn a_miss_explains_itself_with_json_pointer_diffs_and_the_rerecord_command
 #[tokio::test]
 async fn images_are_stored_once_per_content_hash() {
     let server = MockServer::start().await;
-    Mock::given(method("POST")).respond_with(ResponseTemplate::new(200).set_body_json(completion("ok"))).mount(&server).await;
+    Mock::given(method("POST"))
+        .respond_with(ResponseTemplate::new(200).set_body_json(completion("ok")))
+        .mount(&server)
+        .await;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("blobs.json");
     let (top, front) = (png(384, 1), png(384, 2));
     let client = VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::All)).unwrap();
     for step in 0..4 {
-        client.chat(request(&format!("step {step}"), &[&top, &front])).await.unwrap();
+        client
+            .chat(request(&format!("step {step}"), &[&top, &front]))
+            .await
+            .unwrap();
     }
-    let mut blobs: Vec<PathBuf> = std::fs::read_dir(dir.path().join("blobs")).unwrap().map(|e| e.unwrap().path()).collect();
+    let mut blobs: Vec<PathBuf> = std::fs::read_dir(dir.path().join("blobs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
     blobs.sort();
     assert_eq!(blobs.len(), 2, "two distinct images across four calls");
     for blob in &blobs {
@@ -187,7 +250,10 @@ async fn images_are_stored_once_per_content_hash() {
         assert!(bytes == top || bytes == front);
     }
     let size = std::fs::metadata(&path).unwrap().len();
-    assert!(size < 16 * 1024, "cassette holds references, not images: {size} bytes");
+    assert!(
+        size < 16 * 1024,
+        "cassette holds references, not images: {size} bytes"
+    );
     assert!(size * 10 < (top.len() + front.len()) as u64);
     let inspection = tools::inspect(&path).unwrap();
     assert_eq!(inspection.distinct_images, 2);
@@ -199,7 +265,8 @@ async fn images_are_stored_once_per_content_hash() {
 async fn secrets_echoed_by_a_server_are_redacted_and_auth_headers_never_stored() {
     let key = "sk-test-echoed-secret-0011";
     let server = MockServer::start().await;
-    let echoed = json!({"choices": [{"message": {"content": format!("your key is {key}")}, "finish_reason": "stop"}]});
+    let echoed =
+        json!({"choices": [{"message": {"content": format!("your key is {key}")}, "finish_reason": "stop"}]});
     Mock::given(method("POST"))
         .respond_with(
             ResponseTemplate::new(200)
@@ -218,13 +285,19 @@ async fn secrets_echoed_by_a_server_are_redacted_and_auth_headers_never_stored()
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(!text.contains(key), "{text}");
     assert!(text.contains("[REDACTED]"));
-    assert!(!text.to_ascii_lowercase().contains("authorization") && !text.contains("api-key"), "{text}");
+    assert!(
+        !text.to_ascii_lowercase().contains("authorization") && !text.contains("api-key"),
+        "{text}"
+    );
 }
 
 #[tokio::test]
 async fn new_episodes_resumes_a_broken_recording() {
     let server = MockServer::start().await;
-    Mock::given(method("POST")).respond_with(ResponseTemplate::new(200).set_body_json(completion("ok"))).mount(&server).await;
+    Mock::given(method("POST"))
+        .respond_with(ResponseTemplate::new(200).set_body_json(completion("ok")))
+        .mount(&server)
+        .await;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("resume.json");
     // A first run recorded one call and then "crashed".
@@ -232,14 +305,23 @@ async fn new_episodes_resumes_a_broken_recording() {
     first.chat(request("call 1", &[])).await.unwrap();
     drop(first);
     // The rerun replays call 1 and records call 2.
-    let second = VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::NewEpisodes)).unwrap();
-    assert_eq!(second.chat(request("call 1", &[])).await.unwrap().origin, Origin::Replayed);
-    assert_eq!(second.chat(request("call 2", &[])).await.unwrap().origin, Origin::Live);
+    let second =
+        VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::NewEpisodes)).unwrap();
+    assert_eq!(
+        second.chat(request("call 1", &[])).await.unwrap().origin,
+        Origin::Replayed
+    );
+    assert_eq!(
+        second.chat(request("call 2", &[])).await.unwrap().origin,
+        Origin::Live
+    );
     assert_eq!(served(&server).await, 2);
     assert_eq!(CassetteFile::load(&path).unwrap().interactions.len(), 2);
     // No temporary or lock files are left behind.
-    let names: Vec<String> =
-        std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
     assert_eq!(names, ["resume.json"]);
     // `once` with an existing file is replay-only.
     let once = VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::Once)).unwrap();
@@ -249,11 +331,16 @@ async fn new_episodes_resumes_a_broken_recording() {
 #[tokio::test]
 async fn two_recorders_appending_to_one_cassette_lose_nothing() {
     let server = MockServer::start().await;
-    Mock::given(method("POST")).respond_with(ResponseTemplate::new(200).set_body_json(completion("ok"))).mount(&server).await;
+    Mock::given(method("POST"))
+        .respond_with(ResponseTemplate::new(200).set_body_json(completion("ok")))
+        .mount(&server)
+        .await;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("shared.json");
-    let a = VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::NewEpisodes)).unwrap();
-    let b = VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::NewEpisodes)).unwrap();
+    let a =
+        VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::NewEpisodes)).unwrap();
+    let b =
+        VlmClient::from_config(&with_cassette(openai(&server), &path, CassetteMode::NewEpisodes)).unwrap();
     let calls = (0..8).map(|i| {
         let client = if i % 2 == 0 { a.clone() } else { b.clone() };
         async move { client.chat(request(&format!("call {i}"), &[])).await }
@@ -266,7 +353,10 @@ async fn two_recorders_appending_to_one_cassette_lose_nothing() {
 #[tokio::test]
 async fn strict_mode_reports_unused_and_prune_drops_them() {
     let server = MockServer::start().await;
-    Mock::given(method("POST")).respond_with(ResponseTemplate::new(200).set_body_json(completion("ok"))).mount(&server).await;
+    Mock::given(method("POST"))
+        .respond_with(ResponseTemplate::new(200).set_body_json(completion("ok")))
+        .mount(&server)
+        .await;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("strict.json");
     let report = dir.path().join("usage.json");
@@ -281,13 +371,23 @@ async fn strict_mode_reports_unused_and_prune_drops_them() {
     let replayer = VlmClient::from_config(&cfg).unwrap();
     replayer.chat(request("kept", &[&png(16, 7)])).await.unwrap();
     let err = replayer.finish().unwrap_err().to_string();
-    assert!(err.contains("1 recorded interaction(s) were not used") && err.contains("#1 (purpose induce"), "{err}");
+    assert!(
+        err.contains("1 recorded interaction(s) were not used") && err.contains("#1 (purpose induce"),
+        "{err}"
+    );
 
     let usage = tools::load_usage_report(&report).unwrap();
     assert_eq!((usage.used.len(), usage.unused.len()), (1, 1));
     let dry = tools::prune(&path, &usage, true, true).unwrap();
-    assert_eq!((dry.kept, dry.dropped.clone(), dry.removed_blobs.len()), (1, vec![1], 1));
-    assert_eq!(CassetteFile::load(&path).unwrap().interactions.len(), 2, "dry run changes nothing");
+    assert_eq!(
+        (dry.kept, dry.dropped.clone(), dry.removed_blobs.len()),
+        (1, vec![1], 1)
+    );
+    assert_eq!(
+        CassetteFile::load(&path).unwrap().interactions.len(),
+        2,
+        "dry run changes nothing"
+    );
     let done = tools::prune(&path, &usage, true, false).unwrap();
     assert_eq!(done, dry);
     assert_eq!(CassetteFile::load(&path).unwrap().interactions.len(), 1);
@@ -295,26 +395,49 @@ async fn strict_mode_reports_unused_and_prune_drops_them() {
     assert!(tools::verify(&path).unwrap().is_empty());
 
     // Verify notices a missing blob and a hand-edited request.
-    let blob = std::fs::read_dir(dir.path().join("blobs")).unwrap().next().unwrap().unwrap().path();
+    let blob = std::fs::read_dir(dir.path().join("blobs"))
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
     std::fs::remove_file(&blob).unwrap();
     let text = std::fs::read_to_string(&path).unwrap().replace("kept", "edited");
     std::fs::write(&path, text).unwrap();
-    let problems: Vec<String> = tools::verify(&path).unwrap().into_iter().map(|p| p.message).collect();
+    let problems: Vec<String> = tools::verify(&path)
+        .unwrap()
+        .into_iter()
+        .map(|p| p.message)
+        .collect();
     assert_eq!(problems.len(), 2, "{problems:?}");
-    assert!(problems.iter().any(|p| p.contains("is missing")) && problems.iter().any(|p| p.contains("was it edited")));
+    assert!(
+        problems.iter().any(|p| p.contains("is missing"))
+            && problems.iter().any(|p| p.contains("was it edited"))
+    );
 }
 
 #[test]
 fn opening_modes_that_record_without_a_live_transport_fails_clearly() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("x.json");
-    let err = CassetteTransport::open(&path, CassetteMode::NewEpisodes, None, CassetteOptions::default()).unwrap_err();
+    let err = CassetteTransport::open(&path, CassetteMode::NewEpisodes, None, CassetteOptions::default())
+        .unwrap_err();
     assert!(err.to_string().contains("needs to record"), "{err}");
-    std::fs::write(&path, "{\"schema_version\": 1, \"meta\": {}, \"interactions\": [}").unwrap();
-    let err = CassetteTransport::open(&path, CassetteMode::None, None, CassetteOptions::default()).unwrap_err();
+    std::fs::write(
+        &path,
+        "{\"schema_version\": 1, \"meta\": {}, \"interactions\": [}",
+    )
+    .unwrap();
+    let err =
+        CassetteTransport::open(&path, CassetteMode::None, None, CassetteOptions::default()).unwrap_err();
     assert!(err.to_string().contains("x.json:1:"), "{err}");
     let _: Arc<dyn Transport> = Arc::new(
-        CassetteTransport::open(dir.path().join("absent.json"), CassetteMode::None, None, CassetteOptions::default())
-            .unwrap(),
+        CassetteTransport::open(
+            dir.path().join("absent.json"),
+            CassetteMode::None,
+            None,
+            CassetteOptions::default(),
+        )
+        .unwrap(),
     );
 }

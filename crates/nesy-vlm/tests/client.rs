@@ -10,8 +10,8 @@ use std::time::Duration;
 
 use base64::Engine as _;
 use nesy_vlm::{
-    BackendKind, ChatRequest, Image, ImageDetail, Message, Origin, Part, ReasoningEffort, SecretString, TimeoutPhase,
-    Timeouts, Transport, TransportError, VlmClient, VlmError,
+    BackendKind, ChatRequest, Image, ImageDetail, Message, Origin, Part, ReasoningEffort, SecretString,
+    TimeoutPhase, Timeouts, Transport, TransportError, VlmClient, VlmError,
 };
 use serde_json::{Value, json};
 use wiremock::matchers::{header, method, path, query_param};
@@ -48,7 +48,11 @@ async fn openai_reasoning_profile_sends_max_completion_tokens_and_no_temperature
     Mock::given(method("POST"))
         .and(path("/v1/chat/completions"))
         .and(header("authorization", "Bearer sk-test-openai-key-0001"))
-        .respond_with(ResponseTemplate::new(200).set_body_json(completion("ok")).insert_header("x-request-id", "req_42"))
+        .respond_with(
+            ResponseTemplate::new(200)
+                .set_body_json(completion("ok"))
+                .insert_header("x-request-id", "req_42"),
+        )
         .mount(&server)
         .await;
     let mut cfg = config(BackendKind::OpenAi, "gpt-5", &format!("{}/v1", server.uri()));
@@ -60,7 +64,10 @@ async fn openai_reasoning_profile_sends_max_completion_tokens_and_no_temperature
     assert_eq!(reply.origin, Origin::Live);
 
     let (body, request) = only_request(&server).await;
-    assert_eq!(keys(&body), ["max_completion_tokens", "messages", "model", "reasoning_effort"]);
+    assert_eq!(
+        keys(&body),
+        ["max_completion_tokens", "messages", "model", "reasoning_effort"]
+    );
     assert_eq!(body["model"], "gpt-5");
     assert_eq!(body["max_completion_tokens"], 777);
     assert_eq!(body["reasoning_effort"], "low");
@@ -78,12 +85,22 @@ async fn openai_reasoning_profile_sends_max_completion_tokens_and_no_temperature
 #[tokio::test]
 async fn openai_chat_model_gets_temperature_not_reasoning_effort() {
     let server = MockServer::start().await;
-    Mock::given(method("POST")).respond_with(ResponseTemplate::new(200).set_body_json(completion("ok"))).mount(&server).await;
+    Mock::given(method("POST"))
+        .respond_with(ResponseTemplate::new(200).set_body_json(completion("ok")))
+        .mount(&server)
+        .await;
     let mut cfg = config(BackendKind::OpenAi, "gpt-4o", &server.uri());
     cfg.api_key = Some(SecretString::new("sk-test-openai-key-0002"));
-    VlmClient::from_config(&cfg).unwrap().chat(simple_request()).await.unwrap();
+    VlmClient::from_config(&cfg)
+        .unwrap()
+        .chat(simple_request())
+        .await
+        .unwrap();
     let (body, _) = only_request(&server).await;
-    assert_eq!(keys(&body), ["max_completion_tokens", "messages", "model", "temperature"]);
+    assert_eq!(
+        keys(&body),
+        ["max_completion_tokens", "messages", "model", "temperature"]
+    );
     assert_eq!(body["temperature"], 0.2);
 }
 
@@ -94,17 +111,28 @@ async fn azure_classic_uses_deployment_path_api_version_and_api_key_header() {
         .and(path("/openai/deployments/my-gpt5/chat/completions"))
         .and(query_param("api-version", "2025-04-01-preview"))
         .and(header("api-key", "azure-test-key-0003"))
-        .respond_with(ResponseTemplate::new(200).set_body_json(completion("ok")).insert_header("apim-request-id", "apim-7"))
+        .respond_with(
+            ResponseTemplate::new(200)
+                .set_body_json(completion("ok"))
+                .insert_header("apim-request-id", "apim-7"),
+        )
         .mount(&server)
         .await;
     let mut cfg = config(BackendKind::Azure, "gpt-5", &server.uri());
     cfg.azure_deployment = Some("my-gpt5".into());
     cfg.api_key = Some(SecretString::new("azure-test-key-0003"));
-    let reply = VlmClient::from_config(&cfg).unwrap().chat(simple_request()).await.unwrap();
+    let reply = VlmClient::from_config(&cfg)
+        .unwrap()
+        .chat(simple_request())
+        .await
+        .unwrap();
     assert_eq!(reply.request_id.as_deref(), Some("apim-7"));
     let (body, request) = only_request(&server).await;
     // The deployment is in the path, so no `model`; a reasoning deployment gets no temperature.
-    assert_eq!(keys(&body), ["max_completion_tokens", "messages", "reasoning_effort"]);
+    assert_eq!(
+        keys(&body),
+        ["max_completion_tokens", "messages", "reasoning_effort"]
+    );
     assert!(request.headers.get("authorization").is_none());
 }
 
@@ -123,11 +151,19 @@ async fn azure_v1_sends_deployment_as_model_under_openai_v1() {
         ("AZURE_OPENAI_ENDPOINT", server.uri()),
         ("AZURE_OPENAI_API_KEY", "azure-test-key-0004".to_string()),
     ];
-    let env: std::collections::HashMap<String, String> = vars.iter().map(|(k, v)| (k.to_string(), v.clone())).collect();
+    let env: std::collections::HashMap<String, String> =
+        vars.iter().map(|(k, v)| (k.to_string(), v.clone())).collect();
     let cfg = nesy_vlm::VlmConfig::resolve(&Default::default(), &env).unwrap();
-    VlmClient::from_config(&cfg).unwrap().chat(simple_request()).await.unwrap();
+    VlmClient::from_config(&cfg)
+        .unwrap()
+        .chat(simple_request())
+        .await
+        .unwrap();
     let (body, _) = only_request(&server).await;
-    assert_eq!(keys(&body), ["max_completion_tokens", "messages", "model", "temperature"]);
+    assert_eq!(
+        keys(&body),
+        ["max_completion_tokens", "messages", "model", "temperature"]
+    );
     assert_eq!(body["model"], "gpt-4o-deploy");
 }
 
@@ -152,12 +188,23 @@ async fn local_servers_get_max_tokens_and_their_auth_rules() {
         VlmClient::from_config(&cfg).unwrap().chat(request).await.unwrap();
         let (body, http) = only_request(&server).await;
         // Not a reasoning model: temperature yes, reasoning_effort no; the cap is max_tokens.
-        assert_eq!(keys(&body), ["max_tokens", "messages", "model", "temperature"], "{backend}");
+        assert_eq!(
+            keys(&body),
+            ["max_tokens", "messages", "model", "temperature"],
+            "{backend}"
+        );
         assert_eq!(body["max_tokens"], 777);
         assert_eq!(body["model"], "qwen2.5-vl-7b");
         let image_url = &body["messages"][2]["content"][1]["image_url"];
-        assert_eq!(image_url.get("detail").is_some(), detail_sent, "{backend}: {image_url}");
-        let auth = http.headers.get("authorization").map(|v| v.to_str().unwrap().to_string());
+        assert_eq!(
+            image_url.get("detail").is_some(),
+            detail_sent,
+            "{backend}: {image_url}"
+        );
+        let auth = http
+            .headers
+            .get("authorization")
+            .map(|v| v.to_str().unwrap().to_string());
         assert_eq!(auth, key.map(|k| format!("Bearer {k}")), "{backend}");
     }
 }
@@ -165,14 +212,20 @@ async fn local_servers_get_max_tokens_and_their_auth_rules() {
 #[tokio::test]
 async fn images_are_sent_as_base64_png_data_urls_in_order() {
     let server = MockServer::start().await;
-    Mock::given(method("POST")).respond_with(ResponseTemplate::new(200).set_body_json(completion("ok"))).mount(&server).await;
+    Mock::given(method("POST"))
+        .respond_with(ResponseTemplate::new(200).set_body_json(completion("ok")))
+        .mount(&server)
+        .await;
     let mut cfg = config(BackendKind::OpenAi, "gpt-4.1", &server.uri());
     cfg.api_key = Some(SecretString::new("sk-test-openai-key-0006"));
     cfg.defaults.image_detail = Some(ImageDetail::Low);
     let (top, front) = (png(64, 1), png(64, 2));
     let request = ChatRequest::new().message(Message::user(vec![
         Part::text("top view:"),
-        Image::png(top.clone()).unwrap().with_detail(ImageDetail::High).into(),
+        Image::png(top.clone())
+            .unwrap()
+            .with_detail(ImageDetail::High)
+            .into(),
         Part::text("front view:"),
         Image::png(front.clone()).unwrap().into(),
     ]));
@@ -187,7 +240,10 @@ async fn images_are_sent_as_base64_png_data_urls_in_order() {
         assert_eq!(part["image_url"]["detail"], detail);
         let url = part["image_url"]["url"].as_str().unwrap();
         let payload = url.strip_prefix("data:image/png;base64,").expect("PNG data URL");
-        assert_eq!(&base64::engine::general_purpose::STANDARD.decode(payload).unwrap(), bytes);
+        assert_eq!(
+            &base64::engine::general_purpose::STANDARD.decode(payload).unwrap(),
+            bytes
+        );
     }
 }
 
@@ -196,13 +252,21 @@ async fn rate_limit_waits_for_retry_after_on_a_paused_clock() {
     let server = MockServer::start().await;
     let limited = json!({"error": {"message": "Rate limit reached", "type": "requests", "code": "rate_limit_exceeded"}});
     Mock::given(method("POST"))
-        .respond_with(ResponseTemplate::new(429).set_body_json(limited.clone()).insert_header("retry-after", "7"))
+        .respond_with(
+            ResponseTemplate::new(429)
+                .set_body_json(limited.clone())
+                .insert_header("retry-after", "7"),
+        )
         .up_to_n_times(1)
         .with_priority(1)
         .mount(&server)
         .await;
     Mock::given(method("POST"))
-        .respond_with(ResponseTemplate::new(429).set_body_json(limited).insert_header("retry-after-ms", "2500"))
+        .respond_with(
+            ResponseTemplate::new(429)
+                .set_body_json(limited)
+                .insert_header("retry-after-ms", "2500"),
+        )
         .up_to_n_times(1)
         .with_priority(2)
         .mount(&server)
@@ -214,8 +278,13 @@ async fn rate_limit_waits_for_retry_after_on_a_paused_clock() {
         .await;
     let mut cfg = config(BackendKind::OpenAi, "gpt-5", &server.uri());
     cfg.api_key = Some(SecretString::new("sk-test-openai-key-0007"));
-    // No HTTP timers on the paused clock: it would jump them while the socket is waited for.
-    cfg.timeouts = Timeouts { connect: None, read: None, total: None };
+    // No HTTP timers on the paused clock: it would jump to them while the socket is waited for.
+    cfg.timeouts = Timeouts {
+        connect: None,
+        read: None,
+        total: None,
+        pool_idle: None,
+    };
     let client = VlmClient::from_config(&cfg).unwrap();
     let virtual_start = tokio::time::Instant::now();
     let real_start = std::time::Instant::now();
@@ -224,7 +293,10 @@ async fn rate_limit_waits_for_retry_after_on_a_paused_clock() {
     assert_eq!(reply.text, "after the wait");
     assert_eq!(reply.attempts, 3);
     // 7 s from `retry-after`, then 2.5 s from `retry-after-ms`, and nothing else.
-    assert!(waited >= Duration::from_millis(9_500) && waited < Duration::from_millis(9_600), "{waited:?}");
+    assert!(
+        waited >= Duration::from_millis(9_500) && waited < Duration::from_millis(9_600),
+        "{waited:?}"
+    );
     assert!(real_start.elapsed() < Duration::from_secs(5), "no real sleeping");
     assert_eq!(client.usage().total.attempts, 3);
 }
@@ -249,7 +321,10 @@ async fn server_error_then_success_is_retried() {
     let reply = client.chat(simple_request()).await.unwrap();
     assert_eq!((reply.text.as_str(), reply.attempts), ("fine now", 2));
     let usage = client.usage();
-    assert_eq!((usage.total.calls, usage.total.attempts, usage.total.failed_calls), (1, 2, 0));
+    assert_eq!(
+        (usage.total.calls, usage.total.attempts, usage.total.failed_calls),
+        (1, 2, 0)
+    );
     assert_eq!(usage.total.prompt_tokens, 120);
     assert_eq!(usage.by_purpose["describe"].reasoning_tokens, 12);
 }
@@ -262,22 +337,36 @@ async fn insufficient_quota_is_never_retried_and_client_errors_neither() {
             json!({"error": {"message": "You exceeded your current quota", "type": "insufficient_quota", "code": "insufficient_quota"}}),
             "req_quota",
         ),
-        (400, json!({"error": {"message": "Unsupported parameter: 'max_tokens'", "type": "invalid_request_error", "param": "max_tokens"}}), "req_bad"),
+        (
+            400,
+            json!({"error": {"message": "Unsupported parameter: 'max_tokens'", "type": "invalid_request_error", "param": "max_tokens"}}),
+            "req_bad",
+        ),
     ] {
         let server = MockServer::start().await;
         Mock::given(method("POST"))
-            .respond_with(ResponseTemplate::new(status).set_body_json(body).insert_header("x-request-id", request_id))
+            .respond_with(
+                ResponseTemplate::new(status)
+                    .set_body_json(body)
+                    .insert_header("x-request-id", request_id),
+            )
             .mount(&server)
             .await;
         let mut cfg = config(BackendKind::OpenAi, "gpt-5", &server.uri());
         cfg.api_key = Some(SecretString::new("sk-test-openai-key-0008"));
         let client = VlmClient::from_config(&cfg).unwrap();
         let err = client.chat(simple_request()).await.unwrap_err();
-        assert_eq!(server.received_requests().await.unwrap().len(), 1, "HTTP {status} must not be retried");
+        assert_eq!(
+            server.received_requests().await.unwrap().len(),
+            1,
+            "HTTP {status} must not be retried"
+        );
         assert_eq!(err.status(), Some(status));
         assert_eq!(err.request_id(), Some(request_id));
         assert_eq!(err.attempts(), Some(1));
-        let VlmError::Http { provider, .. } = &err else { panic!("{err:?}") };
+        let VlmError::Http { provider, .. } = &err else {
+            panic!("{err:?}")
+        };
         if status == 429 {
             assert!(provider.is_insufficient_quota());
         } else {
@@ -292,17 +381,32 @@ async fn insufficient_quota_is_never_retried_and_client_errors_neither() {
 async fn a_slow_server_times_out_and_is_retried_within_the_budget() {
     let server = MockServer::start().await;
     Mock::given(method("POST"))
-        .respond_with(ResponseTemplate::new(200).set_body_json(completion("too late")).set_delay(Duration::from_secs(3)))
+        .respond_with(
+            ResponseTemplate::new(200)
+                .set_body_json(completion("too late"))
+                .set_delay(Duration::from_secs(3)),
+        )
         .mount(&server)
         .await;
     let mut cfg = config(BackendKind::Vllm, "qwen", &server.uri());
-    cfg.timeouts = Timeouts { connect: Some(Duration::from_secs(2)), read: None, total: Some(Duration::from_millis(200)) };
+    cfg.timeouts.total = Some(Duration::from_millis(200));
     cfg.retry.max_attempts = 2;
     let started = std::time::Instant::now();
-    let err = VlmClient::from_config(&cfg).unwrap().chat(simple_request()).await.unwrap_err();
-    assert!(started.elapsed() < Duration::from_millis(1500), "{:?}", started.elapsed());
+    let err = VlmClient::from_config(&cfg)
+        .unwrap()
+        .chat(simple_request())
+        .await
+        .unwrap_err();
+    assert!(
+        started.elapsed() < Duration::from_millis(1500),
+        "{:?}",
+        started.elapsed()
+    );
     match err {
-        VlmError::Transport { source: TransportError::Timeout { phase, .. }, attempts } => {
+        VlmError::Transport {
+            source: TransportError::Timeout { phase, .. },
+            attempts,
+        } => {
             assert_eq!(phase, TimeoutPhase::Response);
             assert_eq!(attempts, 2);
         }
@@ -313,17 +417,41 @@ async fn a_slow_server_times_out_and_is_retried_within_the_budget() {
 #[tokio::test]
 async fn connection_refused_is_a_typed_transport_error() {
     // Bind then drop a listener: the port is closed on loopback.
-    let port = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
-    let mut cfg = config(BackendKind::LlamaCpp, "local", &format!("http://127.0.0.1:{port}"));
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let mut cfg = config(
+        BackendKind::LlamaCpp,
+        "local",
+        &format!("http://127.0.0.1:{port}"),
+    );
     cfg.retry.max_attempts = 2;
-    let err = VlmClient::from_config(&cfg).unwrap().chat(simple_request()).await.unwrap_err();
-    assert!(matches!(err, VlmError::Transport { source: TransportError::Connect(_), attempts: 2 }), "{err:?}");
+    let err = VlmClient::from_config(&cfg)
+        .unwrap()
+        .chat(simple_request())
+        .await
+        .unwrap_err();
+    assert!(
+        matches!(
+            err,
+            VlmError::Transport {
+                source: TransportError::Connect(_),
+                attempts: 2
+            }
+        ),
+        "{err:?}"
+    );
 }
 
 #[tokio::test]
 async fn truncated_and_invalid_bodies_are_typed_errors_with_position() {
     for (body, expected) in [
-        (&br#"{"id":"x","choices":[{"message":{"content":"(OnTo"#[..], "truncated JSON at line 1 column 49"),
+        (
+            &br#"{"id":"x","choices":[{"message":{"content":"(OnTo"#[..],
+            "truncated JSON at line 1 column 49",
+        ),
         (b"<html>502 Bad Gateway</html>", "invalid JSON at line 1 column 1"),
         (br#"{"choices": "nope"}"#, "invalid JSON"),
     ] {
@@ -333,10 +461,21 @@ async fn truncated_and_invalid_bodies_are_typed_errors_with_position() {
             .mount(&server)
             .await;
         let cfg = config(BackendKind::Ollama, "llava", &server.uri());
-        let err = VlmClient::from_config(&cfg).unwrap().chat(simple_request()).await.unwrap_err();
-        assert!(matches!(err, VlmError::InvalidResponse { status: 200, .. }), "{err:?}");
+        let err = VlmClient::from_config(&cfg)
+            .unwrap()
+            .chat(simple_request())
+            .await
+            .unwrap_err();
+        assert!(
+            matches!(err, VlmError::InvalidResponse { status: 200, .. }),
+            "{err:?}"
+        );
         assert!(err.to_string().contains(expected), "{err}");
-        assert_eq!(server.received_requests().await.unwrap().len(), 1, "a bad body is not retried");
+        assert_eq!(
+            server.received_requests().await.unwrap().len(),
+            1,
+            "a bad body is not retried"
+        );
     }
 }
 
@@ -359,22 +498,37 @@ async fn finish_reason_length_and_refusals_are_errors_and_still_accounted() {
         .await;
     let client = VlmClient::from_config(&config(BackendKind::Vllm, "qwen", &server.uri())).unwrap();
     match client.chat(simple_request()).await.unwrap_err() {
-        VlmError::Truncated { partial_text, usage, .. } => {
+        VlmError::Truncated {
+            partial_text, usage, ..
+        } => {
             assert_eq!(partial_text, "(OnTopOf red_block");
             assert_eq!(usage.unwrap().completion_tokens, 30);
         }
         other => panic!("{other:?}"),
     }
-    assert!(matches!(client.chat(simple_request()).await.unwrap_err(), VlmError::Refusal { reason, .. } if reason == "I can't help with that."));
+    assert!(
+        matches!(client.chat(simple_request()).await.unwrap_err(), VlmError::Refusal { reason, .. } if reason == "I can't help with that.")
+    );
     let usage = client.usage();
-    assert_eq!((usage.total.calls, usage.total.failed_calls, usage.total.completion_tokens), (2, 2, 30));
+    assert_eq!(
+        (
+            usage.total.calls,
+            usage.total.failed_calls,
+            usage.total.completion_tokens
+        ),
+        (2, 2, 30)
+    );
 }
 
 #[tokio::test]
 async fn concurrency_cap_is_enforced() {
     let server = MockServer::start().await;
     Mock::given(method("POST"))
-        .respond_with(ResponseTemplate::new(200).set_body_json(completion("ok")).set_delay(Duration::from_millis(150)))
+        .respond_with(
+            ResponseTemplate::new(200)
+                .set_body_json(completion("ok"))
+                .set_delay(Duration::from_millis(150)),
+        )
         .mount(&server)
         .await;
     for (cap, calls) in [(2usize, 6usize), (6, 6)] {
@@ -389,7 +543,11 @@ async fn concurrency_cap_is_enforced() {
         let max = counter.max.load(Ordering::SeqCst);
         if cap == 2 {
             assert_eq!(max, 2, "at most two calls in flight");
-            assert!(started.elapsed() >= Duration::from_millis(3 * 150), "{:?}", started.elapsed());
+            assert!(
+                started.elapsed() >= Duration::from_millis(3 * 150),
+                "{:?}",
+                started.elapsed()
+            );
         } else {
             // Without the cap binding, the same counter sees more in flight: it measures.
             assert!(max > 2, "uncapped run reached only {max}");
@@ -438,7 +596,10 @@ async fn secrets_stay_out_of_debug_output_errors_and_logs() {
     }
     // The key did go on the wire, where it belongs.
     let sent = &server.received_requests().await.unwrap()[0];
-    assert_eq!(sent.headers.get("authorization").unwrap(), &format!("Bearer {KEY}"));
+    assert_eq!(
+        sent.headers.get("authorization").unwrap(),
+        &format!("Bearer {KEY}")
+    );
 }
 
 #[test]

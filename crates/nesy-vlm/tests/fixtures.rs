@@ -18,7 +18,9 @@ fn smoke_cassette() -> PathBuf {
 
 fn smoke_request() -> ChatRequest {
     ChatRequest::new()
-        .message(Message::system("List the predicates that hold in the scene, one per line."))
+        .message(Message::system(
+            "List the predicates that hold in the scene, one per line.",
+        ))
         .message(Message::user(vec![
             Part::text("Top view, then front view."),
             Image::png(common::png(24, 11)).unwrap().into(),
@@ -29,7 +31,12 @@ fn smoke_request() -> ChatRequest {
 
 fn smoke_config(base_url: &str, mode: CassetteMode) -> nesy_vlm::VlmConfig {
     let mut cfg = common::config(BackendKind::OpenAi, "gpt-5-mini", base_url);
-    cfg.cassette = Some(CassetteSettings { path: smoke_cassette(), mode, strict: true, usage_report: None });
+    cfg.cassette = Some(CassetteSettings {
+        path: smoke_cassette(),
+        mode,
+        strict: true,
+        usage_report: None,
+    });
     cfg
 }
 
@@ -53,30 +60,53 @@ async fn regenerate_smoke_fixture() {
     body["model"] = "gpt-5-mini-2025-08-07".into();
     body["usage"]["completion_tokens_details"]["reasoning_tokens"] = 64.into();
     Mock::given(method("POST"))
-        .respond_with(ResponseTemplate::new(200).set_body_json(body).insert_header("x-request-id", "req_fixture"))
+        .respond_with(
+            ResponseTemplate::new(200)
+                .set_body_json(body)
+                .insert_header("x-request-id", "req_fixture"),
+        )
         .mount(&server)
         .await;
     let mut cfg = smoke_config(&server.uri(), CassetteMode::All);
     cfg.api_key = Some(nesy_vlm::SecretString::new("sk-fixture-not-a-real-key"));
-    VlmClient::from_config(&cfg).unwrap().chat(smoke_request()).await.unwrap();
+    VlmClient::from_config(&cfg)
+        .unwrap()
+        .chat(smoke_request())
+        .await
+        .unwrap();
 }
 
 /// Patterns that betray a credential, checked case-insensitively in every text file.
-const SUSPICIOUS: &[&str] = &["\"authorization\"", "\"api-key\"", "\"x-api-key\"", "\"cookie\"", "\"set-cookie\"", "bearer "];
+const SUSPICIOUS: &[&str] = &[
+    "\"authorization\"",
+    "\"api-key\"",
+    "\"x-api-key\"",
+    "\"cookie\"",
+    "\"set-cookie\"",
+    "bearer ",
+];
 
 fn looks_like_openai_key(text: &str) -> Option<String> {
     text.match_indices("sk-").find_map(|(at, _)| {
-        let tail: String =
-            text[at + 3..].chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_').collect();
+        let tail: String = text[at + 3..]
+            .chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_')
+            .collect();
         (tail.len() >= 20).then(|| format!("sk-{}…", &tail[..4]))
     })
 }
 
 fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
     for entry in entries.flatten() {
         let path = entry.path();
-        if path.is_dir() { walk(&path, out) } else { out.push(path) }
+        if path.is_dir() {
+            walk(&path, out)
+        } else {
+            out.push(path)
+        }
     }
 }
 
@@ -84,10 +114,15 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
 fn no_fixture_anywhere_contains_a_secret() {
     let mut files = Vec::new();
     walk(&fixtures_dir(), &mut files);
-    assert!(files.iter().any(|f| f.ends_with("vlm-smoke.json")), "the scan must see the fixtures tree");
+    assert!(
+        files.iter().any(|f| f.ends_with("vlm-smoke.json")),
+        "the scan must see the fixtures tree"
+    );
     let mut findings = Vec::new();
     for file in files {
-        let Ok(text) = std::fs::read_to_string(&file) else { continue }; // binary (blobs, MCAP)
+        let Ok(text) = std::fs::read_to_string(&file) else {
+            continue;
+        }; // binary (blobs, MCAP)
         let lower = text.to_ascii_lowercase();
         for pattern in SUSPICIOUS {
             if lower.contains(pattern) {
@@ -95,10 +130,17 @@ fn no_fixture_anywhere_contains_a_secret() {
             }
         }
         if let Some(key) = looks_like_openai_key(&text) {
-            findings.push(format!("{}: contains what looks like an API key ({key})", file.display()));
+            findings.push(format!(
+                "{}: contains what looks like an API key ({key})",
+                file.display()
+            ));
         }
     }
-    assert!(findings.is_empty(), "possible secrets in fixtures:\n{}", findings.join("\n"));
+    assert!(
+        findings.is_empty(),
+        "possible secrets in fixtures:\n{}",
+        findings.join("\n")
+    );
 }
 
 #[test]

@@ -1,4 +1,5 @@
 //! One module per subcommand: its clap arguments and its `run` function.
 
+pub mod cassette;
 pub mod render;
 pub mod verify;

@@ -79,7 +79,12 @@ fn replace_images(value: &Value, keep_bytes: bool, images: &mut Vec<FoundImage>)
             }
             None => value.clone(),
         },
-        Value::Array(items) => Value::Array(items.iter().map(|item| replace_images(item, keep_bytes, images)).collect()),
+        Value::Array(items) => Value::Array(
+            items
+                .iter()
+                .map(|item| replace_images(item, keep_bytes, images))
+                .collect(),
+        ),
         Value::Object(map) => {
             let mut out = Map::new();
             for (key, item) in map {
@@ -105,7 +110,11 @@ fn image_from_data_url(text: &str, keep_bytes: bool) -> Option<FoundImage> {
         "image/gif" => "gif",
         _ => "bin",
     };
-    Some(FoundImage { sha256: hex(&Sha256::digest(&bytes)), ext, bytes: keep_bytes.then_some(bytes) })
+    Some(FoundImage {
+        sha256: hex(&Sha256::digest(&bytes)),
+        ext,
+        bytes: keep_bytes.then_some(bytes),
+    })
 }
 
 /// Compact JSON with object keys sorted by their UTF-8 bytes, independent of how the map was
@@ -150,18 +159,36 @@ mod tests {
 
     #[test]
     fn key_ignores_key_order_but_not_values_or_path() {
-        let a: Value = serde_json::from_str(r#"{"model":"m","messages":[{"role":"user","content":"hi"}],"max_tokens":5}"#).unwrap();
-        let b: Value = serde_json::from_str(r#"{"max_tokens":5,"messages":[{"content":"hi","role":"user"}],"model":"m"}"#).unwrap();
-        assert_eq!(canonicalize("/chat/completions", &a, false).key, canonicalize("/chat/completions", &b, false).key);
+        let a: Value = serde_json::from_str(
+            r#"{"model":"m","messages":[{"role":"user","content":"hi"}],"max_tokens":5}"#,
+        )
+        .unwrap();
+        let b: Value = serde_json::from_str(
+            r#"{"max_tokens":5,"messages":[{"content":"hi","role":"user"}],"model":"m"}"#,
+        )
+        .unwrap();
+        assert_eq!(
+            canonicalize("/chat/completions", &a, false).key,
+            canonicalize("/chat/completions", &b, false).key
+        );
         let c = json!({"max_tokens":6,"messages":[{"content":"hi","role":"user"}],"model":"m"});
-        assert_ne!(canonicalize("/chat/completions", &a, false).key, canonicalize("/chat/completions", &c, false).key);
-        assert_ne!(canonicalize("/chat/completions", &a, false).key, canonicalize("/v2/chat", &a, false).key);
+        assert_ne!(
+            canonicalize("/chat/completions", &a, false).key,
+            canonicalize("/chat/completions", &c, false).key
+        );
+        assert_ne!(
+            canonicalize("/chat/completions", &a, false).key,
+            canonicalize("/v2/chat", &a, false).key
+        );
     }
 
     #[test]
     fn images_become_content_references() {
         let png = b"\x89PNG\r\n\x1a\nfake";
-        let url = format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(png));
+        let url = format!(
+            "data:image/png;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(png)
+        );
         let body = json!({"messages":[{"content":[{"type":"image_url","image_url":{"url":url}}]}]});
         let canonical = canonicalize("/p", &body, true);
         let expected_hash = hex(&Sha256::digest(png));
@@ -169,7 +196,10 @@ mod tests {
         assert_eq!(canonical.images[0].sha256, expected_hash);
         assert_eq!(canonical.images[0].bytes.as_deref(), Some(&png[..]));
         assert_eq!(
-            canonical.body.pointer("/messages/0/content/0/image_url/url").unwrap(),
+            canonical
+                .body
+                .pointer("/messages/0/content/0/image_url/url")
+                .unwrap(),
             &Value::String(format!("blob:sha256:{expected_hash}.png"))
         );
         // Canonicalising a stored body again is the identity, so stored keys can be checked.
@@ -180,6 +210,9 @@ mod tests {
     fn canonical_text_is_sorted_and_compact() {
         let mut out = Vec::new();
         write_canonical(&json!({"b":[1,{"d":null,"c":"x\"y"}],"a":0.5}), &mut out);
-        assert_eq!(String::from_utf8(out).unwrap(), r#"{"a":0.5,"b":[1,{"c":"x\"y","d":null}]}"#);
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            r#"{"a":0.5,"b":[1,{"c":"x\"y","d":null}]}"#
+        );
     }
 }

@@ -52,9 +52,17 @@ fn walk(recorded: Option<&Value>, requested: Option<&Value>, pointer: &mut Strin
         (a, b) if a == b => {}
         (Some(Value::String(a)), Some(Value::String(b))) => {
             let (recorded, requested) = string_windows(a, b);
-            out.push(JsonDiff { pointer: pointer.clone(), recorded, requested });
+            out.push(JsonDiff {
+                pointer: pointer.clone(),
+                recorded,
+                requested,
+            });
         }
-        (a, b) => out.push(JsonDiff { pointer: pointer.clone(), recorded: summarize(a), requested: summarize(b) }),
+        (a, b) => out.push(JsonDiff {
+            pointer: pointer.clone(),
+            recorded: summarize(a),
+            requested: summarize(b),
+        }),
     }
 }
 
@@ -138,10 +146,17 @@ const DIFFS_SHOWN: usize = 8;
 
 impl fmt::Display for CassetteMiss {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "cassette miss in {} (mode {})", self.cassette.display(), self.mode)?;
+        writeln!(
+            f,
+            "cassette miss in {} (mode {})",
+            self.cassette.display(),
+            self.mode
+        )?;
         match &self.reason {
             MissReason::NoCassette => writeln!(f, "  the cassette file does not exist")?,
-            MissReason::NotRecorded => writeln!(f, "  no recorded request matches (key {})", &self.key[..12])?,
+            MissReason::NotRecorded => {
+                writeln!(f, "  no recorded request matches (key {})", &self.key[..12])?
+            }
             MissReason::Exhausted { recorded } => writeln!(
                 f,
                 "  this exact request was recorded {recorded} time(s) and every recording was already replayed \
@@ -156,17 +171,43 @@ impl fmt::Display for CassetteMiss {
             writeln!(f, "  nearest recorded requests (recorded -> requested):")?;
         }
         for near in &self.nearest {
-            let purpose = near.purpose.as_deref().map(|p| format!(", purpose {p}")).unwrap_or_default();
-            let path = if near.path != self.path { format!(", path {}", near.path) } else { String::new() };
-            writeln!(f, "  - interaction #{}{purpose}{path}: {} difference(s)", near.index, near.diffs.len())?;
+            let purpose = near
+                .purpose
+                .as_deref()
+                .map(|p| format!(", purpose {p}"))
+                .unwrap_or_default();
+            let path = if near.path != self.path {
+                format!(", path {}", near.path)
+            } else {
+                String::new()
+            };
+            writeln!(
+                f,
+                "  - interaction #{}{purpose}{path}: {} difference(s)",
+                near.index,
+                near.diffs.len()
+            )?;
             for diff in near.diffs.iter().take(DIFFS_SHOWN) {
-                writeln!(f, "      {}: {} -> {}", if diff.pointer.is_empty() { "/" } else { &diff.pointer }, diff.recorded, diff.requested)?;
+                writeln!(
+                    f,
+                    "      {}: {} -> {}",
+                    if diff.pointer.is_empty() {
+                        "/"
+                    } else {
+                        &diff.pointer
+                    },
+                    diff.recorded,
+                    diff.requested
+                )?;
             }
             if near.diffs.len() > DIFFS_SHOWN {
                 writeln!(f, "      … and {} more", near.diffs.len() - DIFFS_SHOWN)?;
             }
         }
-        writeln!(f, "  to record the missing calls against a live model (credentials in the environment), run:")?;
+        writeln!(
+            f,
+            "  to record the missing calls against a live model (credentials in the environment), run:"
+        )?;
         write!(f, "    {}", self.rerecord_command)
     }
 }
@@ -191,7 +232,11 @@ pub(crate) fn summarize_request(body: &Value, purpose: Option<&str>) -> String {
 fn message_text(message: &Value) -> Option<String> {
     match message.get("content")? {
         Value::String(text) => Some(text.clone()),
-        Value::Array(parts) => parts.iter().rev().find_map(|p| p.get("text").and_then(Value::as_str)).map(str::to_string),
+        Value::Array(parts) => parts
+            .iter()
+            .rev()
+            .find_map(|p| p.get("text").and_then(Value::as_str))
+            .map(str::to_string),
         _ => None,
     }
 }
@@ -215,8 +260,14 @@ pub(crate) fn rerecord_command() -> String {
 
 fn shell_quote(arg: &str) -> String {
     let safe = !arg.is_empty()
-        && arg.chars().all(|c| c.is_ascii_alphanumeric() || "_@%+=:,./-".contains(c));
-    if safe { arg.to_string() } else { format!("'{}'", arg.replace('\'', r"'\''")) }
+        && arg
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_@%+=:,./-".contains(c));
+    if safe {
+        arg.to_string()
+    } else {
+        format!("'{}'", arg.replace('\'', r"'\''"))
+    }
 }
 
 #[cfg(test)]

@@ -110,8 +110,13 @@ impl StoredResponse {
             .filter(|(name, _)| is_allowed_header(name))
             .map(|(name, value)| (name.to_ascii_lowercase(), value.clone()))
             .collect();
-        let mut stored =
-            Self { status: response.status, headers, body: None, body_text: None, body_base64: None };
+        let mut stored = Self {
+            status: response.status,
+            headers,
+            body: None,
+            body_text: None,
+            body_base64: None,
+        };
         match std::str::from_utf8(&response.body) {
             Ok(text) => match RawValue::from_string(text.to_string()) {
                 // Only when the raw value is the whole text (no surrounding whitespace), and
@@ -132,13 +137,24 @@ impl StoredResponse {
             (Some(raw), None, None) => Bytes::copy_from_slice(raw.get().as_bytes()),
             (None, Some(text), None) => Bytes::copy_from_slice(text.as_bytes()),
             (None, None, Some(b64)) => Bytes::from(
-                base64::engine::general_purpose::STANDARD.decode(b64).map_err(|err| format!("body_base64: {err}"))?,
+                base64::engine::general_purpose::STANDARD
+                    .decode(b64)
+                    .map_err(|err| format!("body_base64: {err}"))?,
             ),
             (None, None, None) => Bytes::new(),
             _ => return Err("more than one of body, body_text, body_base64".to_string()),
         };
-        let headers = self.headers.iter().map(|(name, value)| (name.clone(), value.clone())).collect();
-        Ok(WireResponse { status: self.status, headers, body, origin })
+        let headers = self
+            .headers
+            .iter()
+            .map(|(name, value)| (name.clone(), value.clone()))
+            .collect();
+        Ok(WireResponse {
+            status: self.status,
+            headers,
+            body,
+            origin,
+        })
     }
 }
 
@@ -161,7 +177,10 @@ impl CassetteFile {
 
     /// Reads a cassette; errors name the file, line and column.
     pub fn load(path: &Path) -> Result<Self, CassetteError> {
-        let text = fs::read_to_string(path).map_err(|source| CassetteError::Io { path: path.to_path_buf(), source })?;
+        let text = fs::read_to_string(path).map_err(|source| CassetteError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
         Self::parse(path, &text)
     }
 
@@ -179,7 +198,9 @@ impl CassetteFile {
         };
         // Check the version first, so a newer file gets a clear message rather than an
         // unknown-field error.
-        let version = serde_json::from_str::<VersionOnly>(text).map_err(parse_error)?.schema_version;
+        let version = serde_json::from_str::<VersionOnly>(text)
+            .map_err(parse_error)?
+            .schema_version;
         match version {
             Some(SCHEMA_VERSION) => {}
             Some(other) => {
@@ -227,7 +248,10 @@ pub(crate) fn recorder() -> String {
 /// Writes bytes to `path` through a temporary file in the same directory and a rename, so a
 /// crash leaves either the old or the new file, never a torn one.
 pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), CassetteError> {
-    let io = |source| CassetteError::Io { path: path.to_path_buf(), source };
+    let io = |source| CassetteError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
     let dir = parent_dir(path);
     fs::create_dir_all(&dir).map_err(io)?;
     let mut temp = tempfile::NamedTempFile::new_in(&dir).map_err(io)?;
@@ -260,7 +284,10 @@ pub(crate) fn write_blob(dir: &Path, name: &str, bytes: &[u8]) -> Result<bool, C
     if path.exists() {
         return Ok(false);
     }
-    let io = |source| CassetteError::Io { path: path.clone(), source };
+    let io = |source| CassetteError::Io {
+        path: path.clone(),
+        source,
+    };
     fs::create_dir_all(dir).map_err(io)?;
     let mut temp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
     temp.write_all(bytes).map_err(io)?;
@@ -355,7 +382,11 @@ mod tests {
                     purpose: None,
                     recorded_at: "t".into(),
                     latency_ms: 1.0,
-                    request: StoredRequest { method: "POST".into(), path: "/p".into(), body: serde_json::Value::Null },
+                    request: StoredRequest {
+                        method: "POST".into(),
+                        path: "/p".into(),
+                        body: serde_json::Value::Null,
+                    },
                     response: stored,
                 }],
             };
@@ -368,10 +399,14 @@ mod tests {
 
     #[test]
     fn parse_errors_and_versions_are_clear() {
-        let err = CassetteFile::parse(Path::new("x.json"), "{\n  \"schema_version\": 1,\n  oops").unwrap_err();
+        let err =
+            CassetteFile::parse(Path::new("x.json"), "{\n  \"schema_version\": 1,\n  oops").unwrap_err();
         assert!(err.to_string().contains("x.json:3:"), "{err}");
         let err = CassetteFile::parse(Path::new("x.json"), r#"{"schema_version": 9}"#).unwrap_err();
-        assert!(err.to_string().contains("schema_version 9 is not supported"), "{err}");
+        assert!(
+            err.to_string().contains("schema_version 9 is not supported"),
+            "{err}"
+        );
         let err = CassetteFile::parse(Path::new("x.json"), r#"{"interactions": []}"#).unwrap_err();
         assert!(err.to_string().contains("not a nesy cassette"), "{err}");
     }

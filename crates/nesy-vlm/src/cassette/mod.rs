@@ -30,7 +30,9 @@ pub mod format;
 pub mod tools;
 
 pub use diff::{CassetteMiss, JsonDiff, MissReason, NearMatch, json_diff};
-pub use format::{CassetteFile, CassetteMeta, Interaction, SCHEMA_VERSION, StoredRequest, StoredResponse, blobs_dir};
+pub use format::{
+    CassetteFile, CassetteMeta, Interaction, SCHEMA_VERSION, StoredRequest, StoredResponse, blobs_dir,
+};
 
 use canonical::{Canonical, canonicalize, request_key};
 use format::{FileLock, write_atomically, write_blob};
@@ -76,7 +78,9 @@ impl FromStr for CassetteMode {
             "once" => Ok(Self::Once),
             "new_episodes" => Ok(Self::NewEpisodes),
             "all" => Ok(Self::All),
-            other => Err(format!("unknown cassette mode {other:?}; expected none, once, new_episodes or all")),
+            other => Err(format!(
+                "unknown cassette mode {other:?}; expected none, once, new_episodes or all"
+            )),
         }
     }
 }
@@ -250,9 +254,13 @@ impl CassetteTransport {
             let mut occurrences: HashMap<String, usize> = HashMap::new();
             for (index, interaction) in file.interactions.into_iter().enumerate() {
                 let key = request_key(&interaction.request.path, &interaction.request.body);
-                let response = interaction.response.to_wire(Origin::Replayed).map_err(|message| {
-                    CassetteError::Schema { path: path.clone(), message: format!("interaction #{index}: {message}") }
-                })?;
+                let response = interaction
+                    .response
+                    .to_wire(Origin::Replayed)
+                    .map_err(|message| CassetteError::Schema {
+                        path: path.clone(),
+                        message: format!("interaction #{index}: {message}"),
+                    })?;
                 let occurrence = occurrences.entry(key.clone()).or_default();
                 state.queues.entry(key.clone()).or_default().push_back(index);
                 recorded.push(Recorded {
@@ -293,17 +301,26 @@ impl CassetteTransport {
 
     /// Interactions loaded for replay that have not been replayed yet.
     pub fn unused(&self) -> Vec<InteractionRef> {
-        let state = self.replay.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let state = self
+            .replay
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
         self.recorded
             .iter()
             .zip(&state.used)
             .filter(|(_, used)| !**used)
-            .map(|(r, _)| InteractionRef { key: r.key.clone(), occurrence: r.occurrence })
+            .map(|(r, _)| InteractionRef {
+                key: r.key.clone(),
+                occurrence: r.occurrence,
+            })
             .collect()
     }
 
     fn try_replay(&self, canonical: &Canonical) -> Result<Option<WireResponse>, usize> {
-        let mut state = self.replay.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let mut state = self
+            .replay
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
         match state.queues.get_mut(&canonical.key) {
             Some(queue) => match queue.pop_front() {
                 Some(index) => {
@@ -371,7 +388,12 @@ impl CassetteTransport {
         let started = Instant::now();
         let mut response = inner.send(request).await?;
         response.origin = Origin::Live;
-        self.append(request, canonical, &response, started.elapsed().as_secs_f64() * 1e3)?;
+        self.append(
+            request,
+            canonical,
+            &response,
+            started.elapsed().as_secs_f64() * 1e3,
+        )?;
         Ok(response)
     }
 
@@ -393,14 +415,30 @@ impl CassetteTransport {
             purpose: request.purpose.clone(),
             recorded_at: crate::timefmt::now_rfc3339(),
             latency_ms: (latency_ms * 1000.0).round() / 1000.0,
-            request: StoredRequest { method: "POST".into(), path: request.path.clone(), body: canonical.body },
+            request: StoredRequest {
+                method: "POST".into(),
+                path: request.path.clone(),
+                body: canonical.body,
+            },
             response: StoredResponse::from_wire(response),
         };
-        let mut cleared = self.writer.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let mut cleared = self
+            .writer
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
         let _lock = FileLock::acquire(&self.path)?;
-        let backend = self.options.backend.clone().or_else(|| self.inner.as_ref().map(|inner| inner.label()));
-        let model = interaction.request.body.get("model").and_then(|m| m.as_str()).map(str::to_string);
-        let mut file = if self.path.exists() && !(self.mode == CassetteMode::All && !*cleared) {
+        let backend = self
+            .options
+            .backend
+            .clone()
+            .or_else(|| self.inner.as_ref().map(|inner| inner.label()));
+        let model = interaction
+            .request
+            .body
+            .get("model")
+            .and_then(|m| m.as_str())
+            .map(str::to_string);
+        let mut file = if (*cleared || self.mode != CassetteMode::All) && self.path.exists() {
             CassetteFile::load(&self.path)?
         } else {
             CassetteFile::new(None, None)
@@ -415,13 +453,28 @@ impl CassetteTransport {
     }
 
     fn write_usage_report(&self, path: &Path) -> Result<(), CassetteError> {
-        let state = self.replay.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let state = self
+            .replay
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
         let (mut used, mut unused) = (Vec::new(), Vec::new());
         for (recorded, was_used) in self.recorded.iter().zip(&state.used) {
-            let reference = InteractionRef { key: recorded.key.clone(), occurrence: recorded.occurrence };
-            if *was_used { used.push(reference) } else { unused.push(reference) }
+            let reference = InteractionRef {
+                key: recorded.key.clone(),
+                occurrence: recorded.occurrence,
+            };
+            if *was_used {
+                used.push(reference)
+            } else {
+                unused.push(reference)
+            }
         }
-        let report = UsageReport { schema_version: 1, cassette: self.path.clone(), used, unused };
+        let report = UsageReport {
+            schema_version: 1,
+            cassette: self.path.clone(),
+            used,
+            unused,
+        };
         let text = serde_json::to_string_pretty(&report).unwrap_or_default();
         write_atomically(path, text.as_bytes())
     }
@@ -434,7 +487,12 @@ impl Transport for CassetteTransport {
 
     fn label(&self) -> String {
         match &self.inner {
-            Some(inner) => format!("cassette {} ({}) over {}", self.path.display(), self.mode, inner.label()),
+            Some(inner) => format!(
+                "cassette {} ({}) over {}",
+                self.path.display(),
+                self.mode,
+                inner.label()
+            ),
             None => format!("cassette {} ({})", self.path.display(), self.mode),
         }
     }
@@ -451,12 +509,25 @@ impl Transport for CassetteTransport {
             let lines = unused
                 .iter()
                 .map(|reference| {
-                    let recorded = self.recorded.iter().position(|r| r.key == reference.key && r.occurrence == reference.occurrence);
-                    let purpose = recorded.and_then(|i| self.recorded[i].purpose.clone()).unwrap_or_else(|| "-".into());
-                    format!("#{} (purpose {purpose}, key {})", recorded.unwrap_or(0), &reference.key[..12])
+                    let recorded = self
+                        .recorded
+                        .iter()
+                        .position(|r| r.key == reference.key && r.occurrence == reference.occurrence);
+                    let purpose = recorded
+                        .and_then(|i| self.recorded[i].purpose.clone())
+                        .unwrap_or_else(|| "-".into());
+                    format!(
+                        "#{} (purpose {purpose}, key {})",
+                        recorded.unwrap_or(0),
+                        &reference.key[..12]
+                    )
                 })
                 .collect();
-            return Err(CassetteError::Unused { path: self.path.clone(), unused: lines }.into());
+            return Err(CassetteError::Unused {
+                path: self.path.clone(),
+                unused: lines,
+            }
+            .into());
         }
         Ok(())
     }

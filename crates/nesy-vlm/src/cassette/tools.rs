@@ -77,12 +77,24 @@ pub fn inspect(path: &Path) -> Result<Inspection, CassetteError> {
     for (index, interaction) in file.interactions.iter().enumerate() {
         let body = &interaction.request.body;
         let model = body.get("model").and_then(Value::as_str).map(str::to_string);
-        *models.entry(model.clone().unwrap_or_else(|| "(in path)".into())).or_insert(0) += 1;
+        *models
+            .entry(model.clone().unwrap_or_else(|| "(in path)".into()))
+            .or_insert(0) += 1;
         let mut refs = Vec::new();
         collect_refs(body, &mut refs);
         blobs.extend(refs.iter().cloned());
-        let response: Option<Value> = interaction.response.body.as_ref().and_then(|raw| serde_json::from_str(raw.get()).ok());
-        let usage = |pointer: &str| response.as_ref().and_then(|r| r.pointer(pointer)).and_then(Value::as_u64).unwrap_or(0);
+        let response: Option<Value> = interaction
+            .response
+            .body
+            .as_ref()
+            .and_then(|raw| serde_json::from_str(raw.get()).ok());
+        let usage = |pointer: &str| {
+            response
+                .as_ref()
+                .and_then(|r| r.pointer(pointer))
+                .and_then(Value::as_u64)
+                .unwrap_or(0)
+        };
         interactions.push(InteractionSummary {
             index,
             key: interaction.key.chars().take(12).collect(),
@@ -153,18 +165,27 @@ pub fn verify(path: &Path) -> Result<Vec<Problem>, CassetteError> {
         if key != interaction.key {
             problems.push(Problem {
                 interaction: at,
-                message: format!("stored key {} does not match the request (recomputed {key}); was it edited?", interaction.key),
+                message: format!(
+                    "stored key {} does not match the request (recomputed {key}); was it edited?",
+                    interaction.key
+                ),
             });
         }
         if let Err(message) = interaction.response.to_wire(crate::transport::Origin::Replayed) {
-            problems.push(Problem { interaction: at, message: format!("response: {message}") });
+            problems.push(Problem {
+                interaction: at,
+                message: format!("response: {message}"),
+            });
         }
         let mut refs = Vec::new();
         collect_refs(&interaction.request.body, &mut refs);
         for name in refs {
             if let Some(ok) = checked.get(&name) {
                 if !ok {
-                    problems.push(Problem { interaction: at, message: format!("blob {name} is missing or corrupt") });
+                    problems.push(Problem {
+                        interaction: at,
+                        message: format!("blob {name} is missing or corrupt"),
+                    });
                 }
                 continue;
             }
@@ -179,7 +200,10 @@ pub fn verify(path: &Path) -> Result<Vec<Problem>, CassetteError> {
             };
             checked.insert(name, result.is_ok());
             if let Err(message) = result {
-                problems.push(Problem { interaction: at, message });
+                problems.push(Problem {
+                    interaction: at,
+                    message,
+                });
             }
         }
     }
@@ -214,9 +238,16 @@ pub fn prune(
     for (index, interaction) in std::mem::take(&mut file.interactions).into_iter().enumerate() {
         let key = request_key(&interaction.request.path, &interaction.request.body);
         let occurrence = occurrences.entry(key.clone()).or_default();
-        let reference = InteractionRef { key, occurrence: *occurrence };
+        let reference = InteractionRef {
+            key,
+            occurrence: *occurrence,
+        };
         *occurrence += 1;
-        if used.contains(&reference) { kept.push(interaction) } else { dropped.push(index) }
+        if used.contains(&reference) {
+            kept.push(interaction)
+        } else {
+            dropped.push(index)
+        }
     }
     file.interactions = kept;
     if !dry_run && !dropped.is_empty() {
@@ -228,11 +259,18 @@ pub fn prune(
         removed_blobs = orphan_blobs(path, if dry_run { Some(&file) } else { None })?;
         if !dry_run {
             for blob in &removed_blobs {
-                fs::remove_file(blob).map_err(|source| CassetteError::Io { path: blob.clone(), source })?;
+                fs::remove_file(blob).map_err(|source| CassetteError::Io {
+                    path: blob.clone(),
+                    source,
+                })?;
             }
         }
     }
-    Ok(PruneOutcome { kept: file.interactions.len(), dropped, removed_blobs })
+    Ok(PruneOutcome {
+        kept: file.interactions.len(),
+        dropped,
+        removed_blobs,
+    })
 }
 
 /// Blobs under `blobs/` beside `cassette` that no `*.json` cassette in that directory
@@ -271,7 +309,11 @@ fn orphan_blobs(cassette: &Path, pending: Option<&CassetteFile>) -> Result<Vec<P
     let mut orphans = Vec::new();
     for entry in fs::read_dir(&blobs).map_err(io(&blobs))? {
         let blob = entry.map_err(io(&blobs))?.path();
-        let name = blob.file_name().and_then(|n| n.to_str()).unwrap_or_default().to_string();
+        let name = blob
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or_default()
+            .to_string();
         if blob.is_file() && !referenced.contains(&name) {
             orphans.push(blob);
         }
@@ -282,7 +324,10 @@ fn orphan_blobs(cassette: &Path, pending: Option<&CassetteFile>) -> Result<Vec<P
 
 /// Reads a usage report written by a cassette run.
 pub fn load_usage_report(path: &Path) -> Result<UsageReport, CassetteError> {
-    let text = fs::read_to_string(path).map_err(|source| CassetteError::Io { path: path.to_path_buf(), source })?;
+    let text = fs::read_to_string(path).map_err(|source| CassetteError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
     serde_json::from_str(&text).map_err(|err| CassetteError::Parse {
         path: path.to_path_buf(),
         line: err.line(),

@@ -55,7 +55,12 @@ static INSTALL_CRYPTO: Once = Once::new();
 impl HttpTransport {
     /// A transport posting to `base_url` + the request path. `base_url` is used as given
     /// (without a trailing slash), e.g. `https://api.openai.com/v1`.
-    pub fn new(base_url: &str, auth: Auth, timeouts: &Timeouts, label: impl Into<String>) -> Result<Self, String> {
+    pub fn new(
+        base_url: &str,
+        auth: Auth,
+        timeouts: &Timeouts,
+        label: impl Into<String>,
+    ) -> Result<Self, String> {
         // reqwest is built without a bundled crypto provider; ring is ours. Installing fails
         // harmlessly when the process already chose one.
         INSTALL_CRYPTO.call_once(|| {
@@ -64,11 +69,13 @@ impl HttpTransport {
         let base_url = base_url.trim_end_matches('/').to_string();
         let parsed = reqwest::Url::parse(&base_url).map_err(|err| format!("base URL {base_url:?}: {err}"))?;
         if !matches!(parsed.scheme(), "http" | "https") {
-            return Err(format!("base URL {base_url:?} must start with http:// or https://"));
+            return Err(format!(
+                "base URL {base_url:?} must start with http:// or https://"
+            ));
         }
         let mut builder = reqwest::Client::builder()
             .user_agent(concat!("nesy-vlm/", env!("CARGO_PKG_VERSION")))
-            .pool_idle_timeout(None);
+            .pool_idle_timeout(timeouts.pool_idle);
         if let Some(connect) = timeouts.connect {
             builder = builder.connect_timeout(connect);
         }
@@ -79,16 +86,24 @@ impl HttpTransport {
             builder = builder.timeout(total);
         }
         // A proxy from the environment must not capture loopback traffic (local servers, tests).
-        let loopback = matches!(parsed.host_str(), Some("localhost" | "127.0.0.1" | "[::1]" | "::1"));
+        let loopback = matches!(
+            parsed.host_str(),
+            Some("localhost" | "127.0.0.1" | "[::1]" | "::1")
+        );
         if loopback {
             builder = builder.no_proxy();
         }
-        let client = builder.build().map_err(|err| format!("building the HTTP client: {err}"))?;
+        let client = builder
+            .build()
+            .map_err(|err| format!("building the HTTP client: {err}"))?;
         let mut auth_headers = HeaderMap::new();
         let auth_kind = match &auth {
             Auth::None => "none",
             Auth::Bearer(key) => {
-                auth_headers.insert(reqwest::header::AUTHORIZATION, secret_header(&format!("Bearer {}", key.expose()))?);
+                auth_headers.insert(
+                    reqwest::header::AUTHORIZATION,
+                    secret_header(&format!("Bearer {}", key.expose()))?,
+                );
                 "bearer"
             }
             Auth::ApiKeyHeader(key) => {
@@ -96,7 +111,13 @@ impl HttpTransport {
                 "api-key"
             }
         };
-        Ok(Self { client, base_url, auth_headers, auth_kind, label: label.into() })
+        Ok(Self {
+            client,
+            base_url,
+            auth_headers,
+            auth_kind,
+            label: label.into(),
+        })
     }
 
     /// The base URL requests are sent to.
@@ -106,8 +127,10 @@ impl HttpTransport {
 
     async fn post(&self, request: &WireRequest) -> Result<WireResponse, TransportError> {
         let url = format!("{}{}", self.base_url, request.path);
-        let body = serde_json::to_vec(&request.body)
-            .map_err(|err| TransportError::Failed { message: format!("encoding the body: {err}"), retryable: false })?;
+        let body = serde_json::to_vec(&request.body).map_err(|err| TransportError::Failed {
+            message: format!("encoding the body: {err}"),
+            retryable: false,
+        })?;
         let response = self
             .client
             .post(&url)
@@ -125,13 +148,18 @@ impl HttpTransport {
             .filter_map(|(name, value)| Some((name.as_str().to_string(), value.to_str().ok()?.to_string())))
             .collect();
         let body = response.bytes().await.map_err(classify)?;
-        Ok(WireResponse { status, headers, body, origin: Origin::Live })
+        Ok(WireResponse {
+            status,
+            headers,
+            body,
+            origin: Origin::Live,
+        })
     }
 }
 
 fn secret_header(value: &str) -> Result<HeaderValue, String> {
-    let mut header =
-        HeaderValue::from_str(value).map_err(|_| "the API key contains characters not allowed in a header")?;
+    let mut header = HeaderValue::from_str(value)
+        .map_err(|_| "the API key contains characters not allowed in a header")?;
     header.set_sensitive(true);
     Ok(header)
 }
@@ -146,7 +174,11 @@ fn classify(err: reqwest::Error) -> TransportError {
         source = cause.source();
     }
     if err.is_timeout() {
-        let phase = if err.is_connect() { TimeoutPhase::Connect } else { TimeoutPhase::Response };
+        let phase = if err.is_connect() {
+            TimeoutPhase::Connect
+        } else {
+            TimeoutPhase::Response
+        };
         TransportError::Timeout { phase, message }
     } else if err.is_connect() {
         TransportError::Connect(message)
@@ -155,7 +187,10 @@ fn classify(err: reqwest::Error) -> TransportError {
     } else if err.is_request() {
         TransportError::Connect(message)
     } else {
-        TransportError::Failed { message, retryable: false }
+        TransportError::Failed {
+            message,
+            retryable: false,
+        }
     }
 }
 

@@ -63,17 +63,26 @@ pub struct WireResponse {
 impl WireResponse {
     /// A response with the given status and body and no headers.
     pub fn new(status: u16, body: impl Into<Bytes>, origin: Origin) -> Self {
-        Self { status, headers: Vec::new(), body: body.into(), origin }
+        Self {
+            status,
+            headers: Vec::new(),
+            body: body.into(),
+            origin,
+        }
     }
 
     /// The first value of a header (name compared case-insensitively).
     pub fn header(&self, name: &str) -> Option<&str> {
-        self.headers.iter().find(|(key, _)| key.eq_ignore_ascii_case(name)).map(|(_, value)| value.as_str())
+        self.headers
+            .iter()
+            .find(|(key, _)| key.eq_ignore_ascii_case(name))
+            .map(|(_, value)| value.as_str())
     }
 
     /// The provider's request id: `x-request-id`, or Azure's `apim-request-id`.
     pub fn request_id(&self) -> Option<&str> {
-        self.header("x-request-id").or_else(|| self.header("apim-request-id"))
+        self.header("x-request-id")
+            .or_else(|| self.header("apim-request-id"))
     }
 
     /// Whether the status is 2xx.
@@ -114,7 +123,9 @@ pub const ALLOWED_HEADERS: &[&str] = &[
 
 /// Whether a header name is on the allowlist.
 pub fn is_allowed_header(name: &str) -> bool {
-    ALLOWED_HEADERS.iter().any(|allowed| allowed.eq_ignore_ascii_case(name))
+    ALLOWED_HEADERS
+        .iter()
+        .any(|allowed| allowed.eq_ignore_ascii_case(name))
 }
 
 /// Something that answers wire requests. Implementations must be cheap to share

@@ -7,7 +7,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 
 use nesy_vlm::{
-    BackendKind, BoxFuture, RetryPolicy, Timeouts, Transport, TransportError, VlmConfig, WireRequest, WireResponse,
+    BackendKind, BoxFuture, RetryPolicy, Timeouts, Transport, TransportError, VlmConfig, WireRequest,
+    WireResponse,
 };
 use serde_json::{Value, json};
 
@@ -38,6 +39,7 @@ pub fn config(backend: BackendKind, model: &str, base_url: &str) -> VlmConfig {
         connect: Some(Duration::from_secs(5)),
         read: Some(Duration::from_secs(10)),
         total: Some(Duration::from_secs(10)),
+        pool_idle: Some(Duration::from_secs(60)),
     };
     config
 }
@@ -78,7 +80,11 @@ pub struct InFlightCounter {
 
 impl InFlightCounter {
     pub fn new(inner: Arc<dyn Transport>) -> Self {
-        Self { inner, now: AtomicUsize::new(0), max: AtomicUsize::new(0) }
+        Self {
+            inner,
+            now: AtomicUsize::new(0),
+            max: AtomicUsize::new(0),
+        }
     }
 }
 

@@ -1,0 +1,279 @@
+//! `nesy cassette`: look after the VLM cassettes that let runs replay offline.
+//!
+//! - `inspect` lists a cassette's calls, tokens and models;
+//! - `prune` drops the interactions a run did not use (from the usage report that run wrote
+//!   with `NESY_CASSETTE_USAGE`), and optionally blobs nothing refers to any more;
+//! - `verify` checks that every blob exists and matches its hash, that stored keys match
+//!   their requests, and that every response decodes. Exit code 1 if anything is wrong.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context as _;
+use nesy_vlm::cassette::tools;
+
+/// Arguments of `nesy cassette`.
+#[derive(Debug, clap::Args)]
+pub struct CassetteArgs {
+    /// What to do with the cassette.
+    #[command(subcommand)]
+    pub action: CassetteAction,
+}
+
+/// The `nesy cassette` actions.
+#[derive(Debug, clap::Subcommand)]
+pub enum CassetteAction {
+    /// List the recorded calls with their purpose, model, images, status, tokens and latency.
+    Inspect {
+        /// The cassette file.
+        cassette: PathBuf,
+        /// Print the listing as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Drop interactions that a replay run did not use.
+    Prune {
+        /// The cassette file.
+        cassette: PathBuf,
+        /// Usage report written by the run (set `NESY_CASSETTE_USAGE=FILE` when replaying).
+        #[arg(long, value_name = "FILE")]
+        used: PathBuf,
+        /// Also delete blobs that no cassette in the same directory refers to.
+        #[arg(long)]
+        orphan_blobs: bool,
+        /// Show what would change without writing.
+        #[arg(long)]
+        dry_run: bool,
+        /// Print the outcome as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Check blobs, keys and response bodies; exit 1 if anything is wrong.
+    Verify {
+        /// Cassette files.
+        #[arg(required = true)]
+        cassettes: Vec<PathBuf>,
+        /// Print the problems as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Runs `nesy cassette`.
+pub fn run(args: CassetteArgs) -> anyhow::Result<ExitCode> {
+    match args.action {
+        CassetteAction::Inspect { cassette, json } => inspect(&cassette, json),
+        CassetteAction::Prune {
+            cassette,
+            used,
+            orphan_blobs,
+            dry_run,
+            json,
+        } => {
+            let report = tools::load_usage_report(&used).context("reading the usage report")?;
+            let outcome = tools::prune(&cassette, &report, orphan_blobs, dry_run)
+                .with_context(|| format!("pruning {}", cassette.display()))?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&outcome)?);
+            } else {
+                let verb = if dry_run { "would drop" } else { "dropped" };
+                println!(
+                    "{}: kept {}, {verb} {} interaction(s)",
+                    cassette.display(),
+                    outcome.kept,
+                    outcome.dropped.len()
+                );
+                for index in &outcome.dropped {
+                    println!("  {verb} #{index}");
+                }
+                for blob in &outcome.removed_blobs {
+                    println!(
+                        "  {} blob {}",
+                        if dry_run { "would remove" } else { "removed" },
+                        blob.display()
+                    );
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        CassetteAction::Verify { cassettes, json } => {
+            let mut all = Vec::new();
+            for cassette in &cassettes {
+                let problems =
+                    tools::verify(cassette).with_context(|| format!("verifying {}", cassette.display()))?;
+                all.push((cassette.clone(), problems));
+            }
+            let failed = all.iter().any(|(_, problems)| !problems.is_empty());
+            if json {
+                let value: Vec<_> = all
+                    .iter()
+                    .map(|(path, problems)| serde_json::json!({"cassette": path, "problems": problems}))
+                    .collect();
+                println!("{}", serde_json::to_string_pretty(&value)?);
+            } else {
+                for (path, problems) in &all {
+                    if problems.is_empty() {
+                        println!("{}: ok", path.display());
+                    }
+                    for problem in problems {
+                        let at = problem
+                            .interaction
+                            .map(|i| format!(" interaction #{i}:"))
+                            .unwrap_or_default();
+                        println!("{}:{at} {}", path.display(), problem.message);
+                    }
+                }
+            }
+            Ok(if failed {
+                ExitCode::from(1)
+            } else {
+                ExitCode::SUCCESS
+            })
+        }
+    }
+}
+
+fn inspect(cassette: &std::path::Path, json: bool) -> anyhow::Result<ExitCode> {
+    let listing = tools::inspect(cassette).with_context(|| format!("inspecting {}", cassette.display()))?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&listing)?);
+        return Ok(ExitCode::SUCCESS);
+    }
+    let meta = &listing.meta;
+    println!(
+        "{}: schema {}, recorded by {} ({}), backend {}, created {}, updated {}",
+        cassette.display(),
+        listing.schema_version,
+        meta.recorder,
+        meta.model.as_deref().unwrap_or("?"),
+        meta.backend.as_deref().unwrap_or("?"),
+        meta.created_at,
+        meta.updated_at
+    );
+    println!(
+        "{:>4}  {:<12}  {:<14}  {:<20}  {:>4}  {:>4}  {:>6}  {:<8}  {:>8}  {:>8}  {:>8}  {:>9}",
+        "#",
+        "key",
+        "purpose",
+        "model",
+        "msgs",
+        "imgs",
+        "status",
+        "finish",
+        "prompt",
+        "output",
+        "reason",
+        "ms"
+    );
+    for call in &listing.interactions {
+        println!(
+            "{:>4}  {:<12}  {:<14}  {:<20}  {:>4}  {:>4}  {:>6}  {:<8}  {:>8}  {:>8}  {:>8}  {:>9.1}",
+            call.index,
+            call.key,
+            call.purpose.as_deref().unwrap_or("-"),
+            call.model.as_deref().unwrap_or("-"),
+            call.messages,
+            call.images,
+            call.status,
+            call.finish_reason.as_deref().unwrap_or("-"),
+            call.prompt_tokens,
+            call.completion_tokens,
+            call.reasoning_tokens,
+            call.latency_ms
+        );
+    }
+    let models: Vec<String> = listing
+        .models
+        .iter()
+        .map(|(model, calls)| format!("{model} ×{calls}"))
+        .collect();
+    println!(
+        "{} call(s); tokens: {} prompt, {} output ({} reasoning); {} distinct image(s); models: {}",
+        listing.interactions.len(),
+        listing.prompt_tokens,
+        listing.completion_tokens,
+        listing.reasoning_tokens,
+        listing.distinct_images,
+        models.join(", ")
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn smoke() -> PathBuf {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/cassettes/vlm-smoke.json")
+    }
+
+    #[test]
+    fn inspect_and_verify_the_smoke_fixture() {
+        let inspect = CassetteArgs {
+            action: CassetteAction::Inspect {
+                cassette: smoke(),
+                json: false,
+            },
+        };
+        assert_eq!(run(inspect).unwrap(), ExitCode::SUCCESS);
+        let verify = CassetteArgs {
+            action: CassetteAction::Verify {
+                cassettes: vec![smoke()],
+                json: true,
+            },
+        };
+        assert_eq!(run(verify).unwrap(), ExitCode::SUCCESS);
+    }
+
+    #[test]
+    fn verify_fails_with_exit_1_on_a_missing_blob_and_errors_on_a_missing_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let copy = dir.path().join("smoke.json");
+        std::fs::copy(smoke(), &copy).unwrap();
+        let verify = CassetteArgs {
+            action: CassetteAction::Verify {
+                cassettes: vec![copy],
+                json: false,
+            },
+        };
+        assert_eq!(
+            run(verify).unwrap(),
+            ExitCode::from(1),
+            "no blobs beside the copy"
+        );
+        let missing = CassetteArgs {
+            action: CassetteAction::Inspect {
+                cassette: dir.path().join("nope.json"),
+                json: false,
+            },
+        };
+        let err = format!("{:#}", run(missing).unwrap_err());
+        assert!(err.contains("nope.json"), "{err}");
+    }
+
+    #[test]
+    fn prune_keeps_what_a_run_used() {
+        let dir = tempfile::tempdir().unwrap();
+        let copy = dir.path().join("smoke.json");
+        std::fs::copy(smoke(), &copy).unwrap();
+        let report = dir.path().join("usage.json");
+        std::fs::write(
+            &report,
+            r#"{"schema_version": 1, "cassette": "smoke.json", "used": [], "unused": []}"#,
+        )
+        .unwrap();
+        let prune = |dry_run| CassetteArgs {
+            action: CassetteAction::Prune {
+                cassette: copy.clone(),
+                used: report.clone(),
+                orphan_blobs: false,
+                dry_run,
+                json: false,
+            },
+        };
+        assert_eq!(run(prune(true)).unwrap(), ExitCode::SUCCESS);
+        assert_eq!(tools::inspect(&copy).unwrap().interactions.len(), 1);
+        assert_eq!(run(prune(false)).unwrap(), ExitCode::SUCCESS);
+        assert_eq!(tools::inspect(&copy).unwrap().interactions.len(), 0);
+    }
+}
