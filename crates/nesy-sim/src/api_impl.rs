@@ -161,7 +161,7 @@ impl Sim {
         clearance: f64,
         angle: f64,
     ) -> Result<(), ApiError> {
-        if !(clearance.is_finite() && clearance >= 0.0) || !angle.is_finite() {
+        if !(clearance.is_finite() && clearance >= 0.0 && angle.is_finite()) {
             return Err(ApiError::InvalidArgument {
                 call: "move_to_position".into(),
                 message: format!("lift_clearance must be ≥ 0 and angle finite, got {clearance} and {angle}"),
@@ -404,11 +404,20 @@ impl Sim {
                 self.parts[load].name, self.parts[self.articulations[articulation].link].name
             )));
         }
+        let a = &self.articulations[articulation];
+        let moving = a.frame * crate::objects::joint_motion(a.joint, a.q);
+        let c = self.part_aabb(part).centre();
+        let handle_local = moving.inverse_transform_point(rapier3d::prelude::Vector::new(
+            c[0] as f32,
+            c[1] as f32,
+            c[2] as f32,
+        ));
         self.handle_grasp = Some(HandleGrasp {
             part,
             articulation,
             tool0: tool,
-            q0: self.articulations[articulation].q,
+            q0: a.q,
+            handle_local,
         });
         match self.scene.embodiment {
             Embodiment::Finger => self.close_fingers(),

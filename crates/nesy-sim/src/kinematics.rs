@@ -501,7 +501,7 @@ impl RobotModel {
         opts: &IkOptions,
     ) -> Option<Vec<f64>> {
         let n = self.arm_dofs();
-        let mut rng = SeedGen(0x5EED_0F_1C);
+        let mut rng = SeedGen(0x5EED_0F1C);
         let mut best: Option<(f64, Vec<f64>)> = None;
         for attempt in 0..opts.restarts.max(1) {
             let mut q: Vec<f64> = match attempt {

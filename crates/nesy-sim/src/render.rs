@@ -2,7 +2,7 @@
 //! per-object colours, the `_marked` variants with a label on every object, and PNG
 //! encoding.
 
-use rapier3d::prelude::{QueryFilter, Ray, Vector};
+use rapier3d::prelude::{Ray, Vector};
 
 use crate::objects::Pattern;
 use crate::sim::Sim;
@@ -22,9 +22,24 @@ pub struct Camera {
 
 /// The benchmark's three views (spec §1).
 pub const CAMERAS: [Camera; 3] = [
-    Camera { name: "top", eye: [0.5, 0.0, 2.5], target: [0.49, 0.0, 0.0], fov_y_deg: 25.0 },
-    Camera { name: "front", eye: [2.0, 0.0, 1.0], target: [0.0, 0.0, 0.5], fov_y_deg: 30.0 },
-    Camera { name: "back", eye: [-1.0, 0.0, 1.0], target: [1.0, 0.0, 0.5], fov_y_deg: 30.0 },
+    Camera {
+        name: "top",
+        eye: [0.5, 0.0, 2.5],
+        target: [0.49, 0.0, 0.0],
+        fov_y_deg: 25.0,
+    },
+    Camera {
+        name: "front",
+        eye: [2.0, 0.0, 1.0],
+        target: [0.0, 0.0, 0.5],
+        fov_y_deg: 30.0,
+    },
+    Camera {
+        name: "back",
+        eye: [-1.0, 0.0, 1.0],
+        target: [1.0, 0.0, 0.5],
+        fov_y_deg: 30.0,
+    },
 ];
 
 /// Image side used by the benchmark.
@@ -43,7 +58,11 @@ pub struct Image {
 
 impl Image {
     fn new(width: u32, height: u32) -> Image {
-        Image { width, height, rgb: vec![0; (width * height * 3) as usize] }
+        Image {
+            width,
+            height,
+            rgb: vec![0; (width * height * 3) as usize],
+        }
     }
 
     fn put(&mut self, x: i64, y: i64, c: [u8; 3]) {
@@ -127,39 +146,149 @@ impl Basis {
 }
 
 const SKY: [f32; 3] = [0.82, 0.86, 0.9];
+/// Screen tiles are this many pixels square; each lists the colliders whose projected
+/// box touches it, so a pixel's ray is tested against a handful of shapes only.
+const TILE: u32 = 16;
+
+/// A collider prepared for ray casting: world pose, shape, world box, look.
+struct Target<'a> {
+    shape: &'a dyn rapier3d::prelude::Shape,
+    pose: rapier3d::prelude::Pose,
+    min: Vector,
+    max: Vector,
+    look: crate::sim::Look,
+}
+
+/// Colliders per screen tile.
+struct Tiles<'a> {
+    targets: Vec<Target<'a>>,
+    columns: u32,
+    lists: Vec<Vec<u32>>,
+}
+
+impl<'a> Tiles<'a> {
+    fn new(sim: &'a Sim, basis: &Basis, width: u32, height: u32) -> Tiles<'a> {
+        let looks = sim.looks();
+        let targets: Vec<Target<'a>> = sim
+            .physics()
+            .colliders
+            .iter()
+            .map(|(_, c)| {
+                let aabb = c.compute_aabb();
+                Target {
+                    shape: c.shape(),
+                    pose: *c.position(),
+                    min: aabb.mins,
+                    max: aabb.maxs,
+                    look: looks[c.user_data as usize],
+                }
+            })
+            .collect();
+        let columns = width.div_ceil(TILE);
+        let rows = height.div_ceil(TILE);
+        let mut lists = vec![Vec::new(); (columns * rows) as usize];
+        for (i, t) in targets.iter().enumerate() {
+            let mut lo = (f32::INFINITY, f32::INFINITY);
+            let mut hi = (f32::NEG_INFINITY, f32::NEG_INFINITY);
+            let mut everywhere = false;
+            for k in 0..8 {
+                let corner = [
+                    if k & 1 == 0 { t.min.x } else { t.max.x } as f64,
+                    if k & 2 == 0 { t.min.y } else { t.max.y } as f64,
+                    if k & 4 == 0 { t.min.z } else { t.max.z } as f64,
+                ];
+                match basis.project(corner, width, height) {
+                    Some((x, y)) => {
+                        lo = (lo.0.min(x), lo.1.min(y));
+                        hi = (hi.0.max(x), hi.1.max(y));
+                    }
+                    None => everywhere = true,
+                }
+            }
+            let (c0, c1, r0, r1) = if everywhere {
+                (0, columns - 1, 0, rows - 1)
+            } else {
+                let clamp_c = |v: f32| ((v.max(0.0) as u32) / TILE).min(columns - 1);
+                let clamp_r = |v: f32| ((v.max(0.0) as u32) / TILE).min(rows - 1);
+                if hi.0 < 0.0 || hi.1 < 0.0 || lo.0 >= width as f32 || lo.1 >= height as f32 {
+                    continue;
+                }
+                (
+                    clamp_c(lo.0 - 1.0),
+                    clamp_c(hi.0 + 1.0),
+                    clamp_r(lo.1 - 1.0),
+                    clamp_r(hi.1 + 1.0),
+                )
+            };
+            for r in r0..=r1 {
+                for c in c0..=c1 {
+                    lists[(r * columns + c) as usize].push(i as u32);
+                }
+            }
+        }
+        Tiles {
+            targets,
+            columns,
+            lists,
+        }
+    }
+
+    /// The nearest hit along a unit ray: (target index, distance, normal).
+    fn cast(&self, px: u32, py: u32, ray: &Ray) -> Option<(usize, f32, Vector)> {
+        let list = &self.lists[((py / TILE) * self.columns + px / TILE) as usize];
+        let inv = Vector::new(1.0 / ray.dir.x, 1.0 / ray.dir.y, 1.0 / ray.dir.z);
+        let mut best: Option<(usize, f32, Vector)> = None;
+        let mut limit = 10.0_f32;
+        for &i in list {
+            let t = &self.targets[i as usize];
+            // Slab test against the world box before the exact shape.
+            let a = (t.min - ray.origin) * inv;
+            let b = (t.max - ray.origin) * inv;
+            let near = a.min(b).max_element();
+            let far = a.max(b).min_element();
+            if far < near.max(0.0) || near > limit {
+                continue;
+            }
+            if let Some(hit) = t.shape.cast_ray_and_get_normal(&t.pose, ray, limit, true) {
+                limit = hit.time_of_impact;
+                best = Some((i as usize, hit.time_of_impact, hit.normal));
+            }
+        }
+        best
+    }
+}
 
 fn shade_rows(
-    world: &rapier3d::prelude::PhysicsWorld,
-    looks: &[crate::sim::Look],
+    tiles: &Tiles,
     basis: &Basis,
     width: u32,
     height: u32,
     rows: std::ops::Range<u32>,
     out: &mut [u8],
 ) {
-    let query = world.query_pipeline_with_filter(QueryFilter::default());
     let light = Vector::new(0.35, -0.25, 1.0).normalize();
     for (r, py) in rows.enumerate() {
         for px in 0..width {
             let dir = basis.ray(px as f32, py as f32, width, height);
             let ray = Ray::new(basis.eye, dir);
-            let colour = match query.cast_ray_and_get_normal(&ray, 10.0, true) {
-                Some((handle, hit)) => {
-                    let collider = &world.colliders[handle];
-                    let look = looks[collider.user_data as usize];
-                    let mut n = hit.normal;
-                    if n.dot(dir) > 0.0 {
-                        n = -n;
-                    }
+            let colour = match tiles.cast(px, py, &ray) {
+                Some((i, toi, normal)) => {
+                    let target = &tiles.targets[i];
+                    let look = target.look;
+                    let n = if normal.dot(dir) > 0.0 { -normal } else { normal };
                     let base = match look.pattern {
                         Pattern::Plain => look.colour,
                         Pattern::Checker { cells, other } => {
-                            let local = collider.position().inverse_transform_point(ray.point_at(hit.time_of_impact));
+                            let local = target.pose.inverse_transform_point(ray.point_at(toi));
                             let [hx, hy] = look.pattern_half_extent;
                             let cell = 2.0 * hx / cells as f32;
                             let i = ((local.x + hx) / cell).floor() as i64;
                             let j = ((local.y + hy) / cell).floor() as i64;
-                            if (i + j).rem_euclid(2) == 0 { look.colour } else { other }
+                            if (i + j).rem_euclid(2) == 0 {
+                                look.colour
+                            } else {
+                                other
+                            }
                         }
                     };
                     let lambert = n.dot(light).max(0.0);
@@ -180,20 +309,20 @@ fn shade_rows(
 /// Renders one camera, splitting rows over `threads` threads.
 pub fn render_camera(sim: &Sim, camera: &Camera, width: u32, height: u32, threads: usize) -> Image {
     let basis = Basis::new(camera, width, height);
+    let tiles = Tiles::new(sim, &basis, width, height);
     let mut image = Image::new(width, height);
     let threads = threads.clamp(1, height as usize);
     let rows_per = height.div_ceil(threads as u32);
     let row_bytes = (width * 3) as usize;
-    let (world, looks) = (sim.physics(), sim.looks());
     std::thread::scope(|scope| {
         for (t, chunk) in image.rgb.chunks_mut(rows_per as usize * row_bytes).enumerate() {
             let start = t as u32 * rows_per;
             let end = (start + rows_per).min(height);
-            let basis = &basis;
+            let (basis, tiles) = (&basis, &tiles);
             if threads == 1 {
-                shade_rows(world, looks, basis, width, height, start..end, chunk);
+                shade_rows(tiles, basis, width, height, start..end, chunk);
             } else {
-                scope.spawn(move || shade_rows(world, looks, basis, width, height, start..end, chunk));
+                scope.spawn(move || shade_rows(tiles, basis, width, height, start..end, chunk));
             }
         }
     });
@@ -216,9 +345,19 @@ pub fn mark(sim: &Sim, camera: &Camera, image: &Image) -> Image {
         let y = (y + 20.0).clamp(24.0, h - 21.0) as i64;
         let width = label_width(&part.name);
         let boxed = |cy: i64| [x - width / 2 - 2, cy - 6, x + width / 2 + 2, cy + 6];
-        let overlaps = |b: &[i64; 4]| placed.iter().any(|p| b[0] < p[2] && p[0] < b[2] && b[1] < p[3] && p[1] < b[3]);
+        let overlaps = |b: &[i64; 4]| {
+            placed
+                .iter()
+                .any(|p| b[0] < p[2] && p[0] < b[2] && b[1] < p[3] && p[1] < b[3])
+        };
         let cy = (0..12)
-            .map(|k| y + if k % 2 == 0 { 11 * (k / 2) } else { -11 * (k / 2 + 1) })
+            .map(|k| {
+                y + if k % 2 == 0 {
+                    11 * (k / 2)
+                } else {
+                    -11 * (k / 2 + 1)
+                }
+            })
             .filter(|cy| (6..image.height as i64 - 6).contains(cy))
             .find(|&cy| !overlaps(&boxed(cy)))
             .unwrap_or(y);
@@ -244,7 +383,10 @@ pub fn draw_label(image: &mut Image, text: &str, cx: i64, cy: i64) {
         }
     }
     for (k, ch) in text.chars().enumerate() {
-        let glyph = font8x8::legacy::BASIC_LEGACY.get(ch as usize).copied().unwrap_or([0; 8]);
+        let glyph = font8x8::legacy::BASIC_LEGACY
+            .get(ch as usize)
+            .copied()
+            .unwrap_or([0; 8]);
         for (row, bits) in glyph.iter().enumerate() {
             for col in 0..8 {
                 if bits >> col & 1 == 1 {
@@ -262,14 +404,21 @@ pub fn render_views(sim: &Sim, size: u32, threads: usize) -> Vec<View> {
         .map(|camera| {
             let image = render_camera(sim, camera, size, size, threads);
             let marked = mark(sim, camera, &image);
-            View { camera: camera.name, image, marked }
+            View {
+                camera: camera.name,
+                image,
+                marked,
+            }
         })
         .collect()
 }
 
 /// Number of threads the renderer uses by default: the available cores, at most 4.
 pub fn default_threads() -> usize {
-    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).min(4)
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+        .min(4)
 }
 
 /// Writes `<camera>.png` and `<camera>_marked.png` for each view into `dir`.

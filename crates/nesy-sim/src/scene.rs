@@ -45,12 +45,15 @@ pub struct SceneSpec {
     pub goals: Vec<SubtaskGoal>,
 }
 
-/// Mirror of [`Embodiment`] for the schema.
+/// Mirror of [`Embodiment`] for the schema: the robot's end effector.
 #[derive(JsonSchema)]
 #[serde(rename_all = "snake_case")]
+#[schemars(rename = "Embodiment")]
 #[allow(dead_code)]
 enum EmbodimentSchema {
+    /// Franka hand with two prismatic fingers.
     Finger,
+    /// Suction tool on link 7.
     Vacuum,
 }
 

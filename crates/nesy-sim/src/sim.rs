@@ -120,6 +120,8 @@ pub(crate) struct HandleGrasp {
     /// Tool position and joint position when grasped.
     pub tool0: Vector3<f64>,
     pub q0: f64,
+    /// Handle centre in the moving joint frame.
+    pub handle_local: Vector,
 }
 
 /// Something that wants to watch the simulation: goal checks every N steps, keyframe
@@ -706,7 +708,7 @@ impl Sim {
             for hook in hooks.iter_mut() {
                 if let Some(n) = hook.step_interval()
                     && n > 0
-                    && self.steps % n == 0
+                    && self.steps.is_multiple_of(n)
                 {
                     hook.on_step(self);
                 }
@@ -749,6 +751,20 @@ impl Sim {
             let tool = (self.base * poses[self.robot.model.tool_link]).translation.vector;
             let q_joint = self.follow_handle(&grasp, tool);
             self.set_articulation(grasp.articulation, q_joint);
+            // Like the authors' controller, a handle left more than the reach behind (the
+            // joint at its limit while the hand moves on) slips out of the grasp.
+            let a = &self.articulations[grasp.articulation];
+            let centre = (a.frame * objects::joint_motion(a.joint, a.q)) * grasp.handle_local;
+            let gap = (tool - Vector3::new(centre.x as f64, centre.y as f64, centre.z as f64)).norm();
+            if gap > crate::api_impl::HANDLE_REACH {
+                self.handle_grasp = None;
+                self.closed = false;
+                self.gripper_target = if self.robot.model.gripper_limits.is_some() {
+                    robot::FINGER_OPEN
+                } else {
+                    0.0
+                };
+            }
         }
     }
 

@@ -41,13 +41,29 @@ fn fk_matches_dh_reference_on_50_configurations() {
     let m = load_model(Embodiment::Finger).unwrap();
     let mut worst = (0.0_f64, 0.0_f64);
     for s in samples {
-        let q: Vec<f64> = s["q"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-        let want_p: Vec<f64> = s["position"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let q: Vec<f64> = s["q"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let want_p: Vec<f64> = s["position"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
         let rows: Vec<Vec<f64>> = s["rotation"]
             .as_array()
             .unwrap()
             .iter()
-            .map(|r| r.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect())
+            .map(|r| {
+                r.as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|v| v.as_f64().unwrap())
+                    .collect()
+            })
             .collect();
         let want_r = Matrix3::from_fn(|i, j| rows[i][j]);
         let got = m.pose_of("panda_link8", &q, 0.0).unwrap();
@@ -55,7 +71,12 @@ fn fk_matches_dh_reference_on_50_configurations() {
         let dr = (got.rotation.to_rotation_matrix().matrix() - want_r).abs().max();
         worst = (worst.0.max(dp), worst.1.max(dr));
     }
-    assert!(worst.0 < 1e-4 && worst.1 < 1e-4, "worst position {:.2e} m, rotation entry {:.2e}", worst.0, worst.1);
+    assert!(
+        worst.0 < 1e-4 && worst.1 < 1e-4,
+        "worst position {:.2e} m, rotation entry {:.2e}",
+        worst.0,
+        worst.1
+    );
 }
 
 #[test]
@@ -99,5 +120,13 @@ fn ik_reaches_workspace_poses_within_1mm_and_half_a_degree() {
 fn ik_refuses_unreachable_targets() {
     let m = load_model(Embodiment::Finger).unwrap();
     let goal = OrientationGoal::Full(pointing_rotation(Vector3::new(0.0, 0.0, -1.0), 0.0));
-    assert!(m.solve_ik(Vector3::new(1.2, 0.0, 0.0), goal, &HOME_ARM, &IkOptions::default()).is_none());
+    assert!(
+        m.solve_ik(
+            Vector3::new(1.2, 0.0, 0.0),
+            goal,
+            &HOME_ARM,
+            &IkOptions::default()
+        )
+        .is_none()
+    );
 }

@@ -8,7 +8,11 @@ use nesy_sim::{ApiError, Direction, Embodiment, RobotApi, SceneError, SceneSpec,
 
 fn wrong_embodiment(result: Result<(), ApiError>, call: &str, use_instead: &str, embodiment: Embodiment) {
     match result {
-        Err(ApiError::WrongEmbodiment { call: c, embodiment: e, use_instead: u }) => {
+        Err(ApiError::WrongEmbodiment {
+            call: c,
+            embodiment: e,
+            use_instead: u,
+        }) => {
             assert_eq!((c.as_str(), e, u.as_str()), (call, embodiment, use_instead));
         }
         other => panic!("{call}: expected WrongEmbodiment, got {other:?}"),
@@ -19,17 +23,57 @@ fn wrong_embodiment(result: Result<(), ApiError>, call: &str, use_instead: &str,
 fn vacuum_calls_on_the_finger_robot_and_the_reverse() {
     let mut sim = load("pick_place_finger");
     let q = sim.arm_joints().to_vec();
-    wrong_embodiment(sim.activate_vacuum(), "activate_vacuum", "close_gripper", Embodiment::Finger);
-    wrong_embodiment(sim.deactivate_vacuum(), "deactivate_vacuum", "open_gripper", Embodiment::Finger);
-    wrong_embodiment(sim.attach_vacuum_handle("x"), "attach_vacuum_handle", "grasp_handle", Embodiment::Finger);
-    wrong_embodiment(sim.detach_vacuum_handle(), "detach_vacuum_handle", "release_handle", Embodiment::Finger);
+    wrong_embodiment(
+        sim.activate_vacuum(),
+        "activate_vacuum",
+        "close_gripper",
+        Embodiment::Finger,
+    );
+    wrong_embodiment(
+        sim.deactivate_vacuum(),
+        "deactivate_vacuum",
+        "open_gripper",
+        Embodiment::Finger,
+    );
+    wrong_embodiment(
+        sim.attach_vacuum_handle("x"),
+        "attach_vacuum_handle",
+        "grasp_handle",
+        Embodiment::Finger,
+    );
+    wrong_embodiment(
+        sim.detach_vacuum_handle(),
+        "detach_vacuum_handle",
+        "release_handle",
+        Embodiment::Finger,
+    );
     assert_eq!(sim.arm_joints(), q.as_slice());
     assert_eq!(sim.trace().len(), 4);
     let mut sim = load("pick_place_vacuum");
-    wrong_embodiment(sim.close_gripper(), "close_gripper", "activate_vacuum", Embodiment::Vacuum);
-    wrong_embodiment(sim.open_gripper(), "open_gripper", "deactivate_vacuum", Embodiment::Vacuum);
-    wrong_embodiment(sim.grasp_handle("x"), "grasp_handle", "attach_vacuum_handle", Embodiment::Vacuum);
-    wrong_embodiment(sim.release_handle(), "release_handle", "detach_vacuum_handle", Embodiment::Vacuum);
+    wrong_embodiment(
+        sim.close_gripper(),
+        "close_gripper",
+        "activate_vacuum",
+        Embodiment::Vacuum,
+    );
+    wrong_embodiment(
+        sim.open_gripper(),
+        "open_gripper",
+        "deactivate_vacuum",
+        Embodiment::Vacuum,
+    );
+    wrong_embodiment(
+        sim.grasp_handle("x"),
+        "grasp_handle",
+        "attach_vacuum_handle",
+        Embodiment::Vacuum,
+    );
+    wrong_embodiment(
+        sim.release_handle(),
+        "release_handle",
+        "detach_vacuum_handle",
+        Embodiment::Vacuum,
+    );
     expect(&sim, "refusals", &["(VacuumInactive)"], &["(VacuumActive)"]);
 }
 
@@ -46,7 +90,11 @@ fn a_cube_under_another_cube_is_refused() {
             }
             other => panic!("expected Infeasible, got {other:?}"),
         }
-        assert_eq!(sim.arm_joints(), q.as_slice(), "a refused call does not move the robot");
+        assert_eq!(
+            sim.arm_joints(),
+            q.as_slice(),
+            "a refused call does not move the robot"
+        );
         assert_eq!(sim.time(), t);
         assert!(sim.trace()[0].result.is_err());
         // The top cube is fine.
@@ -57,7 +105,12 @@ fn a_cube_under_another_cube_is_refused() {
 #[test]
 fn the_bottom_handle_under_the_open_top_drawer_is_refused() {
     let mut sim = load("drawer_blocked_finger");
-    expect(&sim, "reset", &["(OnTopOf top_drawer bottom_drawer_handle)", "(Open top_drawer)"], &[]);
+    expect(
+        &sim,
+        "reset",
+        &["(OnTopOf top_drawer bottom_drawer_handle)", "(Open top_drawer)"],
+        &[],
+    );
     let q = sim.arm_joints().to_vec();
     for result in [
         sim.move_gripper_to("bottom_drawer_handle", Direction::Down, 0.0),
@@ -70,17 +123,29 @@ fn the_bottom_handle_under_the_open_top_drawer_is_refused() {
     }
     assert_eq!(sim.arm_joints(), q.as_slice());
     // Closing the top drawer first uncovers it.
-    sim.move_gripper_to("top_drawer_handle", Direction::Down, 0.0).unwrap();
+    sim.move_gripper_to("top_drawer_handle", Direction::Down, 0.0)
+        .unwrap();
     sim.grasp_handle("top_drawer_handle").unwrap();
     let dy = sim.get_obj_size("bottom_drawer").unwrap()[1] * 0.85;
     sim.move_parallel(Direction::Right, dy, Direction::Down).unwrap();
     sim.release_handle().unwrap();
-    expect(&sim, "top closed", &["(Closed top_drawer)"], &["(OnTopOf top_drawer bottom_drawer_handle)"]);
-    sim.move_gripper_to("bottom_drawer_handle", Direction::Down, 0.0).unwrap();
+    expect(
+        &sim,
+        "top closed",
+        &["(Closed top_drawer)"],
+        &["(OnTopOf top_drawer bottom_drawer_handle)"],
+    );
+    sim.move_gripper_to("bottom_drawer_handle", Direction::Down, 0.0)
+        .unwrap();
     sim.grasp_handle("bottom_drawer_handle").unwrap();
     sim.move_parallel(Direction::Left, dy, Direction::Down).unwrap();
     sim.release_handle().unwrap();
-    expect(&sim, "bottom opened", &["(Open bottom_drawer)", "(Closed top_drawer)"], &[]);
+    expect(
+        &sim,
+        "bottom opened",
+        &["(Open bottom_drawer)", "(Closed top_drawer)"],
+        &[],
+    );
 }
 
 #[test]
@@ -100,10 +165,19 @@ fn unreachable_and_out_of_workspace_targets_are_refused() {
         sim.move_to_position([1.0, 0.0, 0.6], Direction::Down, 0.12, 0.0),
         Err(ApiError::OutOfWorkspace { .. })
     ));
-    assert!(matches!(sim.move_parallel(Direction::Back, 0.5, Direction::Down), Err(ApiError::OutOfWorkspace { .. })));
-    assert!(matches!(sim.move_parallel(Direction::Left, -0.1, Direction::Down), Err(ApiError::InvalidArgument { .. })));
+    assert!(matches!(
+        sim.move_parallel(Direction::Back, 0.5, Direction::Down),
+        Err(ApiError::OutOfWorkspace { .. })
+    ));
+    assert!(matches!(
+        sim.move_parallel(Direction::Left, -0.1, Direction::Down),
+        Err(ApiError::InvalidArgument { .. })
+    ));
     assert_eq!(sim.arm_joints(), q.as_slice());
-    assert!(matches!(sim.get_obj_pos("unicorn"), Err(ApiError::UnknownObject { .. })));
+    assert!(matches!(
+        sim.get_obj_pos("unicorn"),
+        Err(ApiError::UnknownObject { .. })
+    ));
 }
 
 #[test]
@@ -133,14 +207,26 @@ fn an_object_wider_than_the_opening_is_not_grasped() {
     sim.move_gripper_to("red_cube", Direction::Down, 0.015).unwrap();
     sim.close_gripper().unwrap();
     assert_eq!(sim.held_object(), None);
-    expect(&sim, "close", &["(GripperClosed)"], &["(GripperHolding red_cube)"]);
+    expect(
+        &sim,
+        "close",
+        &["(GripperClosed)"],
+        &["(GripperHolding red_cube)"],
+    );
 }
 
 #[test]
 fn the_action_budget_is_enforced() {
     let text = std::fs::read_to_string(scene_path("pick_place_finger")).unwrap();
     let spec = SceneSpec::from_json_str(&text, "budget").unwrap();
-    let mut sim = Sim::with_config(&spec, SimConfig { action_budget: 2, ..SimConfig::default() }).unwrap();
+    let mut sim = Sim::with_config(
+        &spec,
+        SimConfig {
+            action_budget: 2,
+            ..SimConfig::default()
+        },
+    )
+    .unwrap();
     sim.open_gripper().unwrap();
     sim.get_obj_names(); // perception is free
     sim.close_gripper().unwrap();
@@ -163,7 +249,11 @@ fn load_error(mutate: impl FnOnce(&mut serde_json::Value)) -> SceneError {
 fn malformed_scenes_name_the_json_path_and_the_expectation() {
     let e = load_error(|j| j["objects"][1]["kind"] = "sphere".into());
     assert_eq!(e.json_path(), Some("objects[1].kind"));
-    assert!(e.to_string().contains("unknown variant `sphere`, expected one of `cube`"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("unknown variant `sphere`, expected one of `cube`"),
+        "{e}"
+    );
 
     let e = load_error(|j| j["embodiment"] = "suction".into());
     assert_eq!(e.json_path(), Some("embodiment"));
@@ -196,12 +286,25 @@ fn malformed_scenes_name_the_json_path_and_the_expectation() {
     let bad = text.replacen("[0.6, -0.1, 0.5]", "[0.6, NaN, 0.5]", 1);
     let e = SceneSpec::from_json_str(&bad, "nan.json").unwrap_err();
     assert_eq!(e.json_path(), Some("objects[1].pose.position[1]"));
-    assert!(matches!(e, SceneError::Json { line: 8, column: 71, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            SceneError::Json {
+                line: 8,
+                column: 71,
+                ..
+            }
+        ),
+        "{e}"
+    );
     let mut spec = SceneSpec::from_json_str(&text, "ok").unwrap();
     spec.objects[1].pose.position[1] = f64::NAN;
     let e = Sim::new(&spec).err().unwrap();
     assert_eq!(e.json_path(), Some("objects[1].pose.position[1]"));
-    assert!(e.to_string().contains("expected a finite number, found NaN"), "{e}");
+    assert!(
+        e.to_string().contains("expected a finite number, found NaN"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -40,36 +40,87 @@ fn let_go_handle(sim: &mut Sim) {
 /// Predicate names for the embodiment: (open, closed, holding, surrounding).
 fn names(sim: &Sim) -> (&'static str, &'static str, &'static str, &'static str) {
     match sim.embodiment() {
-        nesy_sim::Embodiment::Finger => ("GripperOpen", "GripperClosed", "GripperHolding", "GripperSurrounding"),
-        nesy_sim::Embodiment::Vacuum => ("VacuumInactive", "VacuumActive", "VacuumAttached", "VacuumAligned"),
+        nesy_sim::Embodiment::Finger => (
+            "GripperOpen",
+            "GripperClosed",
+            "GripperHolding",
+            "GripperSurrounding",
+        ),
+        nesy_sim::Embodiment::Vacuum => (
+            "VacuumInactive",
+            "VacuumActive",
+            "VacuumAttached",
+            "VacuumAligned",
+        ),
     }
 }
 
 fn pick_place(scene: &str) {
     let mut sim = load(scene);
     let (open, closed, holding, surrounding) = names(&sim);
-    expect(&sim, "reset", &[&format!("({open})"), "(OnTopOf green_cube blue_cube)", "(OnTopOf red_cube floor)"], &[]);
+    expect(
+        &sim,
+        "reset",
+        &[
+            &format!("({open})"),
+            "(OnTopOf green_cube blue_cube)",
+            "(OnTopOf red_cube floor)",
+        ],
+        &[],
+    );
     let grid = [[-0.02, -0.03], [0.02, -0.03], [0.0, 0.03]];
     // The stacked cube first, then the others, as the authors' expert does.
     for (k, cube) in ["green_cube", "red_cube", "blue_cube"].into_iter().enumerate() {
         let h = sim.get_obj_size(cube).unwrap()[2];
         sim.move_gripper_to(cube, Direction::Down, h / 2.0).unwrap();
-        expect(&sim, "approach", &[&format!("({surrounding} {cube})"), &format!("({open})")], &[]);
+        expect(
+            &sim,
+            "approach",
+            &[&format!("({surrounding} {cube})"), &format!("({open})")],
+            &[],
+        );
         grasp(&mut sim);
-        expect(&sim, "grasp", &[&format!("({holding} {cube})"), &format!("({closed})")], &[]);
+        expect(
+            &sim,
+            "grasp",
+            &[&format!("({holding} {cube})"), &format!("({closed})")],
+            &[],
+        );
         let c = sim.get_obj_pos("toy_box").unwrap();
         let top = sim.get_obj_bbox("toy_box").unwrap()[1][2];
-        sim.move_to_position([c[0] + grid[k][0], c[1] + grid[k][1], top + h + 0.03], Direction::Down, 0.12, 0.0)
-            .unwrap();
-        expect(&sim, "carry", &[&format!("(OverOf {cube} toy_box)"), &format!("({holding} {cube})")], &[]);
+        sim.move_to_position(
+            [c[0] + grid[k][0], c[1] + grid[k][1], top + h + 0.03],
+            Direction::Down,
+            0.12,
+            0.0,
+        )
+        .unwrap();
+        expect(
+            &sim,
+            "carry",
+            &[
+                &format!("(OverOf {cube} toy_box)"),
+                &format!("({holding} {cube})"),
+            ],
+            &[],
+        );
         release(&mut sim);
-        expect(&sim, "release", &[&format!("(InsideOf {cube} toy_box)"), &format!("({open})")], &[&format!("({holding} {cube})")]);
+        expect(
+            &sim,
+            "release",
+            &[&format!("(InsideOf {cube} toy_box)"), &format!("({open})")],
+            &[&format!("({holding} {cube})")],
+        );
     }
     sim.step_idle(100);
     expect(
         &sim,
         "settle",
-        &["(InsideOf green_cube toy_box)", "(InsideOf red_cube toy_box)", "(InsideOf blue_cube toy_box)"],
+        &[
+            "(InsideOf green_cube toy_box)",
+            "(InsideOf red_cube toy_box)",
+            "(InsideOf blue_cube toy_box)",
+        ],
         &[],
     );
     assert!(sim.trace().iter().all(|e| e.result.is_ok()));
@@ -88,26 +139,70 @@ fn pick_cubes_into_the_toy_box_vacuum() {
 fn drawer(scene: &str, cylinder: &str) {
     let mut sim = load(scene);
     let (open, _, holding, _) = names(&sim);
-    expect(&sim, "reset", &["(Open bottom_drawer)", "(Closed top_drawer)"], &[]);
+    expect(
+        &sim,
+        "reset",
+        &["(Open bottom_drawer)", "(Closed top_drawer)"],
+        &[],
+    );
     let h = sim.get_obj_size(cylinder).unwrap()[2];
     sim.move_gripper_to(cylinder, Direction::Down, h / 2.0).unwrap();
     grasp(&mut sim);
     expect(&sim, "grasp", &[&format!("({holding} {cylinder})")], &[]);
     let c = sim.get_obj_pos("bottom_drawer").unwrap();
     let s = sim.get_obj_size("bottom_drawer").unwrap();
-    sim.move_to_position([c[0], c[1], c[2] + s[2] + h], Direction::Down, 0.12, 0.0).unwrap();
-    expect(&sim, "carry", &[&format!("(OverOf {cylinder} bottom_drawer)")], &[]);
+    sim.move_to_position([c[0], c[1], c[2] + s[2] + h], Direction::Down, 0.12, 0.0)
+        .unwrap();
+    expect(
+        &sim,
+        "carry",
+        &[&format!("(OverOf {cylinder} bottom_drawer)")],
+        &[],
+    );
     release(&mut sim);
-    expect(&sim, "drop", &[&format!("(InsideOf {cylinder} bottom_drawer)"), &format!("({open})")], &[]);
+    expect(
+        &sim,
+        "drop",
+        &[
+            &format!("(InsideOf {cylinder} bottom_drawer)"),
+            &format!("({open})"),
+        ],
+        &[],
+    );
     grab_handle(&mut sim, "bottom_drawer_handle");
-    expect(&sim, "grasp handle", &[&format!("({holding} bottom_drawer_handle)")], &[]);
-    sim.move_parallel(Direction::Right, s[1] * 0.85, Direction::Down).unwrap();
-    expect(&sim, "push", &["(Closed bottom_drawer)", &format!("({holding} bottom_drawer_handle)")], &[]);
+    expect(
+        &sim,
+        "grasp handle",
+        &[&format!("({holding} bottom_drawer_handle)")],
+        &[],
+    );
+    sim.move_parallel(Direction::Right, s[1] * 0.85, Direction::Down)
+        .unwrap();
+    expect(
+        &sim,
+        "push",
+        &[
+            "(Closed bottom_drawer)",
+            &format!("({holding} bottom_drawer_handle)"),
+        ],
+        &[],
+    );
     let_go_handle(&mut sim);
     sim.move_parallel(Direction::Up, 0.05, Direction::Down).unwrap();
     sim.step_idle(100);
-    expect(&sim, "final", &["(Closed bottom_drawer)", &format!("(InsideOf {cylinder} bottom_drawer)")], &["(Open bottom_drawer)"]);
-    assert!(sim.articulation_q("bottom_drawer").unwrap() < 0.04, "closed per the success check");
+    expect(
+        &sim,
+        "final",
+        &[
+            "(Closed bottom_drawer)",
+            &format!("(InsideOf {cylinder} bottom_drawer)"),
+        ],
+        &["(Open bottom_drawer)"],
+    );
+    assert!(
+        sim.articulation_q("bottom_drawer").unwrap() < 0.04,
+        "closed per the success check"
+    );
 }
 
 #[test]
@@ -123,15 +218,31 @@ fn cylinder_into_the_open_bottom_drawer_then_close_vacuum() {
 fn hinge(scene: &str) {
     let mut sim = load(scene);
     let (open, _, holding, _) = names(&sim);
-    expect(&sim, "reset", &["(Closed hinge_lid)", "(OnTopOf apple floor)"], &[]);
+    expect(
+        &sim,
+        "reset",
+        &["(Closed hinge_lid)", "(OnTopOf apple floor)"],
+        &[],
+    );
     grab_handle(&mut sim, "hinge_handle");
     expect(&sim, "grasp handle", &[&format!("({holding} hinge_handle)")], &[]);
     let lid = sim.get_obj_pos("hinge_lid").unwrap();
     let r = sim.get_obj_size("hinge_lid").unwrap()[0];
-    sim.move_to_position([lid[0] + 0.5 * r, lid[1], lid[2] + r], Direction::Down, 0.0, 0.0).unwrap();
-    expect(&sim, "lift lid", &["(Open hinge_lid)", &format!("({holding} hinge_handle)")], &[]);
+    sim.move_to_position([lid[0] + 0.5 * r, lid[1], lid[2] + r], Direction::Down, 0.0, 0.0)
+        .unwrap();
+    expect(
+        &sim,
+        "lift lid",
+        &["(Open hinge_lid)", &format!("({holding} hinge_handle)")],
+        &[],
+    );
     let_go_handle(&mut sim);
-    expect(&sim, "release handle", &["(Open hinge_lid)", &format!("({open})")], &[]);
+    expect(
+        &sim,
+        "release handle",
+        &["(Open hinge_lid)", &format!("({open})")],
+        &[],
+    );
     let h = sim.get_obj_size("apple").unwrap()[2];
     sim.move_gripper_to("apple", Direction::Down, h / 2.0).unwrap();
     grasp(&mut sim);
@@ -139,19 +250,37 @@ fn hinge(scene: &str) {
     let body = sim.get_obj_pos("hinge_body").unwrap();
     let top = sim.get_obj_bbox("hinge_body").unwrap()[1][2];
     // Suction holds the fruit by its top, the fingers by its middle.
-    let hang = if sim.embodiment() == nesy_sim::Embodiment::Vacuum { h } else { h / 2.0 };
-    sim.move_to_position([body[0], body[1], top + hang + 0.03], Direction::Down, 0.12, 0.0).unwrap();
+    let hang = if sim.embodiment() == nesy_sim::Embodiment::Vacuum {
+        h
+    } else {
+        h / 2.0
+    };
+    sim.move_to_position([body[0], body[1], top + hang + 0.03], Direction::Down, 0.12, 0.0)
+        .unwrap();
     expect(&sim, "carry", &["(OverOf apple hinge_body)"], &[]);
     release(&mut sim);
     expect(&sim, "drop", &["(InsideOf apple hinge_body)"], &[]);
     grab_handle(&mut sim, "hinge_handle");
     let size = sim.get_obj_size("hinge_body").unwrap();
-    sim.move_to_position([body[0] - 0.5 * size[0], body[1], body[2] + 0.5 * size[2]], Direction::Down, 0.0, 0.0)
-        .unwrap();
+    sim.move_to_position(
+        [body[0] - 0.5 * size[0], body[1], body[2] + 0.5 * size[2]],
+        Direction::Down,
+        0.0,
+        0.0,
+    )
+    .unwrap();
     let_go_handle(&mut sim);
     sim.step_idle(100);
-    expect(&sim, "final", &["(Closed hinge_lid)", "(InsideOf apple hinge_body)"], &["(Open hinge_lid)"]);
-    assert!((sim.articulation_q("hinge_lid").unwrap() + 0.785).abs() < 0.2, "closed per the success check");
+    expect(
+        &sim,
+        "final",
+        &["(Closed hinge_lid)", "(InsideOf apple hinge_body)"],
+        &["(Open hinge_lid)"],
+    );
+    assert!(
+        (sim.articulation_q("hinge_lid").unwrap() + 0.785).abs() < 0.2,
+        "closed per the success check"
+    );
 }
 
 #[test]
@@ -167,8 +296,16 @@ fn open_the_hinge_lid_drop_a_fruit_close_it_vacuum() {
 fn sweep(scene: &str) {
     let mut sim = load(scene);
     let vacuum = sim.embodiment() == nesy_sim::Embodiment::Vacuum;
-    expect(&sim, "reset", &["(OnTopOf white_rook board)", "(OnTopOf black_bishop board)"], &[]);
-    for (piece, target) in [("white_rook", "left_chess_box"), ("black_bishop", "right_chess_box")] {
+    expect(
+        &sim,
+        "reset",
+        &["(OnTopOf white_rook board)", "(OnTopOf black_bishop board)"],
+        &[],
+    );
+    for (piece, target) in [
+        ("white_rook", "left_chess_box"),
+        ("black_bishop", "right_chess_box"),
+    ] {
         let h = sim.get_obj_size(piece).unwrap()[2];
         sim.move_gripper_to(piece, Direction::Down, h / 1.3).unwrap();
         if vacuum {
@@ -179,16 +316,34 @@ fn sweep(scene: &str) {
         }
         let py = sim.get_obj_pos(piece).unwrap()[1];
         let by = sim.get_obj_pos(target).unwrap()[1];
-        let dir = if py > by { Direction::Left } else { Direction::Right };
-        sim.move_parallel(dir, (py - by).abs() + 0.02, Direction::Down).unwrap();
+        let dir = if py > by {
+            Direction::Left
+        } else {
+            Direction::Right
+        };
+        sim.move_parallel(dir, (py - by).abs() + 0.02, Direction::Down)
+            .unwrap();
         if vacuum {
             sim.deactivate_vacuum().unwrap();
         }
-        expect(&sim, "sweep", &[&format!("(InsideOf {piece} {target})")], &[&format!("(OnTopOf {piece} board)")]);
+        expect(
+            &sim,
+            "sweep",
+            &[&format!("(InsideOf {piece} {target})")],
+            &[&format!("(OnTopOf {piece} board)")],
+        );
         sim.move_parallel(Direction::Up, 0.08, Direction::Down).unwrap();
     }
     sim.step_idle(100);
-    expect(&sim, "final", &["(InsideOf white_rook left_chess_box)", "(InsideOf black_bishop right_chess_box)"], &[]);
+    expect(
+        &sim,
+        "final",
+        &[
+            "(InsideOf white_rook left_chess_box)",
+            "(InsideOf black_bishop right_chess_box)",
+        ],
+        &[],
+    );
 }
 
 #[test]
@@ -199,4 +354,54 @@ fn sweep_chess_pieces_into_their_boxes_finger() {
 #[test]
 fn sweep_chess_pieces_into_their_boxes_vacuum() {
     sweep("sweep_vacuum");
+}
+
+fn unstack(scene: &str) {
+    let mut sim = load(scene);
+    let (open, _, holding, _) = names(&sim);
+    expect(&sim, "reset", &["(OnTopOf green_cube blue_cube)"], &[]);
+    let h = sim.get_obj_size("green_cube").unwrap()[2];
+    sim.move_gripper_to("green_cube", Direction::Down, h / 2.0)
+        .unwrap();
+    grasp(&mut sim);
+    expect(&sim, "grasp", &[&format!("({holding} green_cube)")], &[]);
+    let [x, y] = sim.get_empty_floor_xy("green_cube").unwrap();
+    // The spot is in the search region and clear of every other object.
+    assert!(
+        (0.11..=0.53).contains(&x) && (-0.15..=0.16).contains(&y),
+        "{x} {y}"
+    );
+    let hang = if sim.embodiment() == nesy_sim::Embodiment::Vacuum {
+        h
+    } else {
+        h / 2.0
+    };
+    sim.move_to_position([x, y, 0.5 + hang + 0.01], Direction::Down, 0.12, 0.0)
+        .unwrap();
+    release(&mut sim);
+    expect(
+        &sim,
+        "put down",
+        &[
+            "(OnTopOf green_cube floor)",
+            "(OnTopOf blue_cube floor)",
+            &format!("({open})"),
+        ],
+        &["(OnTopOf green_cube blue_cube)"],
+    );
+    // Now the lower cube can be picked.
+    sim.move_gripper_to("blue_cube", Direction::Down, h / 2.0)
+        .unwrap();
+    grasp(&mut sim);
+    expect(&sim, "grasp lower", &[&format!("({holding} blue_cube)")], &[]);
+}
+
+#[test]
+fn unstack_onto_an_empty_floor_spot_finger() {
+    unstack("pick_place_finger");
+}
+
+#[test]
+fn unstack_onto_an_empty_floor_spot_vacuum() {
+    unstack("pick_place_vacuum");
 }

@@ -7,7 +7,9 @@ use nesy_sim::{Sim, observe};
 
 /// Path of a scene fixture.
 pub fn scene_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenes").join(format!("{name}.json"))
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/scenes")
+        .join(format!("{name}.json"))
 }
 
 /// Builds the world of a scene fixture.
