@@ -3,7 +3,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use nesy_core::exec::{implicit_universe, verify_compiled, verify_procedure};
+use nesy_core::exec::{CompiledProcedure, implicit_universe, verify_procedure};
 use nesy_core::operator::format_procedure;
 use nesy_core::planner::{PlannerConfig, plan};
 use nesy_core::text::parse_procedure;
@@ -27,17 +27,10 @@ fn bench(c: &mut Criterion) {
     let goal = workload::goal_116();
     assert!(verify_procedure(&state, &ops, Some(&goal)).is_valid());
     let universe: Universe = implicit_universe(&state, &ops, Some(&goal));
-    let compiled: Vec<_> = ops.iter().map(|o| o.compile(&universe)).collect();
+    let compiled = CompiledProcedure::new(&universe, &ops, Some(&goal));
+    assert!(compiled.verify(&state).is_valid());
     c.bench_function("verify_116_steps/compiled", |b| {
-        b.iter(|| {
-            black_box(verify_compiled(
-                &universe,
-                black_box(&state),
-                &ops,
-                &compiled,
-                Some(&goal),
-            ))
-        })
+        b.iter(|| black_box(compiled.verify(black_box(&state))))
     });
     c.bench_function("verify_116_steps/from_operators", |b| {
         b.iter(|| black_box(verify_procedure(black_box(&state), &ops, Some(&goal))))

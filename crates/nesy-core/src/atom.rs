@@ -1,9 +1,9 @@
 //! Ground atoms such as `(OnTopOf red_cube floor)` or `(GripperOpen)`.
 //!
 //! Atoms are hash-consed: every distinct `(predicate, arguments)` pair is stored once in a
-//! process-wide table and an [`Atom`] is a pointer to that entry. Atoms are therefore
-//! `Copy`, eight bytes wide, compare and hash by a dense id, and a [`crate::State`] of
-//! two hundred atoms clones with one `memcpy`. The table only grows; its size is bounded by
+//! process-wide table and an [`Atom`] is its dense id plus a pointer to that entry. Atoms
+//! are therefore `Copy`, compare and hash by the id without touching memory, and a
+//! [`crate::State`] of two hundred atoms clones with one `memcpy`. The table only grows; its size is bounded by
 //! the number of distinct atoms a process ever builds.
 
 use std::fmt;
@@ -59,12 +59,15 @@ fn intern(pred: Symbol, args: Args) -> &'static AtomData {
 /// `Ord` is by interned id (fast, deterministic for a given interning order); printing code
 /// sorts by text where humans read the result.
 #[derive(Clone, Copy)]
-pub struct Atom(&'static AtomData);
+pub struct Atom {
+    id: u32,
+    data: &'static AtomData,
+}
 
 impl Atom {
     /// Builds an atom from a predicate name and argument names, interning them.
     pub fn new(pred: &str, args: &[&str]) -> Self {
-        Atom(intern(
+        Atom::from_data(intern(
             Symbol::new(pred),
             args.iter().map(|a| Symbol::new(a)).collect(),
         ))
@@ -72,38 +75,42 @@ impl Atom {
 
     /// Builds an atom from already interned symbols.
     pub fn from_symbols(pred: Symbol, args: impl IntoIterator<Item = Symbol>) -> Self {
-        Atom(intern(pred, args.into_iter().collect()))
+        Atom::from_data(intern(pred, args.into_iter().collect()))
+    }
+
+    fn from_data(data: &'static AtomData) -> Self {
+        Atom { id: data.id, data }
     }
 
     /// The predicate.
     pub fn pred(&self) -> Symbol {
-        self.0.pred
+        self.data.pred
     }
 
     /// The arguments, in order.
     pub fn args(&self) -> &[Symbol] {
-        &self.0.args
+        &self.data.args
     }
 
     /// Number of arguments.
     pub fn arity(&self) -> usize {
-        self.0.args.len()
+        self.data.args.len()
     }
 
     /// True if any argument is `object`.
     pub fn mentions(&self, object: Symbol) -> bool {
-        self.0.args.contains(&object)
+        self.data.args.contains(&object)
     }
 
     /// The dense interned id (stable for the life of the process).
     pub fn id(&self) -> u32 {
-        self.0.id
+        self.id
     }
 }
 
 impl PartialEq for Atom {
     fn eq(&self, other: &Self) -> bool {
-        std::ptr::eq(self.0, other.0)
+        self.id == other.id
     }
 }
 
@@ -111,7 +118,7 @@ impl Eq for Atom {}
 
 impl Hash for Atom {
     fn hash<H: Hasher>(&self, state: &mut H) {
-        self.0.id.hash(state);
+        self.id.hash(state);
     }
 }
 
@@ -123,7 +130,7 @@ impl PartialOrd for Atom {
 
 impl Ord for Atom {
     fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.0.id.cmp(&other.0.id)
+        self.id.cmp(&other.id)
     }
 }
 

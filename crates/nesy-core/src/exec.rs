@@ -6,7 +6,8 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 use crate::atom::Atom;
-use crate::formula::{AtomTruth, Formula, GroundError};
+use crate::formula::{AtomTruth, Formula, Ground, GroundError};
+use crate::indexed::{Bits, Cond, Facts, get, set};
 use crate::operator::{CompiledOperator, Operator};
 use crate::state::State;
 use crate::symbol::Symbol;
@@ -272,71 +273,213 @@ pub fn verify_procedure_in(
     ops: &[Operator],
     goal: Option<&Formula>,
 ) -> Report {
-    let compiled: Vec<Result<CompiledOperator, GroundError>> =
-        ops.iter().map(|o| o.compile(universe)).collect();
-    verify_compiled(universe, init, ops, &compiled, goal)
+    CompiledProcedure::new(universe, ops, goal).verify(init)
 }
 
-/// Verifies a procedure whose operators were compiled once against `universe`; this is the
-/// fast path the adaptation loop and the benchmarks use.
-pub fn verify_compiled(
-    universe: &Universe,
-    init: &State,
-    ops: &[Operator],
-    compiled: &[Result<CompiledOperator, GroundError>],
-    goal: Option<&Formula>,
-) -> Report {
-    let mut state = init.clone();
-    let mut steps = Vec::with_capacity(ops.len());
-    let mut first_failure = None;
-    let mut failing_state = None;
-    for (index, (op, c)) in ops.iter().zip(compiled).enumerate() {
-        let action = op.display_name();
-        if first_failure.is_some() {
+/// A goal conjunct as written, grounded, and indexed.
+type GoalConjunct = (Formula, Ground, Cond);
+
+/// One compiled step: its display name, its operator (for violation reports) and its
+/// indexed form.
+#[derive(Debug, Clone)]
+struct CompiledStep {
+    source: Operator,
+    name: String,
+    compiled: Result<(CompiledOperator, IndexedEffects, Vec<Cond>), GroundError>,
+}
+
+#[derive(Debug, Clone)]
+struct IndexedEffects {
+    adds: Vec<u32>,
+    dels: Vec<u32>,
+    conditional: Vec<(Cond, u32, bool)>,
+}
+
+/// A procedure (and goal) compiled once against a universe: every quantifier expanded, every
+/// atom mapped to a dense index. [`CompiledProcedure::verify`] runs over bitset states and
+/// builds [`State`]s only for the report, so verifying from many initial states, or timing
+/// pure execution, pays the grounding once.
+#[derive(Debug, Clone)]
+pub struct CompiledProcedure {
+    facts: Facts,
+    steps: Vec<CompiledStep>,
+    goal: Option<Result<Vec<GoalConjunct>, GroundError>>,
+}
+
+impl CompiledProcedure {
+    /// Compiles `ops` and `goal` against `universe`. Steps that cannot be grounded are
+    /// kept and reported as [`StepStatus::Invalid`] when reached.
+    pub fn new(universe: &Universe, ops: &[Operator], goal: Option<&Formula>) -> Self {
+        let mut facts = Facts::new();
+        let steps = ops
+            .iter()
+            .map(|op| {
+                let compiled = op.compile(universe).map(|c| {
+                    let pre = c.pre.iter().map(|(_, g)| facts.cond(g)).collect();
+                    let eff = IndexedEffects {
+                        adds: c.effects.adds.iter().map(|a| facts.id(*a)).collect(),
+                        dels: c.effects.dels.iter().map(|a| facts.id(*a)).collect(),
+                        conditional: c
+                            .effects
+                            .conditional
+                            .iter()
+                            .map(|e| (facts.cond(&e.condition), facts.id(e.atom), e.add))
+                            .collect(),
+                    };
+                    (c, eff, pre)
+                });
+                CompiledStep {
+                    source: op.clone(),
+                    name: op.display_name(),
+                    compiled,
+                }
+            })
+            .collect();
+        let goal = goal.map(|g| {
+            g.conjuncts()
+                .into_iter()
+                .map(|c| {
+                    let ground = c.ground(universe, &mut Default::default())?;
+                    let cond = facts.cond(&ground);
+                    Ok((c, ground, cond))
+                })
+                .collect::<Result<Vec<_>, GroundError>>()
+        });
+        CompiledProcedure { facts, steps, goal }
+    }
+
+    /// Number of steps.
+    pub fn len(&self) -> usize {
+        self.steps.len()
+    }
+
+    /// True if the procedure has no steps.
+    pub fn is_empty(&self) -> bool {
+        self.steps.is_empty()
+    }
+
+    fn state_of(&self, bits: &Bits, untouched: &[Atom]) -> State {
+        let mut state = self.facts.decode(bits);
+        if !untouched.is_empty() {
+            state = State::from_atoms(state.iter().copied().chain(untouched.iter().copied()));
+        }
+        state
+    }
+
+    /// Verifies the procedure from `init`, stopping at the first failing step; checks the
+    /// goal if every step applied.
+    pub fn verify(&self, init: &State) -> Report {
+        // Atoms of `init` that no step or goal mentions can never change or matter; they
+        // ride along untouched and rejoin the reported states.
+        let mut bits = vec![0u64; self.facts.words()];
+        let mut untouched = Vec::new();
+        for a in init.iter() {
+            match self.facts.index.get(a) {
+                Some(&i) => set(&mut bits, i, true),
+                None => untouched.push(*a),
+            }
+        }
+        let mut steps = Vec::with_capacity(self.steps.len());
+        let mut first_failure = None;
+        let mut failing_state = None;
+        let (mut adds, mut dels) = (Vec::new(), Vec::new());
+        for (index, step) in self.steps.iter().enumerate() {
+            let action = step.name.clone();
+            if first_failure.is_some() {
+                steps.push(StepOutcome {
+                    index,
+                    action,
+                    status: StepStatus::NotExecuted,
+                });
+                continue;
+            }
+            let status = match &step.compiled {
+                Err(error) => StepStatus::Invalid { error: error.clone() },
+                Ok((compiled, eff, pre)) => {
+                    if pre.iter().all(|c| c.holds(&bits)) {
+                        adds.clear();
+                        dels.clear();
+                        adds.extend_from_slice(&eff.adds);
+                        dels.extend_from_slice(&eff.dels);
+                        for (c, f, add) in &eff.conditional {
+                            if c.holds(&bits) {
+                                if *add { adds.push(*f) } else { dels.push(*f) }
+                            }
+                        }
+                        let added: Vec<Atom> = adds
+                            .iter()
+                            .filter(|&&f| !get(&bits, f))
+                            .map(|&f| self.facts.atoms[f as usize])
+                            .collect();
+                        let removed: Vec<Atom> = dels
+                            .iter()
+                            .filter(|&&f| get(&bits, f) && !adds.contains(&f))
+                            .map(|&f| self.facts.atoms[f as usize])
+                            .collect();
+                        for &d in &dels {
+                            set(&mut bits, d, false);
+                        }
+                        for &a in &adds {
+                            set(&mut bits, a, true);
+                        }
+                        let mut added = added;
+                        added.sort_unstable();
+                        added.dedup();
+                        let mut removed = removed;
+                        removed.sort_unstable();
+                        removed.dedup();
+                        StepStatus::Applied { added, removed }
+                    } else {
+                        let state = self.state_of(&bits, &untouched);
+                        StepStatus::Failed {
+                            violation: compiled.violation(&state, &step.source),
+                        }
+                    }
+                }
+            };
+            if !matches!(status, StepStatus::Applied { .. }) {
+                first_failure = Some(index);
+                failing_state = Some(self.state_of(&bits, &untouched));
+            }
             steps.push(StepOutcome {
                 index,
                 action,
-                status: StepStatus::NotExecuted,
+                status,
             });
-            continue;
         }
-        let status = match c {
-            Err(error) => StepStatus::Invalid { error: error.clone() },
-            Ok(c) => match c.apply(&state, op) {
-                Ok(next) => {
-                    let diff = state.diff(&next);
-                    state = next;
-                    StepStatus::Applied {
-                        added: diff.added,
-                        removed: diff.removed,
-                    }
-                }
-                Err(violation) => StepStatus::Failed { violation },
-            },
+        let final_state = self.state_of(&bits, &untouched);
+        let (goal, goal_error) = match (&self.goal, first_failure) {
+            (Some(Ok(conjuncts)), None) => {
+                let unmet: Vec<UnmetPrecondition> = conjuncts
+                    .iter()
+                    .filter(|(_, _, cond)| !cond.holds(&bits))
+                    .map(|(literal, ground, _)| {
+                        let mut atoms = Vec::new();
+                        ground.explain(&final_state, &mut atoms);
+                        UnmetPrecondition {
+                            literal: literal.clone(),
+                            atoms,
+                        }
+                    })
+                    .collect();
+                (
+                    Some(GoalCheck {
+                        satisfied: unmet.is_empty(),
+                        unmet,
+                    }),
+                    None,
+                )
+            }
+            (Some(Err(e)), None) => (None, Some(e.clone())),
+            _ => (None, None),
         };
-        if !matches!(status, StepStatus::Applied { .. }) {
-            first_failure = Some(index);
-            failing_state = Some(state.clone());
+        Report {
+            steps,
+            first_failure,
+            failing_state,
+            final_state,
+            goal,
+            goal_error,
         }
-        steps.push(StepOutcome {
-            index,
-            action,
-            status,
-        });
-    }
-    let (goal, goal_error) = match (goal, first_failure) {
-        (Some(g), None) => match check_goal(universe, &state, g) {
-            Ok(check) => (Some(check), None),
-            Err(e) => (None, Some(e)),
-        },
-        _ => (None, None),
-    };
-    Report {
-        steps,
-        first_failure,
-        failing_state,
-        final_state: state,
-        goal,
-        goal_error,
     }
 }

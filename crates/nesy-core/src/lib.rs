@@ -12,6 +12,7 @@ pub mod adapt;
 pub mod atom;
 pub mod exec;
 pub mod formula;
+mod indexed;
 pub mod metrics;
 pub mod operator;
 pub mod patch;

@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::atom::Atom;
 use crate::formula::{Formula, Ground, GroundError};
+use crate::indexed::{Bits, Cond, Facts, get, set};
 use crate::operator::{CompiledOperator, Operator};
 use crate::state::State;
 use crate::symbol::Symbol;
@@ -108,18 +109,6 @@ pub enum PlanError {
     Ground(#[from] GroundError),
 }
 
-/// A ground formula over fact indices.
-#[derive(Debug, Clone)]
-enum Cond {
-    True,
-    False,
-    Fact(u32),
-    NotFact(u32),
-    Not(Box<Cond>),
-    And(Vec<Cond>),
-    Or(Vec<Cond>),
-}
-
 /// A search node: state, (parent, action) and path cost.
 type Node = (Bits, Option<(usize, usize)>, usize);
 
@@ -129,66 +118,6 @@ struct GroundAction {
     adds: Vec<u32>,
     dels: Vec<u32>,
     conditional: Vec<(Cond, u32, bool)>,
-}
-
-type Bits = Vec<u64>;
-
-fn get(bits: &Bits, i: u32) -> bool {
-    bits[(i / 64) as usize] >> (i % 64) & 1 == 1
-}
-
-fn set(bits: &mut Bits, i: u32, v: bool) {
-    let w = &mut bits[(i / 64) as usize];
-    if v {
-        *w |= 1 << (i % 64)
-    } else {
-        *w &= !(1 << (i % 64))
-    }
-}
-
-impl Cond {
-    fn holds(&self, s: &Bits) -> bool {
-        match self {
-            Cond::True => true,
-            Cond::False => false,
-            Cond::Fact(f) => get(s, *f),
-            Cond::NotFact(f) => !get(s, *f),
-            Cond::Not(c) => !c.holds(s),
-            Cond::And(cs) => cs.iter().all(|c| c.holds(s)),
-            Cond::Or(cs) => cs.iter().any(|c| c.holds(s)),
-        }
-    }
-}
-
-struct Facts {
-    index: FxHashMap<Atom, u32>,
-    atoms: Vec<Atom>,
-}
-
-impl Facts {
-    fn id(&mut self, a: Atom) -> u32 {
-        if let Some(&i) = self.index.get(&a) {
-            return i;
-        }
-        let i = self.atoms.len() as u32;
-        self.atoms.push(a);
-        self.index.insert(a, i);
-        i
-    }
-
-    fn cond(&mut self, g: &Ground) -> Cond {
-        match g {
-            Ground::True => Cond::True,
-            Ground::False => Cond::False,
-            Ground::Atom(a) => Cond::Fact(self.id(*a)),
-            Ground::Not(inner) => match &**inner {
-                Ground::Atom(a) => Cond::NotFact(self.id(*a)),
-                other => Cond::Not(Box::new(self.cond(other))),
-            },
-            Ground::And(gs) => Cond::And(gs.iter().map(|g| self.cond(g)).collect()),
-            Ground::Or(gs) => Cond::Or(gs.iter().map(|g| self.cond(g)).collect()),
-        }
-    }
 }
 
 /// Three-valued truth of a ground formula when only static atoms are known.
@@ -312,18 +241,8 @@ impl Task {
         self.actions.len()
     }
 
-    fn words(&self) -> usize {
-        self.facts.atoms.len().div_ceil(64).max(1)
-    }
-
     fn encode(&self, state: &State) -> Bits {
-        let mut bits = vec![0; self.words()];
-        for a in state.iter() {
-            if let Some(&i) = self.facts.index.get(a) {
-                set(&mut bits, i, true);
-            }
-        }
-        bits
+        self.facts.encode(state)
     }
 
     fn successor(&self, a: &GroundAction, s: &Bits) -> Bits {

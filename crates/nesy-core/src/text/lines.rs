@@ -108,6 +108,10 @@ fn normalize_label(label: &str) -> String {
 /// header's inline content starts (after the colon and any closing emphasis).
 pub(crate) fn header(line: &Line<'_>, labels: &[&str]) -> Option<usize> {
     let (rest, stripped) = strip_decoration(line.text);
+    // Fast reject: formula lines are the bulk of long procedures.
+    if rest.is_empty() || rest.starts_with('(') || rest.starts_with(')') {
+        return None;
+    }
     let (label, after) = match rest.find(':') {
         Some(i) => (&rest[..i], Some(i + 1)),
         None => (rest, None),
