@@ -105,10 +105,6 @@ impl Sim {
         let mut q_from = self.q.clone();
         let mut pose_from: Iso = self.tool_pose();
         for wp in waypoints {
-            let q_to = self.ik(wp, &q_from, &full).ok_or(ApiError::IkFailed {
-                target: [wp.position.x, wp.position.y, wp.position.z],
-                pointing_to: pointing,
-            })?;
             let start = pose_from.translation.vector;
             let length = (wp.position - start).norm();
             let n = (length / SAMPLE_SPACING).ceil() as usize;
@@ -132,6 +128,14 @@ impl Sim {
                     }
                 }
             }
+            // The waypoint itself, seeded from the end of the line so the branch carries on.
+            let q_to = self
+                .ik(wp, &seed, &full)
+                .or_else(|| self.ik(wp, &q_from, &full))
+                .ok_or(ApiError::IkFailed {
+                    target: [wp.position.x, wp.position.y, wp.position.z],
+                    pointing_to: pointing,
+                })?;
             if !ok || max_delta(&seed, &q_to) > 0.3 {
                 path = vec![q_from.clone()];
             }

@@ -351,7 +351,8 @@ fn drawer_cabinet(colour: [f32; 3]) -> Vec<PartBuild> {
         cuboid([t, sy, sz], [-(sx - t) / 2.0, 0.0, sz / 2.0], colour),
         cuboid([t, sy, sz], [(sx - t) / 2.0, 0.0, sz / 2.0], colour),
         cuboid([sx - 2.0 * t, t, sz], [0.0, (sy - t) / 2.0, sz / 2.0], colour),
-        cuboid([sx - 2.0 * t, sy - t, t], [0.0, -t / 2.0, t / 2.0], colour),
+        // No bottom plate: the cabinet stands on the table and the bottom drawer slides just
+        // above it, so nothing catches the bottom edge of objects riding in the drawer.
         cuboid([sx - 2.0 * t, sy - t, t], [0.0, -t / 2.0, 0.097], colour),
         cuboid([sx - 2.0 * t, sy - t, t], [0.0, -t / 2.0, sz - t / 2.0], colour),
     ];

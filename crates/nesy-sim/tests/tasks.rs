@@ -405,3 +405,167 @@ fn unstack_onto_an_empty_floor_spot_finger() {
 fn unstack_onto_an_empty_floor_spot_vacuum() {
     unstack("pick_place_vacuum");
 }
+
+/// All four subtasks at the benchmark's composite offsets (pick_place at (0.35, 0.2), sweep at
+/// (0.35, −0.2), hinge at (0.65, 0.2), a reflected drawer cabinet at (0.65, −0.2)).
+fn composite(embodiment: nesy_sim::Embodiment) {
+    let text = std::fs::read_to_string(common::scene_path("composite_all_finger")).unwrap();
+    let mut spec = nesy_sim::SceneSpec::from_json_str(&text, "composite").unwrap();
+    spec.embodiment = embodiment;
+    let mut sim = Sim::new(&spec).unwrap();
+    let vacuum = embodiment == nesy_sim::Embodiment::Vacuum;
+    let hang = |sim: &mut Sim, obj: &str| {
+        let h = sim.get_obj_size(obj).unwrap()[2];
+        if vacuum { h } else { h / 2.0 }
+    };
+    // Cubes into the toy box, on a 2×2 grid.
+    let grid = [
+        [-0.03, -0.02],
+        [0.03, -0.02],
+        [-0.03, 0.02],
+        [0.03, 0.02],
+        [0.0, 0.0],
+    ];
+    for (k, cube) in [
+        "red_cube",
+        "blue_cube",
+        "yellow_cube",
+        "green_cube",
+        "purple_cube",
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let h = sim.get_obj_size(cube).unwrap()[2];
+        sim.move_gripper_to(cube, Direction::Down, h / 2.0).unwrap();
+        grasp(&mut sim);
+        let c = sim.get_obj_pos("toy_box").unwrap();
+        let top = sim.get_obj_bbox("toy_box").unwrap()[1][2];
+        let z = top + hang(&mut sim, cube) + 0.03 + if k == 4 { 0.03 } else { 0.0 };
+        sim.move_to_position(
+            [c[0] + grid[k][0], c[1] + grid[k][1], z],
+            Direction::Down,
+            0.12,
+            0.0,
+        )
+        .unwrap();
+        release(&mut sim);
+        expect(&sim, cube, &[&format!("(InsideOf {cube} toy_box)")], &[]);
+    }
+    // Sweep.
+    for (piece, target) in [
+        ("white_rook", "left_chess_box"),
+        ("black_knight", "right_chess_box"),
+        ("white_bishop", "left_chess_box"),
+    ] {
+        let h = sim.get_obj_size(piece).unwrap()[2];
+        sim.move_gripper_to(piece, Direction::Down, h / 1.3).unwrap();
+        if vacuum {
+            sim.activate_vacuum().unwrap();
+        }
+        let py = sim.get_obj_pos(piece).unwrap()[1];
+        let by = sim.get_obj_pos(target).unwrap()[1];
+        let dir = if py > by {
+            Direction::Left
+        } else {
+            Direction::Right
+        };
+        sim.move_parallel(dir, (py - by).abs() + 0.02, Direction::Down)
+            .unwrap();
+        if vacuum {
+            sim.deactivate_vacuum().unwrap();
+        }
+        sim.move_parallel(Direction::Up, 0.08, Direction::Down).unwrap();
+        expect(&sim, piece, &[&format!("(InsideOf {piece} {target})")], &[]);
+    }
+    // Fruits into the open hinge box, then close the lid.
+    // Spread along the body's long side: the fruits have flat bases and do not roll aside.
+    for (fruit, dy) in [("apple", -0.06), ("orange", 0.0), ("lemon", 0.06)] {
+        let h = sim.get_obj_size(fruit).unwrap()[2];
+        sim.move_gripper_to(fruit, Direction::Down, h / 2.0).unwrap();
+        grasp(&mut sim);
+        let body = sim.get_obj_pos("hinge_body").unwrap();
+        let top = sim.get_obj_bbox("hinge_body").unwrap()[1][2];
+        let z = top + hang(&mut sim, fruit) + 0.03;
+        sim.move_to_position([body[0], body[1] + dy, z], Direction::Down, 0.12, 0.0)
+            .unwrap();
+        release(&mut sim);
+        expect(&sim, fruit, &[&format!("(InsideOf {fruit} hinge_body)")], &[]);
+    }
+    grab_handle(&mut sim, "hinge_handle");
+    let body = sim.get_obj_pos("hinge_body").unwrap();
+    let size = sim.get_obj_size("hinge_body").unwrap();
+    sim.move_to_position(
+        [body[0] - 0.5 * size[0], body[1], body[2] + 0.5 * size[2]],
+        Direction::Down,
+        0.0,
+        0.0,
+    )
+    .unwrap();
+    let_go_handle(&mut sim);
+    expect(&sim, "close lid", &["(Closed hinge_lid)"], &[]);
+    // Cylinders from the cabinet top into the open bottom drawer (opening toward +y here).
+    for (cyl, dx) in [
+        ("red_cylinder", -0.035),
+        ("green_cylinder", 0.0),
+        ("blue_cylinder", 0.035),
+    ] {
+        let h = sim.get_obj_size(cyl).unwrap()[2];
+        sim.move_gripper_to(cyl, Direction::Down, h / 2.0).unwrap();
+        grasp(&mut sim);
+        let c = sim.get_obj_pos("bottom_drawer").unwrap();
+        let s = sim.get_obj_size("bottom_drawer").unwrap();
+        // High enough that the 20 cm wide hand clears the other cylinders on the cabinet top.
+        sim.move_to_position(
+            [c[0] + dx, c[1] + 0.01, c[2] + s[2] + h + 0.05],
+            Direction::Down,
+            0.12,
+            0.0,
+        )
+        .unwrap();
+        release(&mut sim);
+        expect(&sim, cyl, &[&format!("(InsideOf {cyl} bottom_drawer)")], &[]);
+    }
+    grab_handle(&mut sim, "bottom_drawer_handle");
+    let dy = sim.get_obj_size("bottom_drawer").unwrap()[1] * 0.85;
+    sim.move_parallel(Direction::Left, dy, Direction::Down).unwrap();
+    let_go_handle(&mut sim);
+    sim.step_idle(100);
+    let mut want: Vec<String> = [
+        "red_cube",
+        "blue_cube",
+        "yellow_cube",
+        "green_cube",
+        "purple_cube",
+    ]
+    .iter()
+    .map(|c| format!("(InsideOf {c} toy_box)"))
+    .collect();
+    want.extend(
+        ["apple", "orange", "lemon"]
+            .iter()
+            .map(|f| format!("(InsideOf {f} hinge_body)")),
+    );
+    want.extend(
+        ["red_cylinder", "green_cylinder", "blue_cylinder"]
+            .iter()
+            .map(|c| format!("(InsideOf {c} bottom_drawer)")),
+    );
+    want.extend([
+        "(Closed hinge_lid)".to_owned(),
+        "(Closed bottom_drawer)".to_owned(),
+    ]);
+    let want: Vec<&str> = want.iter().map(String::as_str).collect();
+    expect(&sim, "final", &want, &[]);
+    assert!(sim.trace().iter().all(|e| e.result.is_ok()));
+}
+
+#[test]
+fn all_four_subtasks_at_composite_offsets_finger() {
+    composite(nesy_sim::Embodiment::Finger);
+}
+
+#[test]
+fn all_four_subtasks_at_composite_offsets_vacuum() {
+    composite(nesy_sim::Embodiment::Vacuum);
+}
