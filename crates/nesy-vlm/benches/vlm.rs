@@ -1,11 +1,15 @@
 //! Benchmarks of the VLM client's hot paths.
 //!
-//! - `replay/two_384px_images`: one chat call answered from a cassette, with two 384×384
-//!   PNG keyframes: building the body (base64), canonicalising it (decoding and hashing the
-//!   images), the key lookup, and parsing the response. Target: under 1 ms.
+//! - `replay/*`: one chat call answered from a cassette, with two 384×384 PNG keyframes:
+//!   building the body (base64), canonicalising it (decoding and hashing both images on every
+//!   call), the key lookup, and parsing the response. Target: under 1 ms. `rendered` uses
+//!   two views rendered by nesy-sim (`benches/data/`, made with `nesy render --scene
+//!   fixtures/scenes/composite_all_finger.json --size 384`); `noisy` uses synthetic images
+//!   with per-pixel noise, a worst case about twenty times larger.
 //! - `overhead/*`: a chat call through the client against an in-process mock server, next
 //!   to a raw reqwest POST of the same body to the same server, for a text prompt and for
-//!   the two-image prompt. After the Criterion groups an interleaved run prints the ratio.
+//!   the rendered two-image prompt. After the Criterion groups an interleaved run prints the
+//!   ratio of medians.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -30,15 +34,29 @@ fn runtime() -> tokio::runtime::Runtime {
         .expect("runtime")
 }
 
-fn image_request() -> ChatRequest {
+/// The two rendered keyframes.
+fn rendered_views() -> (Vec<u8>, Vec<u8>) {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/data");
+    let read = |name: &str| std::fs::read(data.join(name)).expect("bench image");
+    (read("top.png"), read("front.png"))
+}
+
+/// Two synthetic 384×384 images with per-pixel noise (poorly compressible).
+fn noisy_views() -> (Vec<u8>, Vec<u8>) {
+    (common::png(384, 1), common::png(384, 2))
+}
+
+/// A request with two images, built from the bytes each time (nothing about the images is
+/// cached between calls).
+fn image_request(views: &(Vec<u8>, Vec<u8>)) -> ChatRequest {
     ChatRequest::new()
         .message(Message::system(
             "Translate the keyframes into the symbolic state.",
         ))
         .message(Message::user(vec![
             Part::text("Top view, then front view. List every predicate that holds."),
-            Image::png(common::png(384, 1)).expect("png").into(),
-            Image::png(common::png(384, 2)).expect("png").into(),
+            Image::png(views.0.clone()).expect("png").into(),
+            Image::png(views.1.clone()).expect("png").into(),
         ]))
         .purpose("bench")
 }
@@ -61,7 +79,8 @@ fn server_config(server: &MockServer) -> VlmConfig {
 }
 
 async fn mock_server() -> MockServer {
-    let server = MockServer::start().await;
+    // Recording would keep a copy of every request body for the whole run.
+    let server = MockServer::builder().disable_request_recording().start().await;
     let body = json!({
         "id": "chatcmpl-bench", "model": "gpt-5",
         "choices": [{"index": 0, "message": {"role": "assistant", "content": "(OnTopOf red_block tray)\n(Closed drawer)"},
@@ -77,43 +96,47 @@ async fn mock_server() -> MockServer {
 
 fn replay(c: &mut Criterion) {
     let rt = runtime();
-    let dir = tempfile::tempdir().expect("tempdir");
-    let path = dir.path().join("bench.json");
-    let request = image_request();
-    let cfg = rt.block_on(async {
-        let server = mock_server().await;
-        let mut cfg = server_config(&server);
-        cfg.cassette = Some(nesy_vlm::CassetteSettings {
-            path: path.clone(),
-            mode: CassetteMode::All,
-            strict: false,
-            usage_report: None,
-        });
-        VlmClient::from_config(&cfg)
-            .expect("client")
-            .chat(request.clone())
-            .await
-            .expect("record");
-        cfg.cassette = None;
-        cfg
-    });
-    let options = CassetteOptions {
-        allow_playback_repeats: true,
-        ..CassetteOptions::default()
-    };
-    let cassette: Arc<dyn Transport> =
-        Arc::new(CassetteTransport::open(&path, CassetteMode::None, None, options).expect("cassette"));
-    let client = VlmClient::with_transport(&cfg, cassette);
     let mut group = c.benchmark_group("replay");
-    group.bench_function("two_384px_images", |b| {
-        b.iter(|| {
-            rt.block_on(client.chat(std::hint::black_box(request.clone())))
-                .expect("replay")
-        })
-    });
-    group.bench_function("build_body_only", |b| {
-        b.iter(|| client.wire_request(std::hint::black_box(&request)))
-    });
+    for (name, views) in [("rendered", rendered_views()), ("noisy", noisy_views())] {
+        eprintln!("{name}: PNG sizes {} and {} bytes", views.0.len(), views.1.len());
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("bench.json");
+        let cfg = rt.block_on(async {
+            let server = mock_server().await;
+            let mut cfg = server_config(&server);
+            cfg.cassette = Some(nesy_vlm::CassetteSettings {
+                path: path.clone(),
+                mode: CassetteMode::All,
+                strict: false,
+                usage_report: None,
+            });
+            let client = VlmClient::from_config(&cfg).expect("client");
+            client.chat(image_request(&views)).await.expect("record");
+            cfg.cassette = None;
+            cfg
+        });
+        let options = CassetteOptions {
+            allow_playback_repeats: true,
+            ..CassetteOptions::default()
+        };
+        let cassette: Arc<dyn Transport> =
+            Arc::new(CassetteTransport::open(&path, CassetteMode::None, None, options).expect("cassette"));
+        let client = VlmClient::with_transport(&cfg, cassette);
+        group.bench_function(format!("{name}/two_384px_images"), |b| {
+            b.iter_batched(
+                || image_request(&views),
+                |request| rt.block_on(client.chat(request)).expect("replay"),
+                criterion::BatchSize::SmallInput,
+            )
+        });
+        group.bench_function(format!("{name}/build_body_only"), |b| {
+            b.iter_batched(
+                || image_request(&views),
+                |request| client.wire_request(&request),
+                criterion::BatchSize::SmallInput,
+            )
+        });
+    }
     group.finish();
 }
 
@@ -168,7 +191,10 @@ impl OverheadRig {
 fn overhead(c: &mut Criterion) {
     let rig = OverheadRig::new();
     let mut group = c.benchmark_group("overhead");
-    for (name, request) in [("text", text_request()), ("two_384px_images", image_request())] {
+    for (name, request) in [
+        ("text", text_request()),
+        ("two_384px_images", image_request(&rendered_views())),
+    ] {
         let body = serde_json::to_vec(&rig.client.wire_request(&request).body).expect("json");
         group.bench_function(format!("{name}/raw_reqwest"), |b| b.iter(|| rig.raw_call(&body)));
         group.bench_function(format!("{name}/client"), |b| b.iter(|| rig.client_call(&request)));
@@ -180,7 +206,10 @@ fn overhead(c: &mut Criterion) {
 /// and their ratio.
 fn overhead_ratio() {
     let rig = OverheadRig::new();
-    for (name, request) in [("text", text_request()), ("two_384px_images", image_request())] {
+    for (name, request) in [
+        ("text", text_request()),
+        ("two_384px_images", image_request(&rendered_views())),
+    ] {
         let body = serde_json::to_vec(&rig.client.wire_request(&request).body).expect("json");
         let (mut raw, mut client) = (Vec::new(), Vec::new());
         for round in 0..400 {

@@ -9,7 +9,7 @@ use tokio::time::Instant;
 use crate::accounting::{CallRecord, PriceTable, RunUsage};
 use crate::cassette::{CassetteMode, CassetteOptions, CassetteTransport};
 use crate::config::{ConfigError, VlmConfig};
-use crate::error::{ProviderError, VlmError};
+use crate::error::{ProviderError, TransportError, VlmError};
 use crate::profile::{AuthScheme, Profile};
 use crate::request::ChatRequest;
 use crate::response::{ChatResponse, parse_completion};
@@ -241,6 +241,8 @@ impl VlmClient {
                     };
                     return (Err(error), attempts, Some(response.origin));
                 }
+                // A cassette error (a replay miss) is the cassette's to explain, not the network's.
+                Err(TransportError::Cassette(err)) => return (Err(VlmError::Cassette(err)), attempts, None),
                 Err(err) => {
                     if can_retry && err.is_retryable() {
                         let delay = policy.delay(attempts, None);

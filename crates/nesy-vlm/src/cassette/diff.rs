@@ -66,6 +66,38 @@ fn walk(recorded: Option<&Value>, requested: Option<&Value>, pointer: &mut Strin
     }
 }
 
+/// How far apart two values are: the number of leaves that differ, where a replaced subtree
+/// counts all the leaves it holds (so a different message outweighs a changed word).
+pub(crate) fn json_distance(recorded: &Value, requested: &Value) -> usize {
+    fn leaves(value: Option<&Value>) -> usize {
+        match value {
+            None => 0,
+            Some(Value::Array(items)) => items.iter().map(|item| leaves(Some(item))).sum::<usize>().max(1),
+            Some(Value::Object(map)) => map.values().map(|item| leaves(Some(item))).sum::<usize>().max(1),
+            Some(_) => 1,
+        }
+    }
+    fn walk(a: Option<&Value>, b: Option<&Value>) -> usize {
+        match (a, b) {
+            (Some(Value::Object(x)), Some(Value::Object(y))) => {
+                x.iter()
+                    .map(|(key, item)| walk(Some(item), y.get(key)))
+                    .sum::<usize>()
+                    + y.iter()
+                        .filter(|(key, _)| !x.contains_key(*key))
+                        .map(|(_, item)| leaves(Some(item)))
+                        .sum::<usize>()
+            }
+            (Some(Value::Array(x)), Some(Value::Array(y))) => {
+                (0..x.len().max(y.len())).map(|i| walk(x.get(i), y.get(i))).sum()
+            }
+            (a, b) if a == b => 0,
+            (a, b) => leaves(a).max(leaves(b)),
+        }
+    }
+    walk(Some(recorded), Some(requested))
+}
+
 fn summarize(value: Option<&Value>) -> String {
     match value {
         None => "(absent)".to_string(),
@@ -285,6 +317,24 @@ mod tests {
         assert_eq!(diffs[0].requested, "(absent)");
         assert!(diffs[1].recorded.contains("red block") && diffs[1].requested.contains("blue block"));
         assert_eq!(diffs[2].recorded, "(absent)");
+    }
+
+    #[test]
+    fn distance_weighs_replaced_subtrees() {
+        let recorded = json!({"m": [{"t": "a"}, {"t": "b"}]});
+        assert_eq!(json_distance(&recorded, &recorded), 0);
+        assert_eq!(
+            json_distance(&recorded, &json!({"m": [{"t": "a"}, {"t": "c"}]})),
+            1
+        );
+        assert_eq!(json_distance(&recorded, &json!({"m": "flat"})), 2);
+        assert_eq!(
+            json_distance(
+                &recorded,
+                &json!({"m": [{"t": "a"}, {"t": "b"}], "x": {"y": 1, "z": 2}})
+            ),
+            2
+        );
     }
 
     #[test]

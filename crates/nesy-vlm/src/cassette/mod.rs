@@ -358,7 +358,9 @@ impl CassetteTransport {
                 diffs: json_diff(&r.body, &canonical.body),
             })
             .collect();
-        nearest.sort_by_key(|near| (near.path != request.path, near.diffs.len(), near.index));
+        let distance =
+            |near: &NearMatch| diff::json_distance(&self.recorded[near.index].body, &canonical.body);
+        nearest.sort_by_cached_key(|near| (near.path != request.path, distance(near), near.index));
         nearest.truncate(3);
         CassetteError::Miss(Box::new(CassetteMiss {
             cassette: self.path.clone(),
