@@ -1,0 +1,50 @@
+//! What a policy runs against: an [`Episode`] is a robot (the [`RobotApi`]) that can also
+//! finish the episode with the post-run settle and goal checks of spec §7.
+
+use std::path::PathBuf;
+
+use nesy_sim::api::{Embodiment, RobotApi};
+use serde::{Deserialize, Serialize};
+
+use crate::result::SubtaskResult;
+
+/// A robot a policy can drive, plus the end-of-episode goal checks.
+pub trait Episode: RobotApi + Send {
+    /// Called once after the policy ended (in any way but a kill): runs the post-run
+    /// settle steps (spec §7: 100 steps, then, if undecided, 100 more with the final check)
+    /// and returns the subtask results. `None` if this robot has no goal checks.
+    fn finish(&mut self) -> Option<Vec<SubtaskResult>>;
+}
+
+/// Which episode a worker should build. Sent from the parent to the worker process.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum EpisodeSpec {
+    /// A simulated scene loaded from a scene file.
+    Scene {
+        /// Path of the scene JSON.
+        path: PathBuf,
+        /// Overrides the scene's embodiment.
+        embodiment: Option<Embodiment>,
+        /// Render every N simulation steps (0 = never).
+        render_every: u32,
+    },
+    /// The recording test double of [`crate::testing`]: records calls, moves nothing.
+    /// For sandbox tests, which exercise the interpreter and the worker, not the robot.
+    RecordingDouble {
+        /// The double's embodiment.
+        embodiment: Embodiment,
+    },
+}
+
+/// Builds the [`Episode`] an [`EpisodeSpec`] names. The CLI supplies one that knows the
+/// simulator; the policy crate itself does not depend on simulator internals.
+pub trait EpisodeFactory {
+    /// Builds the episode, or explains why it cannot.
+    fn build(&self, spec: &EpisodeSpec) -> Result<Box<dyn Episode>, EpisodeBuildError>;
+}
+
+/// Why an episode could not be built.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error, Serialize, Deserialize)]
+#[error("cannot build the episode: {0}")]
+pub struct EpisodeBuildError(pub String);

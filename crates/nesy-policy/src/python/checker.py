@@ -1,0 +1,168 @@
+# nesy's static checks of a policy's source. Runs inside the embedded interpreter, before
+# the audit hook is armed, on the parsed AST; the policy's code is never executed here.
+import ast
+import string
+
+# Names the policy may not use at all (in addition to every name starting with "_").
+DENIED_NAMES = frozenset({
+    "exec", "eval", "compile", "open", "globals", "vars", "locals", "getattr", "setattr",
+    "delattr", "hasattr", "breakpoint", "input", "help", "dir", "id", "type", "memoryview",
+    "bytearray", "classmethod", "staticmethod", "exit", "quit", "copyright", "credits",
+    "license",
+})
+
+# Attributes that lead to frames, code objects or interpreter internals without an
+# underscore prefix.
+DENIED_ATTRIBUTES = frozenset({
+    "gi_frame", "gi_code", "gi_yieldfrom", "cr_frame", "cr_code", "cr_await", "ag_frame",
+    "ag_code", "ag_await", "tb_frame", "tb_next", "f_back", "f_globals", "f_locals",
+    "f_builtins", "f_code", "f_trace", "co_code", "co_consts", "func_globals", "format_map",
+    "mro",
+})
+
+ALLOWED_MODULES = frozenset({"math", "numpy", "robot"})
+
+
+class Checker(ast.NodeVisitor):
+    def __init__(self):
+        self.findings = []
+        self.module_aliases = {"robot", "np", "math", "numpy"}
+
+    def report(self, node, message):
+        self.findings.append((getattr(node, "lineno", 1), getattr(node, "col_offset", 0) + 1, message))
+
+    def check_identifier(self, node, name, what):
+        if name.startswith("_") and name != "_":
+            self.report(node, f"{what} {name!r} starts with an underscore")
+
+    def visit_Name(self, node):
+        # Reading __name__ (for the usual `if __name__ == "__main__":` guard) is harmless.
+        if not (node.id == "__name__" and isinstance(node.ctx, ast.Load)):
+            self.check_identifier(node, node.id, "name")
+        if node.id in DENIED_NAMES:
+            self.report(node, f"name {node.id!r} is not available in policies")
+        self.generic_visit(node)
+
+    def visit_Attribute(self, node):
+        if node.attr.startswith("_"):
+            self.report(node, f"attribute {node.attr!r} starts with an underscore")
+        elif node.attr in DENIED_ATTRIBUTES:
+            self.report(node, f"attribute {node.attr!r} is not available in policies")
+        elif node.attr == "format" and not self.is_safe_format(node.value):
+            self.report(node, "str.format is only allowed on a literal without attribute or index lookups in its fields")
+        if isinstance(node.ctx, (ast.Store, ast.Del)) and self.base_name(node) in self.module_aliases:
+            self.report(node, f"modules cannot be modified ({self.base_name(node)!r})")
+        self.generic_visit(node)
+
+    @staticmethod
+    def base_name(node):
+        while isinstance(node, (ast.Attribute, ast.Subscript)):
+            node = node.value
+        return node.id if isinstance(node, ast.Name) else None
+
+    @staticmethod
+    def is_safe_format(value):
+        if not (isinstance(value, ast.Constant) and isinstance(value.value, str)):
+            return False
+        try:
+            fields = list(string.Formatter().parse(value.value))
+        except ValueError:
+            return False
+        stack = list(fields)
+        while stack:
+            _literal, field, spec, _conv = stack.pop()
+            if field is not None and ("." in field or "[" in field):
+                return False
+            if spec:
+                try:
+                    stack.extend(string.Formatter().parse(spec))
+                except ValueError:
+                    return False
+        return True
+
+    def visit_arg(self, node):
+        self.check_identifier(node, node.arg, "parameter")
+        self.generic_visit(node)
+
+    def visit_keyword(self, node):
+        if node.arg is not None:
+            self.check_identifier(node, node.arg, "keyword argument")
+        self.generic_visit(node)
+
+    def visit_FunctionDef(self, node):
+        self.check_identifier(node, node.name, "function")
+        self.generic_visit(node)
+
+    def visit_ClassDef(self, node):
+        self.check_identifier(node, node.name, "class")
+        self.generic_visit(node)
+
+    def visit_AsyncFunctionDef(self, node):
+        self.report(node, "async functions are not available in policies")
+
+    def visit_Await(self, node):
+        self.report(node, "await is not available in policies")
+
+    def visit_AsyncFor(self, node):
+        self.report(node, "async for is not available in policies")
+
+    def visit_AsyncWith(self, node):
+        self.report(node, "async with is not available in policies")
+
+    def visit_Global(self, node):
+        for name in node.names:
+            self.check_identifier(node, name, "name")
+
+    def visit_Nonlocal(self, node):
+        for name in node.names:
+            self.check_identifier(node, name, "name")
+
+    def visit_Import(self, node):
+        for alias in node.names:
+            top = alias.name.split(".")[0]
+            if alias.name not in ALLOWED_MODULES:
+                self.report(node, f"import of {alias.name!r} is not allowed (allowed: {', '.join(sorted(ALLOWED_MODULES))})")
+            if alias.asname:
+                self.check_identifier(node, alias.asname, "alias")
+            self.module_aliases.add(alias.asname or top)
+
+    def visit_ImportFrom(self, node):
+        if node.level or node.module not in ALLOWED_MODULES:
+            name = "." * node.level + (node.module or "")
+            self.report(node, f"import from {name!r} is not allowed (allowed: {', '.join(sorted(ALLOWED_MODULES))})")
+        for alias in node.names:
+            self.check_identifier(node, alias.name, "imported name")
+            if alias.asname:
+                self.check_identifier(node, alias.asname, "alias")
+
+    def visit_MatchAs(self, node):
+        if node.name:
+            self.check_identifier(node, node.name, "name")
+        self.generic_visit(node)
+
+    def visit_MatchStar(self, node):
+        if node.name:
+            self.check_identifier(node, node.name, "name")
+
+    def visit_MatchMapping(self, node):
+        if node.rest:
+            self.check_identifier(node, node.rest, "name")
+        self.generic_visit(node)
+
+    def visit_ExceptHandler(self, node):
+        if node.name:
+            self.check_identifier(node, node.name, "name")
+        self.generic_visit(node)
+
+
+def check(source):
+    """Returns a list of (line, column, message); empty if the source may run."""
+    try:
+        tree = ast.parse(source, filename="policy.py", mode="exec")
+    except SyntaxError as err:
+        return [(err.lineno or 1, err.offset or 1, f"syntax error: {err.msg}")]
+    except ValueError as err:
+        return [(1, 1, f"invalid source: {err}")]
+    checker = Checker()
+    checker.visit(tree)
+    return sorted(checker.findings)

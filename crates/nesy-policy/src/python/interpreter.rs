@@ -1,0 +1,228 @@
+//! Starting the embedded interpreter: the audit hook and the `robot` module are registered
+//! first, then CPython starts from an isolated `PyConfig` (no environment variables, no
+//! site-packages, no user directory, no signal handlers). In static builds the standard
+//! library comes from a zip embedded in the binary and served from a memfd.
+//!
+//! After start-up nesy imports everything a policy may ever need (the allowlisted modules,
+//! the static checker and its `ast` dependencies), so the armed audit hook can refuse every
+//! later import.
+
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use pyo3::ffi;
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyModule};
+
+use super::robot_module::robot;
+use super::{audit, budget, builtins, robot_module};
+
+/// Why the interpreter could not start.
+#[derive(Clone, Debug, thiserror::Error)]
+pub enum InitError {
+    /// `Py_InitializeFromConfig` failed.
+    #[error("embedded Python failed to start: {0}")]
+    Startup(String),
+    /// Importing the modules policies need failed.
+    #[error("embedded Python could not prepare the policy runtime: {0}")]
+    Prepare(String),
+    /// The embedded standard library could not be served.
+    #[error("cannot serve the embedded standard library: {0}")]
+    Stdlib(String),
+}
+
+const CHECKER_SOURCE: &str = include_str!("checker.py");
+const NUMPY_SHIM_SOURCE: &str = include_str!("numpy_shim.py");
+
+/// The stdlib zip, only in static builds (`--features embedded-stdlib`, with
+/// `NESY_STDLIB_ZIP` pointing at the zip when compiling).
+#[cfg(feature = "embedded-stdlib")]
+const EMBEDDED_STDLIB: Option<&[u8]> = Some(include_bytes!(env!("NESY_STDLIB_ZIP")));
+#[cfg(not(feature = "embedded-stdlib"))]
+const EMBEDDED_STDLIB: Option<&[u8]> = None;
+
+static STARTED: OnceLock<Result<Duration, InitError>> = OnceLock::new();
+
+/// Starts the interpreter once per process and returns how long start-up took (including
+/// the preparation imports).
+pub fn initialize() -> Result<Duration, InitError> {
+    STARTED
+        .get_or_init(|| {
+            let t0 = Instant::now();
+            // SAFETY: runs once, before anything else touches the interpreter.
+            unsafe { start()? };
+            Python::attach(|py| prepared(py).map(|_| ()))?;
+            Ok(t0.elapsed())
+        })
+        .clone()
+}
+
+/// True if the binary carries its own standard library.
+pub fn has_embedded_stdlib() -> bool {
+    EMBEDDED_STDLIB.is_some()
+}
+
+fn wide(s: &str) -> Vec<libc::wchar_t> {
+    s.chars()
+        .map(|c| c as libc::wchar_t)
+        .chain(std::iter::once(0))
+        .collect()
+}
+
+unsafe fn check(status: ffi::PyStatus, what: &str) -> Result<(), InitError> {
+    // SAFETY: `status` came from a PyConfig call.
+    if unsafe { ffi::PyStatus_Exception(status) } == 0 {
+        return Ok(());
+    }
+    let message = if status.err_msg.is_null() {
+        "unknown error".to_owned()
+    } else {
+        // SAFETY: CPython sets a static NUL-terminated message.
+        unsafe { std::ffi::CStr::from_ptr(status.err_msg) }
+            .to_string_lossy()
+            .into_owned()
+    };
+    Err(InitError::Startup(format!("{what}: {message}")))
+}
+
+/// Writes the embedded zip to a sealed memfd and returns its `/proc/self/fd/N` path.
+fn serve_stdlib(zip: &[u8]) -> Result<String, InitError> {
+    // SAFETY: plain syscalls on a fresh descriptor.
+    unsafe {
+        let fd = libc::memfd_create(c"nesy-stdlib".as_ptr(), libc::MFD_ALLOW_SEALING);
+        if fd < 0 {
+            return Err(InitError::Stdlib(format!(
+                "memfd_create: {}",
+                std::io::Error::last_os_error()
+            )));
+        }
+        let mut written = 0;
+        while written < zip.len() {
+            let n = libc::write(fd, zip[written..].as_ptr().cast(), zip.len() - written);
+            if n <= 0 {
+                return Err(InitError::Stdlib(format!(
+                    "write: {}",
+                    std::io::Error::last_os_error()
+                )));
+            }
+            written += n as usize;
+        }
+        libc::fcntl(
+            fd,
+            libc::F_ADD_SEALS,
+            libc::F_SEAL_WRITE | libc::F_SEAL_GROW | libc::F_SEAL_SHRINK | libc::F_SEAL_SEAL,
+        );
+        Ok(format!("/proc/self/fd/{fd}"))
+    }
+}
+
+unsafe fn start() -> Result<(), InitError> {
+    audit::install();
+    pyo3::append_to_inittab!(robot);
+    let stdlib_path = EMBEDDED_STDLIB.map(serve_stdlib).transpose()?;
+    // SAFETY: PyConfig is plain data initialised by PyConfig_InitIsolatedConfig; it is
+    // cleared before returning.
+    unsafe {
+        let mut config = std::mem::MaybeUninit::<ffi::PyConfig>::zeroed();
+        ffi::PyConfig_InitIsolatedConfig(config.as_mut_ptr());
+        let config = config.assume_init_mut();
+        config.site_import = 0;
+        config.write_bytecode = 0;
+        config.install_signal_handlers = 0;
+        config.user_site_directory = 0;
+        config.parse_argv = 0;
+        config.pathconfig_warnings = 0;
+        config.faulthandler = 0;
+        let result = (|| {
+            if let Some(path) = &stdlib_path {
+                let path = wide(path);
+                check(
+                    ffi::PyWideStringList_Append(&mut config.module_search_paths, path.as_ptr()),
+                    "search path",
+                )?;
+                config.module_search_paths_set = 1;
+                let home = wide("/nonexistent");
+                check(
+                    ffi::PyConfig_SetString(config, &mut config.home, home.as_ptr()),
+                    "home",
+                )?;
+            }
+            check(ffi::Py_InitializeFromConfig(config), "Py_InitializeFromConfig")
+        })();
+        ffi::PyConfig_Clear(config);
+        result?;
+        ffi::PyEval_SaveThread();
+    }
+    Ok(())
+}
+
+/// Objects prepared once after start-up.
+pub(crate) struct Prepared {
+    pub checker: Py<PyAny>,
+    pub robot: Py<PyModule>,
+    pub numpy: Py<PyModule>,
+    /// `name -> function` of the robot API, injected into every policy's globals.
+    pub api: Vec<(&'static str, Py<PyAny>)>,
+    /// `None` compiled in eval mode: evaluated to consume queued asynchronous exceptions.
+    pub noop: Py<PyAny>,
+}
+
+static PREPARED: PyOnceLock<Result<Prepared, InitError>> = PyOnceLock::new();
+
+/// The prepared runtime objects (created on first use).
+pub(crate) fn prepared(py: Python<'_>) -> Result<&Prepared, InitError> {
+    PREPARED
+        .get_or_init(py, || prepare(py).map_err(|e| InitError::Prepare(e.to_string())))
+        .as_ref()
+        .map_err(Clone::clone)
+}
+
+fn prepare(py: Python<'_>) -> PyResult<Prepared> {
+    let robot = py.import("robot")?;
+    let math = py.import("math")?;
+    builtins::register_module(py, "robot", robot.as_any())?;
+    builtins::register_module(py, "math", math.as_any())?;
+    // The checker runs with the real builtins: it is nesy's code and never sees the policy run.
+    let checker_module = PyModule::from_code(
+        py,
+        &std::ffi::CString::new(CHECKER_SOURCE)?,
+        c"<nesy-checker>",
+        c"nesy_checker",
+    )?;
+    let checker = checker_module.getattr("check")?.unbind();
+    // The numpy subset runs with the policy's curated builtins.
+    let numpy = PyModule::new(py, "numpy")?;
+    let globals: Bound<'_, PyDict> = numpy.dict();
+    globals.set_item("__builtins__", builtins::curated(py)?)?;
+    let code =
+        py.import("builtins")?
+            .getattr("compile")?
+            .call1((NUMPY_SHIM_SOURCE, "<numpy-subset>", "exec"))?;
+    // SAFETY: GIL held; `code` is a code object and `globals` a dict.
+    let ran = unsafe { ffi::PyEval_EvalCode(code.as_ptr(), globals.as_ptr(), globals.as_ptr()) };
+    if ran.is_null() {
+        return Err(PyErr::fetch(py));
+    }
+    // SAFETY: `ran` is a new reference we own.
+    unsafe { ffi::Py_DECREF(ran) };
+    builtins::register_module(py, "numpy", numpy.as_any())?;
+    robot_module::set_array_constructor(py, numpy.getattr("array")?.unbind());
+    budget::set_violation_type(py.get_type::<robot_module::SandboxViolation>().as_ptr());
+    let mut api = Vec::with_capacity(robot_module::SIGNATURES.len());
+    for sig in robot_module::SIGNATURES {
+        api.push((sig.name, robot.getattr(sig.name)?.unbind()));
+    }
+    let noop = py
+        .import("builtins")?
+        .getattr("compile")?
+        .call1(("None", "<nesy-noop>", "eval"))?
+        .unbind();
+    Ok(Prepared {
+        checker,
+        robot: robot.unbind(),
+        numpy: numpy.unbind(),
+        api,
+        noop,
+    })
+}

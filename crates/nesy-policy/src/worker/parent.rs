@@ -1,0 +1,313 @@
+//! The parent side: spawn the worker, feed it the request, collect its messages and its raw
+//! output, and kill it when the wall clock runs out.
+
+use std::ffi::OsString;
+use std::fs::File;
+use std::io::{BufRead, BufReader, Read, Write};
+use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
+use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use super::protocol::{RESULT_FD, WorkerMessage, WorkerRequest};
+use crate::episode::EpisodeSpec;
+use crate::limits::Limits;
+use crate::result::{CapturedText, ExecutionResult, Outcome, TimeLimit, WorkerReport};
+
+/// How to start a worker process.
+#[derive(Clone, Debug)]
+pub struct WorkerCommand {
+    /// The executable (normally the running `nesy` binary).
+    pub program: PathBuf,
+    /// Arguments selecting the hidden worker subcommand.
+    pub args: Vec<OsString>,
+}
+
+/// Name of the hidden worker subcommand of `nesy`.
+pub const WORKER_SUBCOMMAND: &str = "policy-worker";
+
+impl WorkerCommand {
+    /// The running executable, re-executed as `<exe> policy-worker`.
+    pub fn current_exe() -> std::io::Result<WorkerCommand> {
+        Ok(WorkerCommand::nesy_binary(std::env::current_exe()?))
+    }
+
+    /// A given `nesy` binary, e.g. `env!("CARGO_BIN_EXE_nesy")` in tests.
+    pub fn nesy_binary(path: impl Into<PathBuf>) -> WorkerCommand {
+        WorkerCommand {
+            program: path.into(),
+            args: vec![WORKER_SUBCOMMAND.into()],
+        }
+    }
+}
+
+/// Why a policy could not be run at all (as opposed to running and failing).
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The worker process could not be started.
+    #[error("cannot start the policy worker {program}: {source}")]
+    Spawn {
+        /// The executable.
+        program: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The worker reported that it could not set up the episode.
+    #[error("the policy worker could not set up the episode: {0}")]
+    Setup(String),
+    /// An OS call in the parent failed.
+    #[error("policy worker plumbing failed: {0}")]
+    Io(#[from] std::io::Error),
+}
+
+const RAW_OUTPUT_CAP: usize = 16 * 1024;
+
+fn nonce() -> String {
+    let mut bytes = [0u8; 16];
+    // SAFETY: getrandom fills the buffer it is given.
+    let n = unsafe { libc::getrandom(bytes.as_mut_ptr().cast(), bytes.len(), 0) };
+    if n != bytes.len() as isize {
+        // Fall back to time and pid; the nonce only has to be unknown to the policy.
+        let t = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap_or_default();
+        bytes[..8].copy_from_slice(&(t.as_nanos() as u64).to_le_bytes());
+        bytes[8..12].copy_from_slice(&std::process::id().to_le_bytes());
+    }
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+fn pipe() -> std::io::Result<(OwnedFd, OwnedFd)> {
+    let mut fds = [0; 2];
+    // SAFETY: pipe2 writes two descriptors into the array.
+    if unsafe { libc::pipe2(fds.as_mut_ptr(), libc::O_CLOEXEC) } != 0 {
+        return Err(std::io::Error::last_os_error());
+    }
+    // SAFETY: both descriptors are fresh and owned by us.
+    Ok(unsafe { (OwnedFd::from_raw_fd(fds[0]), OwnedFd::from_raw_fd(fds[1])) })
+}
+
+fn drain_capped(mut reader: impl Read + Send + 'static) -> std::thread::JoinHandle<CapturedText> {
+    std::thread::spawn(move || {
+        let mut captured = CapturedText::default();
+        let mut buf = [0u8; 8192];
+        loop {
+            match reader.read(&mut buf) {
+                Ok(0) | Err(_) => break,
+                Ok(n) => captured.push_capped(&String::from_utf8_lossy(&buf[..n]), RAW_OUTPUT_CAP),
+            }
+        }
+        captured
+    })
+}
+
+/// Runs `source` against the episode `spec` in a fresh worker process under `limits`.
+///
+/// Every way the policy can end is an `Ok(ExecutionResult)` (see [`Outcome`]); `Err` means
+/// the episode could not be set up (bad scene, worker missing).
+pub fn run_policy(
+    worker: &WorkerCommand,
+    source: &str,
+    spec: &EpisodeSpec,
+    limits: &Limits,
+) -> Result<ExecutionResult, RunError> {
+    let started = Instant::now();
+    let nonce = nonce();
+    let request = WorkerRequest {
+        nonce: nonce.clone(),
+        source: source.to_owned(),
+        episode: spec.clone(),
+        limits: limits.clone(),
+    };
+    let (read_end, write_end) = pipe()?;
+    let write_raw = write_end.as_raw_fd();
+    let parent_pid = std::process::id() as libc::pid_t;
+    let mut command = Command::new(&worker.program);
+    command
+        .args(&worker.args)
+        .env_clear()
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    // SAFETY: only async-signal-safe calls between fork and exec.
+    unsafe {
+        command.pre_exec(move || {
+            if libc::dup2(write_raw, RESULT_FD) < 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            libc::setpgid(0, 0);
+            libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL, 0, 0, 0);
+            if libc::getppid() != parent_pid {
+                libc::_exit(1);
+            }
+            Ok(())
+        });
+    }
+    let mut child = command.spawn().map_err(|source| RunError::Spawn {
+        program: worker.program.clone(),
+        source,
+    })?;
+    drop(write_end);
+
+    let stdout = drain_capped(child.stdout.take().expect("piped"));
+    let stderr = drain_capped(child.stderr.take().expect("piped"));
+    let mut stdin = child.stdin.take().expect("piped");
+    let body = serde_json::to_vec(&request).map_err(std::io::Error::other)?;
+    let writer = std::thread::spawn(move || {
+        let _ = stdin.write_all(&body);
+    });
+
+    let (tx, rx) = mpsc::channel::<WorkerMessage>();
+    let reader_nonce = nonce.clone();
+    let reader = std::thread::spawn(move || {
+        let mut forged = 0usize;
+        for line in BufReader::new(File::from(read_end)).lines() {
+            let Ok(line) = line else { break };
+            match serde_json::from_str::<WorkerMessage>(&line) {
+                Ok(message) if message.nonce() == reader_nonce => {
+                    if tx.send(message).is_err() {
+                        break;
+                    }
+                }
+                _ => forged += 1,
+            }
+        }
+        forged
+    });
+
+    let kill_at = started + Duration::from_millis(limits.wall_time_ms + limits.kill_grace_ms);
+    let mut trace = Vec::new();
+    let mut startup_s = None;
+    let mut final_result = None;
+    let mut setup_error = None;
+    let mut killed_by_parent = false;
+    loop {
+        let now = Instant::now();
+        if now >= kill_at {
+            kill_group(&mut child);
+            killed_by_parent = true;
+            break;
+        }
+        match rx.recv_timeout(kill_at - now) {
+            Ok(WorkerMessage::Ready { startup_s: s, .. }) => startup_s = Some(s),
+            Ok(WorkerMessage::Trace { entry, .. }) => trace.push(entry),
+            Ok(WorkerMessage::Result { result, .. }) => {
+                final_result = Some(*result);
+                break;
+            }
+            Ok(WorkerMessage::Error { message, .. }) => {
+                setup_error = Some(message);
+                break;
+            }
+            Err(mpsc::RecvTimeoutError::Timeout) => continue,
+            Err(mpsc::RecvTimeoutError::Disconnected) => break,
+        }
+    }
+    let status = wait_until(&mut child, kill_at.max(Instant::now()) + Duration::from_secs(2))?;
+    let _ = writer.join();
+    let _ = reader.join();
+    let raw_output = {
+        let mut text = stdout.join().unwrap_or_default();
+        let err = stderr.join().unwrap_or_default();
+        text.push_capped(&err.text, RAW_OUTPUT_CAP);
+        text.truncated_bytes += err.truncated_bytes;
+        text
+    };
+    let report = WorkerReport {
+        exit_code: status.code(),
+        signal: status.signal(),
+        raw_output,
+        startup_s,
+    };
+    if let Some(message) = setup_error {
+        return Err(RunError::Setup(message));
+    }
+    let wall_time_s = started.elapsed().as_secs_f64();
+    if let Some(mut result) = final_result {
+        result.wall_time_s = wall_time_s;
+        result.worker = Some(report);
+        return Ok(result);
+    }
+    let outcome = if killed_by_parent {
+        Outcome::Timeout {
+            limit: TimeLimit::ParentKill,
+            error: None,
+        }
+    } else {
+        died(&report)
+    };
+    Ok(ExecutionResult {
+        outcome,
+        trace,
+        stdout: CapturedText::default(),
+        stderr: CapturedText::default(),
+        wall_time_s,
+        subtasks: None,
+        worker: Some(report),
+    })
+}
+
+/// Classifies a worker that ended without a result.
+fn died(report: &WorkerReport) -> Outcome {
+    let out_of_memory = report.raw_output.text.contains("memory allocation of")
+        || report.raw_output.text.contains("MemoryError")
+        || report.raw_output.text.contains("Cannot allocate memory");
+    match report.signal {
+        Some(libc::SIGXCPU) => Outcome::Timeout {
+            limit: TimeLimit::CpuTime,
+            error: None,
+        },
+        Some(libc::SIGABRT) if out_of_memory => Outcome::Memory { error: None },
+        Some(signal) => Outcome::Killed {
+            reason: format!("worker killed by signal {} ({signal})", signal_name(signal)),
+        },
+        None if out_of_memory => Outcome::Memory { error: None },
+        None => Outcome::Killed {
+            reason: format!(
+                "worker exited with status {} without reporting a result",
+                report
+                    .exit_code
+                    .map(|c| c.to_string())
+                    .unwrap_or_else(|| "?".into())
+            ),
+        },
+    }
+}
+
+fn signal_name(signal: i32) -> &'static str {
+    match signal {
+        libc::SIGKILL => "SIGKILL",
+        libc::SIGSEGV => "SIGSEGV",
+        libc::SIGABRT => "SIGABRT",
+        libc::SIGXFSZ => "SIGXFSZ",
+        libc::SIGSYS => "SIGSYS",
+        libc::SIGBUS => "SIGBUS",
+        libc::SIGTERM => "SIGTERM",
+        libc::SIGPIPE => "SIGPIPE",
+        _ => "signal",
+    }
+}
+
+fn kill_group(child: &mut Child) {
+    let pid = child.id() as libc::pid_t;
+    // SAFETY: signalling the worker's own process group (it called setpgid(0, 0)).
+    unsafe {
+        libc::kill(-pid, libc::SIGKILL);
+    }
+    let _ = child.kill();
+}
+
+fn wait_until(child: &mut Child, deadline: Instant) -> std::io::Result<std::process::ExitStatus> {
+    loop {
+        if let Some(status) = child.try_wait()? {
+            return Ok(status);
+        }
+        if Instant::now() >= deadline {
+            kill_group(child);
+            return child.wait();
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+}
