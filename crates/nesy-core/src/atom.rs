@@ -1,15 +1,15 @@
 //! Ground atoms such as `(OnTopOf red_cube floor)` or `(GripperOpen)`.
 //!
 //! Atoms are hash-consed: every distinct `(predicate, arguments)` pair is stored once in a
-//! process-wide table and an [`Atom`] is its dense id plus a pointer to that entry. Atoms
-//! are therefore `Copy`, compare and hash by the id without touching memory, and a
-//! [`crate::State`] of two hundred atoms clones with one `memcpy`. The table only grows; its size is bounded by
-//! the number of distinct atoms a process ever builds.
+//! process-wide table and an [`Atom`] is just its dense `u32` id. Atoms are therefore
+//! `Copy`, four bytes wide, compare and hash without touching memory, and a
+//! [`crate::State`] of two hundred atoms clones with one 800-byte `memcpy`. The predicate
+//! and arguments are found through a lock-free, append-only slot table. The table only
+//! grows; its size is bounded by the number of distinct atoms a process ever builds.
 
 use std::fmt;
-use std::hash::{Hash, Hasher};
 use std::str::FromStr;
-use std::sync::{LazyLock, RwLock};
+use std::sync::{LazyLock, OnceLock, RwLock};
 
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
@@ -23,51 +23,64 @@ pub type Args = SmallVec<[Symbol; 3]>;
 /// The interned data behind an atom.
 #[derive(Debug)]
 struct AtomData {
-    id: u32,
     pred: Symbol,
     args: Args,
 }
 
 type AtomKey = (Symbol, Args);
 
-static ATOMS: LazyLock<RwLock<FxHashMap<AtomKey, &'static AtomData>>> =
-    LazyLock::new(|| RwLock::new(FxHashMap::default()));
+/// Key → id; taken for writing only when a new atom is created.
+static ATOMS: LazyLock<RwLock<FxHashMap<AtomKey, u32>>> = LazyLock::new(|| RwLock::new(FxHashMap::default()));
 
-fn intern(pred: Symbol, args: Args) -> &'static AtomData {
+/// Id → data, in segments of doubling size (segment k holds `64 << k` slots), so that
+/// reading never takes a lock and no slot ever moves.
+const SEGMENTS: usize = 27;
+type Segment = Box<[OnceLock<&'static AtomData>]>;
+static SLOTS: [OnceLock<Segment>; SEGMENTS] = [const { OnceLock::new() }; SEGMENTS];
+
+/// Segment and offset of an id.
+fn locate(id: u32) -> (usize, usize) {
+    let n = u64::from(id) / 64 + 1;
+    let k = 63 - n.leading_zeros() as usize;
+    let start = 64 * ((1u64 << k) - 1);
+    (k, (u64::from(id) - start) as usize)
+}
+
+fn intern(pred: Symbol, args: Args) -> u32 {
     let key = (pred, args);
-    if let Some(found) = ATOMS.read().unwrap_or_else(|e| e.into_inner()).get(&key) {
-        return found;
+    if let Some(&id) = ATOMS.read().unwrap_or_else(|e| e.into_inner()).get(&key) {
+        return id;
     }
     let mut table = ATOMS.write().unwrap_or_else(|e| e.into_inner());
-    if let Some(found) = table.get(&key) {
-        return found;
+    if let Some(&id) = table.get(&key) {
+        return id;
     }
     let id = u32::try_from(table.len()).expect("more than 2^32 distinct atoms");
     // Leaked on purpose: the table lives for the whole process and hands out `'static`
-    // references, which is what makes `Atom` a plain pointer.
+    // references.
     let data: &'static AtomData = Box::leak(Box::new(AtomData {
-        id,
         pred: key.0,
         args: key.1.clone(),
     }));
-    table.insert(key, data);
-    data
+    let (k, offset) = locate(id);
+    let segment = SLOTS[k].get_or_init(|| (0..(64usize << k)).map(|_| OnceLock::new()).collect());
+    // Ids are handed out once, under the write lock, so the slot is still empty.
+    let _ = segment[offset].set(data);
+    table.insert(key, id);
+    id
 }
 
 /// A ground atom: a predicate applied to object constants.
 ///
 /// `Ord` is by interned id (fast, deterministic for a given interning order); printing code
 /// sorts by text where humans read the result.
-#[derive(Clone, Copy)]
-pub struct Atom {
-    id: u32,
-    data: &'static AtomData,
-}
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Atom(u32);
 
 impl Atom {
     /// Builds an atom from a predicate name and argument names, interning them.
     pub fn new(pred: &str, args: &[&str]) -> Self {
-        Atom::from_data(intern(
+        Atom(intern(
             Symbol::new(pred),
             args.iter().map(|a| Symbol::new(a)).collect(),
         ))
@@ -75,62 +88,40 @@ impl Atom {
 
     /// Builds an atom from already interned symbols.
     pub fn from_symbols(pred: Symbol, args: impl IntoIterator<Item = Symbol>) -> Self {
-        Atom::from_data(intern(pred, args.into_iter().collect()))
+        Atom(intern(pred, args.into_iter().collect()))
     }
 
-    fn from_data(data: &'static AtomData) -> Self {
-        Atom { id: data.id, data }
+    fn data(self) -> &'static AtomData {
+        let (k, offset) = locate(self.0);
+        SLOTS[k]
+            .get()
+            .and_then(|segment| segment[offset].get().copied())
+            .expect("an Atom's id always comes from the table, which filled its slot first")
     }
 
     /// The predicate.
     pub fn pred(&self) -> Symbol {
-        self.data.pred
+        self.data().pred
     }
 
     /// The arguments, in order.
     pub fn args(&self) -> &[Symbol] {
-        &self.data.args
+        &self.data().args
     }
 
     /// Number of arguments.
     pub fn arity(&self) -> usize {
-        self.data.args.len()
+        self.data().args.len()
     }
 
     /// True if any argument is `object`.
     pub fn mentions(&self, object: Symbol) -> bool {
-        self.data.args.contains(&object)
+        self.data().args.contains(&object)
     }
 
     /// The dense interned id (stable for the life of the process).
     pub fn id(&self) -> u32 {
-        self.id
-    }
-}
-
-impl PartialEq for Atom {
-    fn eq(&self, other: &Self) -> bool {
-        self.id == other.id
-    }
-}
-
-impl Eq for Atom {}
-
-impl Hash for Atom {
-    fn hash<H: Hasher>(&self, state: &mut H) {
-        self.id.hash(state);
-    }
-}
-
-impl PartialOrd for Atom {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Atom {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.id.cmp(&other.id)
+        self.0
     }
 }
 
@@ -237,6 +228,21 @@ mod tests {
         }
         let spaced: Atom = "  ( InsideOf  apple   hinge_body )".parse().unwrap();
         assert_eq!(spaced, Atom::new("InsideOf", &["apple", "hinge_body"]));
+    }
+
+    #[test]
+    fn slot_layout_covers_ids_without_gaps() {
+        let (mut segment, mut offset) = (0, 0);
+        for id in 0..100_000u32 {
+            assert_eq!(locate(id), (segment, offset), "id {id}");
+            offset += 1;
+            if offset == 64 << segment {
+                segment += 1;
+                offset = 0;
+            }
+        }
+        let (k, offset) = locate(u32::MAX);
+        assert!(k < SEGMENTS && offset < 64 << k);
     }
 
     #[test]

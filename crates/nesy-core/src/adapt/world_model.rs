@@ -10,6 +10,7 @@ use crate::exec::{ExecError, apply_in, format_unmet, implicit_universe};
 use crate::formula::Formula;
 use crate::operator::Operator;
 use crate::state::State;
+use crate::symbol::Symbol;
 use crate::text::parse_induction_reply;
 
 /// The verified symbolic world model W of a demonstration.
@@ -33,16 +34,18 @@ impl WorldModel {
 }
 
 /// Checks an induced operator against its transition: preconditions in `prev`, and the
-/// successor against `next` under `check`. Returns the problem if it fails.
+/// successor against `next` under `check`. Quantifiers range over `objects` (the scene's
+/// objects) plus every object the states and the operator mention, all typed `thing`.
+/// Returns the problem if it fails.
 pub fn check_transition(
     prev: &State,
     next: &State,
     op: &Operator,
+    objects: &[Symbol],
     check: TransitionCheck,
 ) -> Result<(), Problem> {
-    let universe = implicit_universe(prev, std::slice::from_ref(op), None);
-    let mut universe = universe;
-    for o in next.objects() {
+    let mut universe = implicit_universe(prev, std::slice::from_ref(op), None);
+    for o in next.objects().into_iter().chain(objects.iter().copied()) {
         universe.add_thing(o);
     }
     let produced = match apply_in(&universe, prev, op) {
@@ -150,7 +153,14 @@ pub async fn construct_world_model<R: Reasoner>(
             let problem = match &parsed {
                 Err(error) => Some(Problem::Unparsable { error: error.clone() }),
                 Ok(_) if !config.ablation.world_model => None,
-                Ok(r) => check_transition(prev, next, &r.operator, config.transition_check).err(),
+                Ok(r) => check_transition(
+                    prev,
+                    next,
+                    &r.operator,
+                    &demo.task.objects,
+                    config.transition_check,
+                )
+                .err(),
             };
             let verdict = match &problem {
                 None => Verdict::Accepted {
