@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{VlmError, truncate_chars};
+use crate::error::{ProviderError, VlmError, truncate_chars};
 use crate::transport::Origin;
 
 /// Token usage of one call. Reasoning tokens are part of `completion_tokens` (as OpenAI
@@ -83,6 +83,7 @@ struct WireCompletion {
     #[serde(default)]
     choices: Vec<WireChoice>,
     usage: Option<WireUsage>,
+    error: Option<serde_json::Value>,
 }
 
 #[derive(Deserialize)]
@@ -151,11 +152,14 @@ pub(crate) fn parse_completion(
             err.column()
         ))
     })?;
-    let choice = wire
-        .choices
-        .into_iter()
-        .next()
-        .ok_or_else(|| invalid("no `choices[0]` in the response".to_string()))?;
+    let choice = wire.choices.into_iter().next().ok_or_else(|| match &wire.error {
+        // Some proxies wrap a provider error in a 200.
+        Some(_) => invalid(format!(
+            "an error object instead of choices: {}",
+            ProviderError::from_body(body)
+        )),
+        None => invalid("no `choices[0]` in the response".to_string()),
+    })?;
     let usage = wire.usage.map(|u| Usage {
         prompt_tokens: u.prompt_tokens.unwrap_or(0),
         completion_tokens: u.completion_tokens.unwrap_or(0),
@@ -270,5 +274,12 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("no `choices[0]`"), "{err}");
+        let err =
+            parse_completion(200, br#"{"error":{"message":"upstream quota","code":"x"}}"#, None).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("an error object instead of choices: upstream quota (code=x)"),
+            "{err}"
+        );
     }
 }
