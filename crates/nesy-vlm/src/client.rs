@@ -254,14 +254,7 @@ impl VlmClient {
                         tokio::time::sleep(delay).await;
                         continue;
                     }
-                    return (
-                        Err(VlmError::Transport {
-                            source: err,
-                            attempts,
-                        }),
-                        attempts,
-                        None,
-                    );
+                    return (Err(VlmError::Transport { error: err, attempts }), attempts, None);
                 }
             }
         }

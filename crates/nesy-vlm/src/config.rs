@@ -24,12 +24,12 @@ pub const DEFAULT_AZURE_API_VERSION: &str = "2025-04-01-preview";
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     /// The TOML file could not be read.
-    #[error("reading VLM config file {}: {source}", path.display())]
+    #[error("reading VLM config file {}: {error}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
+        /// The I/O error (shown in the message, so not also a `source`).
+        error: std::io::Error,
     },
     /// The TOML file does not parse or has an unknown key (the message has line and column).
     #[error("VLM config file {}: {message}", path.display())]
@@ -574,7 +574,7 @@ impl FileConfig {
     fn load(path: &Path) -> Result<Self, ConfigError> {
         let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
             path: path.to_path_buf(),
-            source,
+            error: source,
         })?;
         toml::from_str(&text).map_err(|err| ConfigError::File {
             path: path.to_path_buf(),

@@ -20,10 +20,10 @@ pub enum VlmError {
     #[error("invalid request: {0}")]
     InvalidRequest(String),
     /// The transport failed without an HTTP response (timeout, refused connection, cut body).
-    #[error("{source} (after {attempts} attempt(s))")]
+    #[error("{error} (after {attempts} attempt(s))")]
     Transport {
-        /// What went wrong on the last attempt.
-        source: TransportError,
+        /// What went wrong on the last attempt (shown in the message, so not also a `source`).
+        error: TransportError,
         /// Attempts made, including the last.
         attempts: u32,
     },

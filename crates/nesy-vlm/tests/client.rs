@@ -404,7 +404,7 @@ async fn a_slow_server_times_out_and_is_retried_within_the_budget() {
     );
     match err {
         VlmError::Transport {
-            source: TransportError::Timeout { phase, .. },
+            error: TransportError::Timeout { phase, .. },
             attempts,
         } => {
             assert_eq!(phase, TimeoutPhase::Response);
@@ -437,7 +437,7 @@ async fn connection_refused_is_a_typed_transport_error() {
         matches!(
             err,
             VlmError::Transport {
-                source: TransportError::Connect(_),
+                error: TransportError::Connect(_),
                 attempts: 2
             }
         ),

@@ -179,7 +179,7 @@ impl CassetteFile {
     pub fn load(path: &Path) -> Result<Self, CassetteError> {
         let text = fs::read_to_string(path).map_err(|source| CassetteError::Io {
             path: path.to_path_buf(),
-            source,
+            error: source,
         })?;
         Self::parse(path, &text)
     }
@@ -250,7 +250,7 @@ pub(crate) fn recorder() -> String {
 pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), CassetteError> {
     let io = |source| CassetteError::Io {
         path: path.to_path_buf(),
-        source,
+        error: source,
     };
     let dir = parent_dir(path);
     fs::create_dir_all(&dir).map_err(io)?;
@@ -286,7 +286,7 @@ pub(crate) fn write_blob(dir: &Path, name: &str, bytes: &[u8]) -> Result<bool, C
     }
     let io = |source| CassetteError::Io {
         path: path.clone(),
-        source,
+        error: source,
     };
     fs::create_dir_all(dir).map_err(io)?;
     let mut temp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
@@ -346,7 +346,7 @@ impl FileLock {
                     }
                     std::thread::sleep(Duration::from_millis(5));
                 }
-                Err(source) => return Err(CassetteError::Io { path, source }),
+                Err(source) => return Err(CassetteError::Io { path, error: source }),
             }
         }
     }

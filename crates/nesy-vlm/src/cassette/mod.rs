@@ -89,12 +89,12 @@ impl FromStr for CassetteMode {
 #[derive(Debug, thiserror::Error)]
 pub enum CassetteError {
     /// Reading or writing a file failed.
-    #[error("cassette file {}: {source}", path.display())]
+    #[error("cassette file {}: {error}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
+        /// The I/O error (shown in the message, so not also a `source`).
+        error: std::io::Error,
     },
     /// The file is not valid JSON or does not have the cassette shape.
     #[error("cassette {}:{line}:{column}: {message}", path.display())]

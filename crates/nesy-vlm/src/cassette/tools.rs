@@ -261,7 +261,7 @@ pub fn prune(
             for blob in &removed_blobs {
                 fs::remove_file(blob).map_err(|source| CassetteError::Io {
                     path: blob.clone(),
-                    source,
+                    error: source,
                 })?;
             }
         }
@@ -283,7 +283,7 @@ fn orphan_blobs(cassette: &Path, pending: Option<&CassetteFile>) -> Result<Vec<P
     }
     let io = |path: &Path| {
         let path = path.to_path_buf();
-        move |source| CassetteError::Io { path, source }
+        move |source| CassetteError::Io { path, error: source }
     };
     let mut referenced = BTreeSet::new();
     for entry in fs::read_dir(&dir).map_err(io(&dir))? {
@@ -326,7 +326,7 @@ fn orphan_blobs(cassette: &Path, pending: Option<&CassetteFile>) -> Result<Vec<P
 pub fn load_usage_report(path: &Path) -> Result<UsageReport, CassetteError> {
     let text = fs::read_to_string(path).map_err(|source| CassetteError::Io {
         path: path.to_path_buf(),
-        source,
+        error: source,
     })?;
     serde_json::from_str(&text).map_err(|err| CassetteError::Parse {
         path: path.to_path_buf(),
