@@ -49,19 +49,38 @@ impl VlmClient {
     /// a cassette when one is configured. In `none` mode (and `once` with an existing file)
     /// no HTTP client is built, so no key is needed.
     pub fn from_config(config: &VlmConfig) -> Result<Self, VlmError> {
-        let needs_live = match &config.cassette {
+        let live: Option<Arc<dyn Transport>> = if Self::may_go_live(config) {
+            Some(Arc::new(Self::http_transport(config)?))
+        } else {
+            None
+        };
+        Self::assemble(config, live, Some(config.backend.as_str().to_string()))
+    }
+
+    /// Like [`VlmClient::from_config`], but with `inner` in place of HTTP (for example an
+    /// offline responder): the configured cassette, if any, records and replays around it.
+    pub fn from_config_over(config: &VlmConfig, inner: Arc<dyn Transport>) -> Result<Self, VlmError> {
+        // The cassette's backend label comes from the inner transport.
+        Self::assemble(config, Some(inner), None)
+    }
+
+    /// Whether the configured cassette mode can send a call to the inner transport.
+    fn may_go_live(config: &VlmConfig) -> bool {
+        match &config.cassette {
             None => true,
             Some(cassette) => match cassette.mode {
                 CassetteMode::None => false,
                 CassetteMode::Once => !cassette.path.exists(),
                 CassetteMode::NewEpisodes | CassetteMode::All => true,
             },
-        };
-        let live: Option<Arc<dyn Transport>> = if needs_live {
-            Some(Arc::new(Self::http_transport(config)?))
-        } else {
-            None
-        };
+        }
+    }
+
+    fn assemble(
+        config: &VlmConfig,
+        live: Option<Arc<dyn Transport>>,
+        backend_label: Option<String>,
+    ) -> Result<Self, VlmError> {
         let transport: Arc<dyn Transport> = match &config.cassette {
             Some(cassette) => Arc::new(CassetteTransport::open(
                 &cassette.path,
@@ -71,7 +90,7 @@ impl VlmClient {
                     strict: cassette.strict,
                     usage_report: cassette.usage_report.clone(),
                     model: Some(config.model.clone()),
-                    backend: Some(config.backend.as_str().to_string()),
+                    backend: backend_label,
                     redact: config.api_key.iter().cloned().collect(),
                     allow_playback_repeats: false,
                 },

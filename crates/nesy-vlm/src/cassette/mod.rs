@@ -388,8 +388,7 @@ impl CassetteTransport {
             return Err(self.miss(request, &canonical, exhausted).into());
         };
         let started = Instant::now();
-        let mut response = inner.send(request).await?;
-        response.origin = Origin::Live;
+        let response = inner.send(request).await?;
         self.append(
             request,
             canonical,
