@@ -76,15 +76,37 @@ async fn regenerate_smoke_fixture() {
         .unwrap();
 }
 
-/// Patterns that betray a credential, checked case-insensitively in every text file.
-const SUSPICIOUS: &[&str] = &[
-    "\"authorization\"",
-    "\"api-key\"",
-    "\"x-api-key\"",
-    "\"cookie\"",
-    "\"set-cookie\"",
-    "bearer ",
+/// Header names that carry credentials; found as a JSON key with a string value they betray
+/// a recorded secret (an object merely *named* "cookie" in a scene is not flagged).
+const SECRET_HEADERS: &[&str] = &[
+    "authorization",
+    "proxy-authorization",
+    "api-key",
+    "x-api-key",
+    "cookie",
+    "set-cookie",
 ];
+
+/// `"<name>": "` (any case, any spacing) somewhere in the text.
+fn header_with_string_value(lower: &str, name: &str) -> bool {
+    let quoted = format!("\"{name}\"");
+    lower.match_indices(&quoted).any(|(at, _)| {
+        let rest = lower[at + quoted.len()..].trim_start();
+        rest.strip_prefix(':')
+            .is_some_and(|value| value.trim_start().starts_with('"'))
+    })
+}
+
+/// `Bearer <token>` with a token of at least 8 characters.
+fn bearer_token(lower: &str) -> bool {
+    lower.match_indices("bearer ").any(|(at, _)| {
+        lower[at + 7..]
+            .chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || "-._~+/".contains(*c))
+            .count()
+            >= 8
+    })
+}
 
 fn looks_like_openai_key(text: &str) -> Option<String> {
     text.match_indices("sk-").find_map(|(at, _)| {
@@ -124,10 +146,13 @@ fn no_fixture_anywhere_contains_a_secret() {
             continue;
         }; // binary (blobs, MCAP)
         let lower = text.to_ascii_lowercase();
-        for pattern in SUSPICIOUS {
-            if lower.contains(pattern) {
-                findings.push(format!("{}: contains {pattern}", file.display()));
+        for name in SECRET_HEADERS {
+            if header_with_string_value(&lower, name) {
+                findings.push(format!("{}: a {name:?} header value", file.display()));
             }
+        }
+        if bearer_token(&lower) {
+            findings.push(format!("{}: a bearer token", file.display()));
         }
         if let Some(key) = looks_like_openai_key(&text) {
             findings.push(format!(
@@ -147,4 +172,15 @@ fn no_fixture_anywhere_contains_a_secret() {
 fn the_secret_scan_catches_what_it_should() {
     assert!(looks_like_openai_key("key sk-proj-AbCdEfGhIjKlMnOpQrStUv").is_some());
     assert!(looks_like_openai_key("\"sk-short\" and risk-free").is_none());
+    assert!(header_with_string_value(
+        r#"{"headers": {"authorization" :  "bearer x"}}"#,
+        "authorization"
+    ));
+    assert!(header_with_string_value(r#"{"api-key":"abc"}"#, "api-key"));
+    assert!(!header_with_string_value(
+        r#"{"objects": ["cookie"], "cookie": {"mass": 0.1}}"#,
+        "cookie"
+    ));
+    assert!(bearer_token("authorization: bearer eyjhbgcioijiuzi1ni"));
+    assert!(!bearer_token("the bearer of bad news"));
 }
