@@ -94,26 +94,34 @@ impl State {
     pub fn with_changes(&self, deletes: &[Atom], adds: &[Atom]) -> State {
         debug_assert!(deletes.windows(2).all(|w| w[0] < w[1]));
         debug_assert!(adds.windows(2).all(|w| w[0] < w[1]));
-        let mut out = Vec::with_capacity(self.atoms.len() + adds.len());
-        let (mut d, mut a) = (0, 0);
-        for &atom in &self.atoms {
-            while a < adds.len() && adds[a] < atom {
-                out.push(adds[a]);
+        // Changes are few and states are long: find each change by binary search and copy
+        // the unchanged runs between them wholesale.
+        let src = &self.atoms;
+        let mut out = Vec::with_capacity(src.len() + adds.len());
+        let (mut pos, mut d, mut a) = (0, 0, 0);
+        loop {
+            let next = match (deletes.get(d), adds.get(a)) {
+                (None, None) => break,
+                (Some(&x), None) => x,
+                (None, Some(&y)) => y,
+                (Some(&x), Some(&y)) => x.min(y),
+            };
+            let at = pos + src[pos..].partition_point(|s| *s < next);
+            out.extend_from_slice(&src[pos..at]);
+            pos = at;
+            let is_add = adds.get(a) == Some(&next);
+            if is_add {
+                out.push(next); // added, or deleted and re-added: true afterwards
                 a += 1;
             }
-            while d < deletes.len() && deletes[d] < atom {
+            if deletes.get(d) == Some(&next) {
                 d += 1;
             }
-            let deleted = d < deletes.len() && deletes[d] == atom;
-            let readded = a < adds.len() && adds[a] == atom;
-            if readded {
-                a += 1;
-            }
-            if !deleted || readded {
-                out.push(atom);
+            if src.get(pos) == Some(&next) {
+                pos += 1; // the old copy is consumed either way
             }
         }
-        out.extend_from_slice(&adds[a..]);
+        out.extend_from_slice(&src[pos..]);
         State { atoms: out }
     }
 

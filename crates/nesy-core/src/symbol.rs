@@ -8,7 +8,11 @@ use std::sync::LazyLock;
 
 use lasso::{Spur, ThreadedRodeo};
 
-static INTERNER: LazyLock<ThreadedRodeo> = LazyLock::new(ThreadedRodeo::new);
+/// Fx hashing: names are short and trusted enough that SipHash's DoS resistance buys
+/// nothing here, while interning sits on every parser's hot path.
+type Interner = ThreadedRodeo<Spur, rustc_hash::FxBuildHasher>;
+
+static INTERNER: LazyLock<Interner> = LazyLock::new(|| ThreadedRodeo::with_hasher(rustc_hash::FxBuildHasher));
 
 /// An interned name.
 ///
@@ -32,7 +36,7 @@ impl Symbol {
     pub fn as_str(self) -> &'static str {
         // The interner is a never-dropped static, so its strings live for the whole
         // process; `resolve` ties them to the borrow of the static, which is 'static.
-        let rodeo: &'static ThreadedRodeo = &INTERNER;
+        let rodeo: &'static Interner = &INTERNER;
         rodeo.resolve(&self.0)
     }
 }

@@ -204,4 +204,22 @@ proptest! {
             prop_assert!(failed_step);
         }
     }
+
+    #[test]
+    fn with_changes_is_deletes_then_adds(seed in any::<u64>()) {
+        let mut rng = SeedRng(seed);
+        let s = state(&mut rng, 60);
+        let mut dels: Vec<nesy_core::Atom> = (0..rng.below(8)).map(|_| ground_atom(&mut rng)).collect();
+        let mut adds: Vec<nesy_core::Atom> = (0..rng.below(8)).map(|_| ground_atom(&mut rng)).collect();
+        dels.sort();
+        dels.dedup();
+        adds.sort();
+        adds.dedup();
+        let mut expected: BTreeSet<String> = texts(&s);
+        for d in &dels {
+            expected.remove(&d.to_string());
+        }
+        expected.extend(adds.iter().map(|a| a.to_string()));
+        prop_assert_eq!(texts(&s.with_changes(&dels, &adds)), expected);
+    }
 }

@@ -89,18 +89,43 @@ pub(crate) fn strip_bullet(text: &str) -> &str {
     if marker.is_ok() { input.trim_start() } else { t }
 }
 
-/// Normalises a header label: lower case, emphasis and hyphens removed, whitespace collapsed.
-fn normalize_label(label: &str) -> String {
-    let cleaned: String = label
+/// Compares a header label with a normalised one (lower case, single spaces) while
+/// ignoring case, emphasis (`*`, `_`, backticks, `#`), hyphens and runs of whitespace,
+/// and tolerating a trailing `s` (plural drift). No allocation: this runs on every
+/// non-formula line.
+fn label_matches(raw: &str, label: &str) -> bool {
+    let mut cleaned = raw
         .chars()
-        .filter(|c| !matches!(c, '*' | '_' | '`' | '#'))
-        .collect();
-    cleaned
-        .replace('-', "")
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .join(" ")
-        .to_lowercase()
+        .filter(|c| !matches!(c, '*' | '_' | '`' | '#' | '-'))
+        .map(|c| {
+            if c.is_whitespace() {
+                ' '
+            } else {
+                c.to_ascii_lowercase()
+            }
+        })
+        .peekable();
+    // Skip leading spaces and collapse inner runs.
+    let mut normalized = std::iter::from_fn(move || {
+        let c = cleaned.next()?;
+        if c == ' ' {
+            while cleaned.peek() == Some(&' ') {
+                cleaned.next();
+            }
+            cleaned.peek()?; // a trailing space ends the label
+        }
+        Some(c)
+    })
+    .skip_while(|c| *c == ' ');
+    let mut want = label.chars();
+    loop {
+        match (normalized.next(), want.next()) {
+            (None, None) => return true,
+            (Some('s'), None) => return normalized.next().is_none(),
+            (Some(a), Some(b)) if a == b => {}
+            _ => return false,
+        }
+    }
 }
 
 /// If `line` is a section header whose label is one of `labels` (already normalised,
@@ -116,9 +141,7 @@ pub(crate) fn header(line: &Line<'_>, labels: &[&str]) -> Option<usize> {
         Some(i) => (&rest[..i], Some(i + 1)),
         None => (rest, None),
     };
-    let norm = normalize_label(label);
-    let singular = norm.strip_suffix('s').unwrap_or(&norm);
-    if !labels.iter().any(|l| *l == norm || *l == singular) {
+    if !labels.iter().any(|l| label_matches(label, l)) {
         return None;
     }
     match after {
@@ -193,6 +216,18 @@ mod tests {
             "CloseHingeLid"
         );
         assert!(normalize_action_name("- **").is_none());
+    }
+
+    #[test]
+    fn label_drift() {
+        assert!(label_matches("Preconditions", "precondition"));
+        assert!(label_matches("**Pre-Conditions** ", "precondition"));
+        assert!(label_matches("  Action   Semantic", "action semantic"));
+        assert!(label_matches("ACTION SEMANTICS", "action semantic"));
+        assert!(!label_matches("Action Semantic Notes", "action semantic"));
+        assert!(!label_matches("Preconditionss", "precondition"));
+        assert!(!label_matches("Effect of the action", "effect"));
+        assert!(!label_matches("", "effect"));
     }
 
     #[test]
