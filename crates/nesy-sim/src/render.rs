@@ -164,6 +164,8 @@ struct Tiles<'a> {
     targets: Vec<Target<'a>>,
     columns: u32,
     lists: Vec<Vec<u32>>,
+    /// Distance from the eye to each target's box.
+    depth: Vec<f32>,
 }
 
 impl<'a> Tiles<'a> {
@@ -226,10 +228,20 @@ impl<'a> Tiles<'a> {
                 }
             }
         }
+        // Front to back, so the nearest hit is found early and the box test rejects the rest.
+        let eye = basis.eye;
+        let depth: Vec<f32> = targets
+            .iter()
+            .map(|t| (eye.clamp(t.min, t.max) - eye).length())
+            .collect();
+        for list in &mut lists {
+            list.sort_by(|a, b| depth[*a as usize].total_cmp(&depth[*b as usize]));
+        }
         Tiles {
             targets,
             columns,
             lists,
+            depth,
         }
     }
 
@@ -246,6 +258,11 @@ impl<'a> Tiles<'a> {
             let b = (t.max - ray.origin) * inv;
             let near = a.min(b).max_element();
             let far = a.max(b).min_element();
+            if self.depth[i as usize] > limit {
+                // Lists are sorted by the distance from the eye to each box, a lower bound
+                // of any hit on it: no later box can beat the hit already found.
+                break;
+            }
             if far < near.max(0.0) || near > limit {
                 continue;
             }

@@ -357,7 +357,8 @@ impl SceneError {
         }
     }
 
-    fn with_origin(mut self, name: &str) -> Self {
+    /// The same error attributed to `name` (a file path) instead of `<scene>`.
+    pub fn with_origin(mut self, name: &str) -> Self {
         match &mut self {
             SceneError::Json { origin, .. } | SceneError::Invalid { origin, .. } => *origin = name.to_owned(),
             SceneError::Io { .. } => {}

@@ -180,18 +180,23 @@ pub struct Sim {
     pub(crate) hooks: Vec<Box<dyn SimHook>>,
 }
 
-fn shape_of(p: &Primitive) -> SharedShape {
+/// A Rapier shape for a URDF primitive, with the rotation that maps the shape's own axis
+/// onto the URDF's (parry cylinders run along y, URDF cylinders along z).
+fn shape_of(p: &Primitive) -> (SharedShape, Pose) {
     match *p {
-        Primitive::Box(s) => SharedShape::cuboid(s[0] as f32 / 2.0, s[1] as f32 / 2.0, s[2] as f32 / 2.0),
-        Primitive::Cylinder { radius, length } => {
-            // parry cylinders run along y; URDF cylinders along z.
-            SharedShape::compound(vec![(
-                Pose::from_rotation(Rotation::from_rotation_x(std::f32::consts::FRAC_PI_2)),
-                SharedShape::cylinder(length as f32 / 2.0, radius as f32),
-            )])
-        }
-        Primitive::Capsule { radius, length } => SharedShape::capsule_z(length as f32 / 2.0, radius as f32),
-        Primitive::Sphere(r) => SharedShape::ball(r as f32),
+        Primitive::Box(s) => (
+            SharedShape::cuboid(s[0] as f32 / 2.0, s[1] as f32 / 2.0, s[2] as f32 / 2.0),
+            Pose::IDENTITY,
+        ),
+        Primitive::Cylinder { radius, length } => (
+            SharedShape::cylinder(length as f32 / 2.0, radius as f32),
+            Pose::from_rotation(Rotation::from_rotation_x(std::f32::consts::FRAC_PI_2)),
+        ),
+        Primitive::Capsule { radius, length } => (
+            SharedShape::capsule_z(length as f32 / 2.0, radius as f32),
+            Pose::IDENTITY,
+        ),
+        Primitive::Sphere(r) => (SharedShape::ball(r as f32), Pose::IDENTITY),
     }
 }
 
@@ -203,7 +208,7 @@ impl Sim {
 
     /// Reads, validates and builds a scene file.
     pub fn from_file(path: &std::path::Path) -> Result<Sim, SceneError> {
-        Sim::new(&SceneSpec::from_file(path)?)
+        Sim::new(&SceneSpec::from_file(path)?).map_err(|e| e.with_origin(&path.display().to_string()))
     }
 
     /// Builds the world for a scene, checks that no two objects interpenetrate, and lets
@@ -391,9 +396,12 @@ impl Sim {
                 let h = add_collider(
                     &mut world,
                     &mut looks,
-                    ColliderBuilder::new(shape_of(prim))
-                        .position(iso_to_pose(local))
-                        .friction(objects::FRICTION),
+                    {
+                        let (shape, axis) = shape_of(prim);
+                        ColliderBuilder::new(shape)
+                            .position(iso_to_pose(local) * axis)
+                            .friction(objects::FRICTION)
+                    },
                     body,
                     plain(colour),
                 );

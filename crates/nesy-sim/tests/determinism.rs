@@ -87,3 +87,9 @@ fn hooks_run_every_n_steps_and_after_every_call() {
     assert_eq!(log.calls[1].call.name(), "move_gripper_to");
     assert_eq!(log.calls.as_slice(), sim.trace());
 }
+
+#[test]
+fn the_simulator_can_move_between_threads() {
+    fn assert_send<T: Send>() {}
+    assert_send::<Sim>();
+}

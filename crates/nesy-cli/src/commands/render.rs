@@ -35,7 +35,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     }
     let spec = nesy_sim::SceneSpec::from_file(&args.scene)?;
     let config = SimConfig { settle_steps: args.settle_steps, ..SimConfig::default() };
-    let sim = Sim::with_config(&spec, config).with_context(|| format!("building the world of {}", args.scene.display()))?;
+    let sim = Sim::with_config(&spec, config).map_err(|e| e.with_origin(&args.scene.display().to_string()))?;
     let threads = args.threads.unwrap_or_else(default_threads).max(1);
     let started = Instant::now();
     let views = render_views(&sim, args.size, threads);
