@@ -71,7 +71,10 @@ fn fk_matches_dh_reference_on_50_configurations() {
         let dr = (got.rotation.to_rotation_matrix().matrix() - want_r).abs().max();
         worst = (worst.0.max(dp), worst.1.max(dr));
     }
-    eprintln!("FK vs DH reference: worst position {:.2e} m, rotation entry {:.2e}", worst.0, worst.1);
+    eprintln!(
+        "FK vs DH reference: worst position {:.2e} m, rotation entry {:.2e}",
+        worst.0, worst.1
+    );
     assert!(
         worst.0 < 1e-4 && worst.1 < 1e-4,
         "worst position {:.2e} m, rotation entry {:.2e}",

@@ -569,3 +569,124 @@ fn all_four_subtasks_at_composite_offsets_finger() {
 fn all_four_subtasks_at_composite_offsets_vacuum() {
     composite(nesy_sim::Embodiment::Vacuum);
 }
+
+/// Obstruction level 1 of the sweep: a piece in the wrong box is lifted back onto the board,
+/// then swept into the right one.
+fn wrong_box_piece(embodiment: nesy_sim::Embodiment) {
+    let text = std::fs::read_to_string(common::scene_path("sweep_finger")).unwrap();
+    let mut spec = nesy_sim::SceneSpec::from_json_str(&text, "sweep").unwrap();
+    spec.embodiment = embodiment;
+    // The white rook starts in the right (black) box.
+    spec.objects[3].pose.position = [0.46, 0.087, 0.503];
+    let mut sim = Sim::new(&spec).unwrap();
+    expect(&sim, "reset", &["(InsideOf white_rook right_chess_box)"], &[]);
+    let vacuum = embodiment == nesy_sim::Embodiment::Vacuum;
+    let h = sim.get_obj_size("white_rook").unwrap()[2];
+    sim.move_gripper_to("white_rook", Direction::Down, h / 2.0)
+        .unwrap();
+    grasp(&mut sim);
+    let board = sim.get_obj_bbox("board").unwrap();
+    let x = sim.get_obj_pos("white_rook").unwrap()[0];
+    let hang = if vacuum { h } else { h / 2.0 };
+    sim.move_to_position([x, 0.0, board[1][2] + hang + 0.01], Direction::Down, 0.12, 0.0)
+        .unwrap();
+    release(&mut sim);
+    expect(
+        &sim,
+        "back on the board",
+        &["(OnTopOf white_rook board)"],
+        &["(InsideOf white_rook right_chess_box)"],
+    );
+    sim.move_gripper_to("white_rook", Direction::Down, h / 1.3)
+        .unwrap();
+    if vacuum {
+        sim.activate_vacuum().unwrap();
+    }
+    let py = sim.get_obj_pos("white_rook").unwrap()[1];
+    let by = sim.get_obj_pos("left_chess_box").unwrap()[1];
+    sim.move_parallel(Direction::Left, (py - by).abs() + 0.02, Direction::Down)
+        .unwrap();
+    if vacuum {
+        sim.deactivate_vacuum().unwrap();
+    }
+    sim.step_idle(50);
+    expect(&sim, "swept", &["(InsideOf white_rook left_chess_box)"], &[]);
+}
+
+#[test]
+fn a_piece_in_the_wrong_box_is_moved_back_and_swept_finger() {
+    wrong_box_piece(nesy_sim::Embodiment::Finger);
+}
+
+#[test]
+fn a_piece_in_the_wrong_box_is_moved_back_and_swept_vacuum() {
+    wrong_box_piece(nesy_sim::Embodiment::Vacuum);
+}
+
+/// Obstruction level 2 of the hinge: a fruit on the closed lid is moved to the floor first.
+fn fruit_on_lid(embodiment: nesy_sim::Embodiment) {
+    let text = std::fs::read_to_string(common::scene_path("hinge_finger")).unwrap();
+    let mut spec = nesy_sim::SceneSpec::from_json_str(&text, "hinge").unwrap();
+    spec.embodiment = embodiment;
+    spec.objects[1].pose.position = [0.525, 0.02, 0.627];
+    let mut sim = Sim::new(&spec).unwrap();
+    expect(
+        &sim,
+        "reset",
+        &["(OnTopOf apple hinge_lid)", "(Closed hinge_lid)"],
+        &[],
+    );
+    let vacuum = embodiment == nesy_sim::Embodiment::Vacuum;
+    let h = sim.get_obj_size("apple").unwrap()[2];
+    sim.move_gripper_to("apple", Direction::Down, h / 2.0).unwrap();
+    grasp(&mut sim);
+    let [x, y] = sim.get_empty_floor_xy("apple").unwrap();
+    let hang = if vacuum { h } else { h / 2.0 };
+    sim.move_to_position([x, y, 0.5 + hang + 0.01], Direction::Down, 0.12, 0.0)
+        .unwrap();
+    release(&mut sim);
+    expect(
+        &sim,
+        "fruit off the lid",
+        &["(OnTopOf apple floor)"],
+        &["(OnTopOf apple hinge_lid)"],
+    );
+    grab_handle(&mut sim, "hinge_handle");
+    let lid = sim.get_obj_pos("hinge_lid").unwrap();
+    let r = sim.get_obj_size("hinge_lid").unwrap()[0];
+    sim.move_to_position([lid[0] + 0.5 * r, lid[1], lid[2] + r], Direction::Down, 0.0, 0.0)
+        .unwrap();
+    let_go_handle(&mut sim);
+    expect(&sim, "opened", &["(Open hinge_lid)"], &[]);
+}
+
+#[test]
+fn a_fruit_on_the_lid_is_moved_away_before_opening_finger() {
+    fruit_on_lid(nesy_sim::Embodiment::Finger);
+}
+
+#[test]
+fn a_fruit_on_the_lid_is_moved_away_before_opening_vacuum() {
+    fruit_on_lid(nesy_sim::Embodiment::Vacuum);
+}
+
+#[test]
+fn side_approaches_point_the_tool_sideways() {
+    for (dir, axis) in [
+        (Direction::Left, [0.0, -1.0, 0.0]),
+        (Direction::Right, [0.0, 1.0, 0.0]),
+    ] {
+        let mut sim = load("hinge_finger");
+        sim.move_gripper_to("apple", dir, 0.02).unwrap();
+        let tool = sim.tool_pose();
+        let z = tool.rotation * nalgebra::Vector3::z();
+        assert!(
+            (z - nalgebra::Vector3::from(axis)).norm() < 0.01,
+            "{dir:?}: tool axis {z}"
+        );
+        let apple = sim.get_obj_bbox("apple").unwrap();
+        // `depth` past the near face along the approach.
+        let near_face = if axis[1] < 0.0 { apple[1][1] } else { apple[0][1] };
+        assert!((tool.translation.vector.y - (near_face + axis[1] * 0.02)).abs() < 2e-3);
+    }
+}
