@@ -215,6 +215,13 @@ impl Sim {
     }
 
     fn do_move_gripper_to(&mut self, name: &str, pointing: Direction, depth: f64) -> Result<(), ApiError> {
+        if name == "floor" || name == self.gripper_name() {
+            return Err(ApiError::Infeasible {
+                call: "move_gripper_to".into(),
+                target: name.into(),
+                reason: "it is not an object the gripper can move to; use move_to_position".into(),
+            });
+        }
         let part = self.part_or_unknown(name)?;
         let aabb = self.part_aabb(part);
         let p = &self.parts[part];

@@ -325,6 +325,9 @@ fn shade_rows(
 
 /// Renders one camera, splitting rows over `threads` threads.
 pub fn render_camera(sim: &Sim, camera: &Camera, width: u32, height: u32, threads: usize) -> Image {
+    if width == 0 || height == 0 {
+        return Image::new(width, height);
+    }
     let basis = Basis::new(camera, width, height);
     let tiles = Tiles::new(sim, &basis, width, height);
     let mut image = Image::new(width, height);

@@ -316,3 +316,44 @@ fn every_fixture_scene_loads() {
         }
     }
 }
+
+#[test]
+fn degenerate_inputs_do_not_panic() {
+    let spec = SceneSpec::from_json_str(
+        r#"{"schema_version": 1, "embodiment": "vacuum", "objects": []}"#,
+        "empty",
+    )
+    .unwrap();
+    let mut sim = Sim::new(&spec).unwrap();
+    assert_eq!(
+        sim.get_obj_names(),
+        vec!["floor".to_owned(), "vacuum_gripper".to_owned()]
+    );
+    assert!(matches!(
+        sim.move_gripper_to("floor", Direction::Down, 0.01),
+        Err(ApiError::Infeasible { .. })
+    ));
+    assert!(matches!(
+        sim.move_to_position([f64::NAN, 0.0, 0.6], Direction::Down, 0.12, 0.0),
+        Err(ApiError::OutOfWorkspace { .. })
+    ));
+    assert!(matches!(
+        sim.move_to_position([0.4, 0.0, 0.6], Direction::Down, f64::INFINITY, 0.0),
+        Err(ApiError::InvalidArgument { .. })
+    ));
+    assert!(matches!(
+        sim.move_parallel(Direction::Up, f64::NAN, Direction::Down),
+        Err(ApiError::InvalidArgument { .. })
+    ));
+    assert_eq!(sim.get_obj_pos("floor").unwrap()[2], 0.5);
+    let views = nesy_sim::render::render_views(&sim, 0, 2);
+    assert!(views.iter().all(|v| v.image.rgb.is_empty()));
+    let views = nesy_sim::render::render_views(&sim, 17, 3);
+    assert!(
+        views
+            .iter()
+            .all(|v| v.image.rgb.len() == 17 * 17 * 3 && v.marked.rgb.len() == 17 * 17 * 3)
+    );
+    assert!(SceneSpec::from_json_str("{", "truncated").is_err());
+    assert!(SceneSpec::from_json_str("", "empty").is_err());
+}
