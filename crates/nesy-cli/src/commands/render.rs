@@ -34,13 +34,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--size must be between 16 and 4096 pixels, got {}", args.size);
     }
     let spec = nesy_sim::SceneSpec::from_file(&args.scene)?;
-    let config = SimConfig { settle_steps: args.settle_steps, ..SimConfig::default() };
-    let sim = Sim::with_config(&spec, config).map_err(|e| e.with_origin(&args.scene.display().to_string()))?;
+    let config = SimConfig {
+        settle_steps: args.settle_steps,
+        ..SimConfig::default()
+    };
+    let sim =
+        Sim::with_config(&spec, config).map_err(|e| e.with_origin(&args.scene.display().to_string()))?;
     let threads = args.threads.unwrap_or_else(default_threads).max(1);
     let started = Instant::now();
     let views = render_views(&sim, args.size, threads);
     let elapsed = started.elapsed();
-    let written = write_views(&views, &args.out).with_context(|| format!("writing images to {}", args.out.display()))?;
+    let written = write_views(&views, &args.out)
+        .with_context(|| format!("writing images to {}", args.out.display()))?;
     for path in &written {
         println!("{}", path.display());
     }
@@ -51,4 +56,64 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         elapsed.as_secs_f64() * 1000.0
     );
     Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fixture(name: &str) -> PathBuf {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/scenes")
+            .join(name)
+    }
+
+    #[test]
+    fn writes_six_pngs() {
+        let out = tempfile::tempdir().unwrap();
+        let args = RenderArgs {
+            scene: fixture("hinge_finger.json"),
+            out: out.path().to_path_buf(),
+            size: 64,
+            threads: Some(2),
+            settle_steps: 5,
+        };
+        assert_eq!(run(args).unwrap(), ExitCode::SUCCESS);
+        for view in [
+            "top",
+            "front",
+            "back",
+            "top_marked",
+            "front_marked",
+            "back_marked",
+        ] {
+            let bytes = std::fs::read(out.path().join(format!("{view}.png"))).unwrap();
+            assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+            // IHDR width and height.
+            assert_eq!(&bytes[16..24], &[0, 0, 0, 64, 0, 0, 0, 64]);
+        }
+    }
+
+    #[test]
+    fn a_bad_scene_names_the_file_and_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let scene = dir.path().join("bad.json");
+        std::fs::write(
+            &scene,
+            r#"{"schema_version": 1, "embodiment": "suction", "objects": []}"#,
+        )
+        .unwrap();
+        let args = RenderArgs {
+            scene: scene.clone(),
+            out: dir.path().join("out"),
+            size: 64,
+            threads: None,
+            settle_steps: 0,
+        };
+        let message = format!("{:#}", run(args).unwrap_err());
+        assert!(
+            message.contains("bad.json") && message.contains("embodiment"),
+            "{message}"
+        );
+    }
 }
