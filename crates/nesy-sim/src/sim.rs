@@ -56,7 +56,7 @@ pub struct Look {
     pub pattern: Pattern,
     /// Part index in [`Sim::parts`], or `None` for the table, pedestal and robot.
     pub part: Option<usize>,
-    /// Pose of the pattern frame relative to the collider (for checkers).
+    /// Half extents in x and y of a cuboid collider, the frame of its checker pattern.
     pub pattern_half_extent: [f32; 2],
 }
 
@@ -94,10 +94,9 @@ pub struct Articulation {
     pub parts: Vec<usize>,
     /// Joint type.
     pub joint: JointBuild,
-    /// World pose of the joint frame at the closed position.
+    /// World pose of the joint frame at the closed position; the moving parts' colliders
+    /// are expressed in it.
     pub frame: Pose,
-    /// Build offsets of the moving parts (part frame relative to the joint frame).
-    pub part_offsets: Vec<Pose>,
     /// Joint position, benchmark convention.
     pub q: f64,
     /// Limits.
@@ -149,7 +148,7 @@ pub(crate) struct RobotBodies {
     pub carrier_link: usize,
     /// Pad centres (link index, point in link frame) of the two fingers.
     pub pads: Option<[(usize, Vector3<f64>); 2]>,
-    /// Every robot collider (for the `gripper` AABB: only the hand and fingers).
+    /// Colliders of the hand and fingers or the suction tool (the `gripper` object).
     pub gripper_colliders: Vec<ColliderHandle>,
 }
 
@@ -296,7 +295,6 @@ impl Sim {
                                     parts: Vec::new(),
                                     joint,
                                     frame: joint_frame,
-                                    part_offsets: Vec::new(),
                                     q,
                                     limits: articulation_limits(&link_name).unwrap_or((0.0, 0.0)),
                                 });
@@ -305,8 +303,6 @@ impl Sim {
                         };
                         let a = &mut articulations[ai];
                         a.parts.push(part_index);
-                        // Every moving part's frame is the joint frame.
-                        a.part_offsets.push(Pose::IDENTITY);
                         if build.role == PartRole::Handle {
                             a.handle = Some(part_index);
                         }
@@ -808,9 +804,9 @@ impl Sim {
         let a = &mut self.articulations[ai];
         a.q = q.clamp(a.limits.0, a.limits.1);
         let pose = a.frame * objects::joint_motion(a.joint, a.q);
-        for (&p, off) in a.parts.iter().zip(&a.part_offsets) {
+        for &p in &a.parts {
             let body = self.parts[p].body;
-            self.world.bodies[body].set_next_kinematic_position(pose * *off);
+            self.world.bodies[body].set_next_kinematic_position(pose);
         }
     }
 
