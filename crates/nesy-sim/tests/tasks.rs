@@ -558,6 +558,12 @@ fn composite(embodiment: nesy_sim::Embodiment) {
     let want: Vec<&str> = want.iter().map(String::as_str).collect();
     expect(&sim, "final", &want, &[]);
     assert!(sim.trace().iter().all(|e| e.result.is_ok()));
+    // Everything is at rest, as the benchmark's success check (speed ≤ 0.02 m/s) requires.
+    for (i, part) in sim.parts().iter().enumerate() {
+        let v = sim.part_velocity(i);
+        let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        assert!(speed <= 0.02, "{} moves at {speed:.3} m/s", part.name);
+    }
 }
 
 #[test]
