@@ -28,8 +28,13 @@ pub enum Command {
     Cassette(commands::cassette::CassetteArgs),
     /// Render a scene's top, front and back views as PNG (plain and labelled).
     Render(commands::render::RenderArgs),
+    /// Run a code policy against a scene in the sandboxed Python worker.
+    Run(commands::run::RunArgs),
     /// Verify a plan against a PDDL domain and problem, like VAL.
     Verify(commands::verify::VerifyArgs),
+    /// Worker process of `nesy run` (internal).
+    #[command(name = "policy-worker", hide = true)]
+    PolicyWorker(commands::worker::WorkerArgs),
 }
 
 /// Exit code for bad input or usage errors.
@@ -50,7 +55,9 @@ pub fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
         Command::Cassette(args) => commands::cassette::run(args),
         Command::Render(args) => commands::render::run(args),
+        Command::Run(args) => commands::run::run(args),
         Command::Verify(args) => commands::verify::run(args),
+        Command::PolicyWorker(args) => commands::worker::run(args),
     };
     match result {
         Ok(code) => code,

@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use nesy_core::State;
 use nesy_sim::api::{Embodiment, RobotApi};
 use serde::{Deserialize, Serialize};
 
@@ -12,8 +13,17 @@ use crate::result::SubtaskResult;
 pub trait Episode: RobotApi + Send {
     /// Called once after the policy ended (in any way but a kill): runs the post-run
     /// settle steps (spec §7: 100 steps, then, if undecided, 100 more with the final check)
-    /// and returns the subtask results. `None` if this robot has no goal checks.
-    fn finish(&mut self) -> Option<Vec<SubtaskResult>>;
+    /// and returns what the episode achieved.
+    fn finish(&mut self) -> EpisodeEnd;
+}
+
+/// What an episode reports after the policy and the settle steps.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EpisodeEnd {
+    /// Goal-check results; `None` if this robot has no goal checks.
+    pub subtasks: Option<Vec<SubtaskResult>>,
+    /// The observed symbolic state after settling; `None` if the robot has no world.
+    pub final_state: Option<State>,
 }
 
 /// Which episode a worker should build. Sent from the parent to the worker process.

@@ -19,10 +19,11 @@ pub mod limits;
 pub mod python;
 pub mod result;
 pub mod runner;
+pub mod sim_episode;
 pub mod testing;
 pub mod worker;
 
-pub use episode::{Episode, EpisodeBuildError, EpisodeFactory, EpisodeSpec};
+pub use episode::{Episode, EpisodeBuildError, EpisodeEnd, EpisodeFactory, EpisodeSpec};
 pub use limits::Limits;
 pub use python::interpreter::{InitError, initialize};
 pub use result::{
@@ -30,3 +31,5 @@ pub use result::{
     TimeLimit, TracebackFrame, WorkerReport,
 };
 pub use runner::{POLICY_FILE, api_function_names, api_signatures, check_source, run_in_process};
+pub use sim_episode::{SETTLE_STEPS, SimEpisodes};
+pub use worker::{RunError, WorkerCommand, run_policy};

@@ -1,5 +1,6 @@
 //! What running a policy produced: [`ExecutionResult`] and its [`Outcome`].
 
+use nesy_core::State;
 use nesy_sim::api::TraceEntry;
 use serde::{Deserialize, Serialize};
 
@@ -21,6 +22,9 @@ pub struct ExecutionResult {
     /// Goal-check results after the post-run settle steps of spec §7; `None` when the robot
     /// behind the episode has no goal checks (e.g. the sandbox test double).
     pub subtasks: Option<Vec<SubtaskResult>>,
+    /// The observed symbolic state after the settle steps (`None` for robots without a
+    /// world, such as the test double, and for episodes that were killed or rejected).
+    pub final_state: Option<State>,
     /// Details of the worker process, for runs through [`crate::worker`].
     pub worker: Option<WorkerReport>,
 }

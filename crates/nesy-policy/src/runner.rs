@@ -73,8 +73,9 @@ pub fn run_in_process_without_static_checks(
     source: &str,
     episode: Box<dyn Episode>,
     limits: &Limits,
+    sink: Option<TraceSink>,
 ) -> Result<ExecutionResult, InitError> {
-    run(source, episode, limits, None, false)
+    run(source, episode, limits, sink, false)
 }
 
 fn run(
@@ -100,6 +101,7 @@ fn run(
             stderr: Default::default(),
             wall_time_s: started.elapsed().as_secs_f64(),
             subtasks: None,
+            final_state: None,
             worker: None,
         });
     }
@@ -119,14 +121,15 @@ fn run(
     if let Some(watchdog) = watchdog {
         watchdog.join();
     }
-    let subtasks = episode.finish();
+    let end = episode.finish();
     Ok(ExecutionResult {
         outcome,
         trace: episode.trace().to_vec(),
         stdout,
         stderr,
         wall_time_s: started.elapsed().as_secs_f64(),
-        subtasks,
+        subtasks: end.subtasks,
+        final_state: end.final_state,
         worker: None,
     })
 }

@@ -8,8 +8,7 @@
 
 use nesy_sim::api::{ApiCall, ApiError, ApiValue, Direction, Embodiment, RobotApi, TraceEntry};
 
-use crate::episode::Episode;
-use crate::result::SubtaskResult;
+use crate::episode::{Episode, EpisodeEnd};
 
 /// A robot that records calls and moves nothing. See the module docs.
 #[derive(Clone, Debug)]
@@ -90,8 +89,8 @@ impl RecordingRobot {
 }
 
 impl Episode for RecordingRobot {
-    fn finish(&mut self) -> Option<Vec<SubtaskResult>> {
-        None
+    fn finish(&mut self) -> EpisodeEnd {
+        EpisodeEnd::default()
     }
 }
 

@@ -408,6 +408,7 @@ fn curated_builtins_and_import_allowlist_hold_without_static_checks() {
             source,
             Box::new(RecordingRobot::new(Embodiment::Finger)),
             &Limits::default(),
+            None,
         )
         .unwrap()
     };
@@ -441,6 +442,7 @@ fn audit_hook_terminates_frame_and_code_access_even_when_caught() {
                 wall_time_ms: 5_000,
                 ..Limits::default()
             },
+            None,
         )
         .unwrap()
     };

@@ -2,4 +2,6 @@
 
 pub mod cassette;
 pub mod render;
+pub mod run;
 pub mod verify;
+pub mod worker;

@@ -101,7 +101,12 @@ pub fn worker_main(factory: &dyn EpisodeFactory) -> ExitCode {
             entry: entry.clone(),
         });
     });
-    match runner::run_in_process(&request.source, episode, &request.limits, Some(sink)) {
+    let ran = if request.static_checks {
+        runner::run_in_process(&request.source, episode, &request.limits, Some(sink))
+    } else {
+        runner::run_in_process_without_static_checks(&request.source, episode, &request.limits, Some(sink))
+    };
+    match ran {
         Ok(result) => channel.send(&WorkerMessage::Result {
             nonce,
             result: Box::new(result),

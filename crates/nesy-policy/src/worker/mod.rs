@@ -17,7 +17,8 @@ mod child;
 mod limits;
 mod parent;
 pub mod protocol;
-mod seccomp;
+pub mod seccomp;
 
 pub use child::worker_main;
-pub use parent::{RunError, WorkerCommand, run_policy};
+pub use parent::{RunError, WORKER_SUBCOMMAND, WorkerCommand, run_policy, run_policy_without_static_checks};
+pub use seccomp::install as install_seccomp_filter;

@@ -113,6 +113,28 @@ pub fn run_policy(
     spec: &EpisodeSpec,
     limits: &Limits,
 ) -> Result<ExecutionResult, RunError> {
+    run(worker, source, spec, limits, true)
+}
+
+/// Like [`run_policy`] with the static checks (layer 1) off, so tests can show that the
+/// worker's own layers hold. Never use it for untrusted code outside such tests.
+#[doc(hidden)]
+pub fn run_policy_without_static_checks(
+    worker: &WorkerCommand,
+    source: &str,
+    spec: &EpisodeSpec,
+    limits: &Limits,
+) -> Result<ExecutionResult, RunError> {
+    run(worker, source, spec, limits, false)
+}
+
+fn run(
+    worker: &WorkerCommand,
+    source: &str,
+    spec: &EpisodeSpec,
+    limits: &Limits,
+    static_checks: bool,
+) -> Result<ExecutionResult, RunError> {
     let started = Instant::now();
     let nonce = nonce();
     let request = WorkerRequest {
@@ -120,6 +142,7 @@ pub fn run_policy(
         source: source.to_owned(),
         episode: spec.clone(),
         limits: limits.clone(),
+        static_checks,
     };
     let (read_end, write_end) = pipe()?;
     let write_raw = write_end.as_raw_fd();
@@ -245,6 +268,7 @@ pub fn run_policy(
         stderr: CapturedText::default(),
         wall_time_s,
         subtasks: None,
+        final_state: None,
         worker: Some(report),
     })
 }

@@ -24,6 +24,13 @@ pub struct WorkerRequest {
     pub episode: EpisodeSpec,
     /// Budgets.
     pub limits: Limits,
+    /// Run the static checks (always, except in tests that show the later layers).
+    #[serde(default = "yes")]
+    pub static_checks: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// One JSON line from the worker on [`RESULT_FD`].

@@ -8,7 +8,7 @@ use std::io;
 
 /// Installs the filter on every thread of the process.
 #[cfg(target_arch = "x86_64")]
-pub(crate) fn install() -> io::Result<()> {
+pub fn install() -> io::Result<()> {
     use libc::sock_filter;
 
     const LD_W_ABS: u16 = 0x20;
@@ -93,11 +93,12 @@ pub(crate) fn install() -> io::Result<()> {
     // Layout: [arch check][nr load][denied...][clone3][clone][open][openat][allow]
     //         [deny][enosys][check clone: 4][check open: 4][check openat: 4]
     // (BPF jumps only go forward, so each check ends in its own returns.)
-    let mut prog: Vec<sock_filter> = Vec::new();
-    prog.push(stmt(LD_W_ABS, OFFSET_ARCH));
-    prog.push(jump(JEQ_K, AUDIT_ARCH_X86_64, 1, 0));
-    prog.push(stmt(RET_K, RET_KILL_PROCESS));
-    prog.push(stmt(LD_W_ABS, OFFSET_NR));
+    let mut prog: Vec<sock_filter> = vec![
+        stmt(LD_W_ABS, OFFSET_ARCH),
+        jump(JEQ_K, AUDIT_ARCH_X86_64, 1, 0),
+        stmt(RET_K, RET_KILL_PROCESS),
+        stmt(LD_W_ABS, OFFSET_NR),
+    ];
     let dispatch_start = prog.len();
     let dispatch_len = denied.len() + 4;
     let allow = dispatch_start + dispatch_len;
@@ -161,6 +162,6 @@ pub(crate) fn install() -> io::Result<()> {
 
 /// No filter on other architectures (documented limitation).
 #[cfg(not(target_arch = "x86_64"))]
-pub(crate) fn install() -> io::Result<()> {
+pub fn install() -> io::Result<()> {
     Ok(())
 }

@@ -1,0 +1,129 @@
+//! `nesy run`: run a code policy against a scene in the sandboxed worker process.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use nesy_policy::{EpisodeSpec, ExecutionResult, Limits, Outcome, WorkerCommand, run_policy};
+use nesy_sim::api::Embodiment;
+
+/// Arguments of `nesy run`.
+#[derive(Debug, clap::Args)]
+pub struct RunArgs {
+    /// The policy's Python source.
+    #[arg(long)]
+    pub policy: PathBuf,
+    /// Scene file (`scene.json`).
+    #[arg(long)]
+    pub scene: PathBuf,
+    /// Override the scene's end effector.
+    #[arg(long, value_parser = parse_embodiment)]
+    pub embodiment: Option<Embodiment>,
+    /// Print the full execution result as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Render views every N simulation steps (not implemented yet; 0 = never).
+    #[arg(long, default_value_t = 0)]
+    pub render_every: u32,
+    /// Wall-clock budget of the policy in seconds.
+    #[arg(long, default_value_t = 120.0)]
+    pub timeout: f64,
+    /// Maximum number of robot action calls.
+    #[arg(long, default_value_t = 200)]
+    pub max_actions: usize,
+}
+
+fn parse_embodiment(text: &str) -> Result<Embodiment, String> {
+    match text {
+        "finger" => Ok(Embodiment::Finger),
+        "vacuum" => Ok(Embodiment::Vacuum),
+        other => Err(format!("expected finger or vacuum, got {other:?}")),
+    }
+}
+
+/// Runs `nesy run`: exit 0 if the policy ran to its end, 1 if it failed in any way, 2 on
+/// bad input.
+pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
+    let source = std::fs::read_to_string(&args.policy)
+        .with_context(|| format!("reading the policy {}", args.policy.display()))?;
+    if !(args.timeout.is_finite() && args.timeout > 0.0) {
+        anyhow::bail!(
+            "--timeout must be a positive number of seconds, got {}",
+            args.timeout
+        );
+    }
+    let limits = Limits {
+        wall_time_ms: (args.timeout * 1000.0) as u64,
+        action_calls: args.max_actions,
+        ..Limits::default()
+    };
+    let spec = EpisodeSpec::Scene {
+        path: std::path::absolute(&args.scene).unwrap_or(args.scene.clone()),
+        embodiment: args.embodiment,
+        render_every: args.render_every,
+    };
+    let worker = WorkerCommand::current_exe().context("locating the nesy executable")?;
+    let result = run_policy(&worker, &source, &spec, &limits)
+        .with_context(|| format!("running {} on {}", args.policy.display(), args.scene.display()))?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&result)?);
+    } else {
+        print_summary(&result);
+    }
+    Ok(if result.is_ok() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn print_summary(result: &ExecutionResult) {
+    if !result.stdout.text.is_empty() {
+        print!("{}", result.stdout.text);
+    }
+    if !result.stderr.text.is_empty() {
+        eprint!("{}", result.stderr.text);
+    }
+    let actions = result.trace.iter().filter(|e| e.call.is_action()).count();
+    let refused = result.trace.iter().filter(|e| e.result.is_err()).count();
+    println!(
+        "outcome: {} ({} API calls, {actions} actions, {refused} refused, {:.2} s)",
+        result.outcome.kind(),
+        result.trace.len(),
+        result.wall_time_s
+    );
+    match &result.outcome {
+        Outcome::Ok => {}
+        Outcome::Rejected { violations } => {
+            for v in violations {
+                println!("  {v}");
+            }
+        }
+        Outcome::PythonError(error) => println!("{}", error.traceback),
+        Outcome::SandboxViolation { event, detail, .. } => {
+            println!(
+                "  refused: {event}{}",
+                detail.as_ref().map(|d| format!(" ({d})")).unwrap_or_default()
+            )
+        }
+        Outcome::Timeout { limit, error } => {
+            println!("  limit: {limit:?}");
+            if let Some(error) = error {
+                println!("{}", error.traceback);
+            }
+        }
+        Outcome::Memory { .. } => println!("  out of memory"),
+        Outcome::Killed { reason } => println!("  {reason}"),
+    }
+    match &result.subtasks {
+        Some(subtasks) => {
+            for s in subtasks {
+                println!("subtask {}: {:?}", s.subtask, s.status);
+            }
+        }
+        None => println!("subtasks: goal checks not available"),
+    }
+    if let Some(state) = &result.final_state {
+        println!("final state:\n{state}");
+    }
+}

@@ -1,0 +1,54 @@
+//! The simulator as an [`Episode`]: nesy-sim's [`Sim`] runs the robot API; after the policy
+//! it settles for the post-run steps of spec §7 and reports the observed symbolic state.
+
+use nesy_sim::{Sim, observe};
+
+use crate::episode::{Episode, EpisodeBuildError, EpisodeEnd, EpisodeFactory, EpisodeSpec};
+use crate::testing::RecordingRobot;
+
+/// Control steps the world settles after the policy ends before the goal check (spec §7:
+/// `check_result` first steps 100 times; the second 100 steps, with the final check, run
+/// only while the result is undecided, which needs the goal checks of nesy-sim).
+pub const SETTLE_STEPS: u32 = 100;
+
+impl Episode for Sim {
+    fn finish(&mut self) -> EpisodeEnd {
+        self.step_idle(SETTLE_STEPS);
+        // Goal checks (subtask results) are not available from nesy-sim yet.
+        EpisodeEnd {
+            subtasks: None,
+            final_state: Some(observe(self)),
+        }
+    }
+}
+
+/// Builds episodes from scene files with nesy-sim, and the recording test double.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SimEpisodes;
+
+impl EpisodeFactory for SimEpisodes {
+    fn build(&self, spec: &EpisodeSpec) -> Result<Box<dyn Episode>, EpisodeBuildError> {
+        match spec {
+            EpisodeSpec::Scene {
+                path,
+                embodiment,
+                render_every,
+            } => {
+                if *render_every != 0 {
+                    return Err(EpisodeBuildError(
+                        "rendering during a policy run (--render-every) is not implemented yet".to_owned(),
+                    ));
+                }
+                let mut scene = nesy_sim::SceneSpec::from_file(path)
+                    .map_err(|e| EpisodeBuildError(format!("{}: {e}", path.display())))?;
+                if let Some(embodiment) = embodiment {
+                    scene.embodiment = *embodiment;
+                }
+                let sim =
+                    Sim::new(&scene).map_err(|e| EpisodeBuildError(format!("{}: {e}", path.display())))?;
+                Ok(Box::new(sim))
+            }
+            EpisodeSpec::RecordingDouble { embodiment } => Ok(Box::new(RecordingRobot::new(*embodiment))),
+        }
+    }
+}

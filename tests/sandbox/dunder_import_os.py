@@ -1,0 +1,2 @@
+# expect: rejected
+__import__("os").system("touch @MARKER@/dunder_import")

@@ -1,0 +1,4 @@
+# expect: rejected
+import gc
+for obj in gc.get_objects():
+    pass

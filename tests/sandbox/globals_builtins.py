@@ -1,0 +1,3 @@
+# expect: rejected
+b = globals()["__builtins__"]
+b["open"]("@MARKER@/globals", "w")

@@ -1,0 +1,2 @@
+# expect: memory
+s = "x" * (4 * 10 ** 9)

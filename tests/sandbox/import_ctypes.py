@@ -1,0 +1,3 @@
+# expect: rejected
+import ctypes
+ctypes.CDLL(None).system(b"touch @MARKER@/ctypes")

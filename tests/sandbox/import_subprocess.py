@@ -1,0 +1,3 @@
+# expect: rejected
+import subprocess
+subprocess.run(["touch", "@MARKER@/subprocess"])

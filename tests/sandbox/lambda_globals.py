@@ -1,0 +1,3 @@
+# expect: rejected
+g = (lambda: 0).__globals__
+print(g)

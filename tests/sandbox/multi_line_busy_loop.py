@@ -1,0 +1,5 @@
+# expect: timeout
+x = 0
+while True:
+    x = x + 1
+    x = x - 1

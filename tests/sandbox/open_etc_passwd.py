@@ -1,0 +1,2 @@
+# expect: rejected
+print(open("/etc/passwd").read())

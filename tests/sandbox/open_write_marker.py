@@ -1,0 +1,3 @@
+# expect: rejected
+with open("@MARKER@/open_write", "w") as f:
+    f.write("escaped")

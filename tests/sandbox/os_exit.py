@@ -1,0 +1,3 @@
+# expect: rejected
+import os
+os._exit(0)

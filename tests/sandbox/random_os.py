@@ -1,0 +1,3 @@
+# expect: rejected
+import random
+random._os.system("touch @MARKER@/random_os")

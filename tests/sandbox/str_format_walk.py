@@ -1,0 +1,2 @@
+# expect: rejected
+print("{0.__class__.__base__.__subclasses__}".format(()))

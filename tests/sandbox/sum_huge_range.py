@@ -1,0 +1,2 @@
+# expect: timeout
+print(sum(range(10 ** 13)))

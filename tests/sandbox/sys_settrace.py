@@ -1,0 +1,5 @@
+# expect: rejected
+import sys
+sys.settrace(None)
+while True:
+    pass

@@ -1,0 +1,3 @@
+# expect: rejected
+T = type("T", (), {"__del__": lambda self: print("finalizer")})
+t = T()

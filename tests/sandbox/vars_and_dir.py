@@ -1,0 +1,3 @@
+# expect: rejected
+print(vars(robot))
+print(dir(robot))
