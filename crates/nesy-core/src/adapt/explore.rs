@@ -203,8 +203,11 @@ pub async fn explore<R: Reasoner>(
     // or match) and stops.
     let single_shot = !ablation.identification && !ablation.verification;
     let mut revised = false;
+    // Identification is recorded once per procedure version, not once per proposal.
+    let mut identified = false;
     loop {
-        if ablation.identification || ablation.verification {
+        if (ablation.identification || ablation.verification) && !identified {
+            identified = true;
             trace.events.push(TraceEvent::Identification {
                 iteration,
                 procedure: procedure.clone(),
@@ -335,6 +338,7 @@ pub async fn explore<R: Reasoner>(
                 procedure = applied.procedure;
                 report = new_report;
                 revised = true;
+                identified = false;
                 feedback.clear();
                 let p = progress(&report);
                 if p > best.0 {
