@@ -2,7 +2,7 @@
 
 Run with the same CPython minor version the binary links (Debian's python3.11). A fresh
 isolated interpreter imports what nesy's embedded runtime imports at start-up (the
-`encodings` package, `ast` and `string` with their dependencies); every pure-Python module
+`encodings` package and `ast` with its dependencies); every pure-Python module
 it loaded is compiled to .pyc with this interpreter and written into an uncompressed
 (STORED) zip, because zipimport would need zlib to read deflated entries. Modules frozen
 into or built into libpython are not needed and skipped.
@@ -18,7 +18,7 @@ import zipfile
 
 PROBE = """
 import sys, os, encodings
-import ast, string
+import ast
 stdlib = os.path.dirname(os.__file__)
 names = {n for n, m in list(sys.modules.items())
          if (getattr(m, '__file__', None) or '').endswith('.py') and m.__file__.startswith(stdlib + os.sep)}

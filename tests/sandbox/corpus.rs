@@ -18,8 +18,13 @@ fn corpus_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/sandbox")
 }
 
+/// The `nesy` binary under test; `NESY_SANDBOX_WORKER` points the corpus at another build
+/// (e.g. the static binary of `scripts/build-static.sh`).
 fn worker() -> WorkerCommand {
-    WorkerCommand::nesy_binary(env!("CARGO_BIN_EXE_nesy"))
+    match std::env::var_os("NESY_SANDBOX_WORKER") {
+        Some(path) => WorkerCommand::nesy_binary(path),
+        None => WorkerCommand::nesy_binary(env!("CARGO_BIN_EXE_nesy")),
+    }
 }
 
 fn limits() -> Limits {
@@ -234,4 +239,61 @@ fn worker_reports_setup_errors() {
     };
     let err = run_policy(&worker(), "pass", &spec, &limits()).unwrap_err();
     assert!(err.to_string().contains("/nonexistent/scene.json"), "{err}");
+}
+
+/// Figures for the README: the cost of one episode through the worker process against the
+/// same trivial episode in-process, and a worked example through the worker on the real
+/// simulator. Run with `cargo test --release -p nesy-cli --test sandbox_corpus -- --ignored
+/// --nocapture`.
+#[test]
+#[ignore]
+fn worker_overhead_figures() {
+    const RUNS: usize = 20;
+    let limits = Limits::default();
+    let mut worker_times = Vec::new();
+    let mut startup_times = Vec::new();
+    for _ in 0..RUNS {
+        let result = run_policy(&worker(), "pass", &double(), &limits).unwrap();
+        assert!(result.is_ok());
+        worker_times.push(result.wall_time_s);
+        startup_times.push(result.worker.unwrap().startup_s.unwrap());
+    }
+    nesy_policy::initialize().unwrap();
+    let mut local_times = Vec::new();
+    for _ in 0..RUNS {
+        let episode = Box::new(nesy_policy::testing::RecordingRobot::new(Embodiment::Finger));
+        let result = nesy_policy::run_in_process("pass", episode, &limits, None).unwrap();
+        local_times.push(result.wall_time_s);
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2] * 1e3
+    };
+    let (w, s, l) = (
+        median(&mut worker_times),
+        median(&mut startup_times),
+        median(&mut local_times),
+    );
+    println!(
+        "episode `pass`: worker {w:.2} ms (worker start-up to ready {s:.2} ms), in-process {l:.3} ms, worker overhead {:.2} ms",
+        w - l
+    );
+
+    let scene =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenes/pick_place_finger.json");
+    let source = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../nesy-policy/policies/pick_place.py"),
+    )
+    .unwrap();
+    let spec = EpisodeSpec::Scene {
+        path: scene,
+        embodiment: None,
+        render_every: 0,
+    };
+    let result = run_policy(&worker(), &source, &spec, &limits).unwrap();
+    assert!(result.is_ok(), "{:?}", result.outcome);
+    println!(
+        "pick_place.py on pick_place_finger.json through the worker: {:.1} ms",
+        result.wall_time_s * 1e3
+    );
 }

@@ -25,7 +25,7 @@ pub mod worker;
 
 pub use episode::{Episode, EpisodeBuildError, EpisodeEnd, EpisodeFactory, EpisodeSpec};
 pub use limits::Limits;
-pub use python::interpreter::{InitError, initialize};
+pub use python::interpreter::{InitError, StartupTimes, initialize};
 pub use result::{
     CapturedText, ExecutionResult, Outcome, PythonError, StaticViolation, SubtaskResult, SubtaskStatus,
     TimeLimit, TracebackFrame, WorkerReport,

@@ -135,6 +135,7 @@ impl Watchdog {
     pub(crate) fn join(mut self) {
         self.stop.store(true, Ordering::Release);
         if let Some(handle) = self.handle.take() {
+            handle.thread().unpark();
             let _ = handle.join();
         }
     }
@@ -148,7 +149,8 @@ fn watch(thread_id: std::ffi::c_long, deadline: Instant, stop: &AtomicBool) {
         } else {
             WATCHDOG_PERIOD
         };
-        std::thread::sleep(wait);
+        // Parked rather than slept, so `Watchdog::join` can wake it at once.
+        std::thread::park_timeout(wait);
         if stop.load(Ordering::Acquire) {
             return;
         }

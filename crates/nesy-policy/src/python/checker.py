@@ -1,7 +1,7 @@
 # nesy's static checks of a policy's source. Runs inside the embedded interpreter, before
 # the audit hook is armed, on the parsed AST; the policy's code is never executed here.
 import ast
-import string
+from _string import formatter_parser
 
 # Names the policy may not use at all (in addition to every name starting with "_").
 DENIED_NAMES = frozenset({
@@ -65,7 +65,7 @@ class Checker(ast.NodeVisitor):
         if not (isinstance(value, ast.Constant) and isinstance(value.value, str)):
             return False
         try:
-            fields = list(string.Formatter().parse(value.value))
+            fields = list(formatter_parser(value.value))
         except ValueError:
             return False
         stack = list(fields)
@@ -75,7 +75,7 @@ class Checker(ast.NodeVisitor):
                 return False
             if spec:
                 try:
-                    stack.extend(string.Formatter().parse(spec))
+                    stack.extend(formatter_parser(spec))
                 except ValueError:
                     return False
         return True

@@ -34,6 +34,10 @@ pub enum InitError {
 
 const CHECKER_SOURCE: &str = include_str!("checker.py");
 const NUMPY_SHIM_SOURCE: &str = include_str!("numpy_shim.py");
+/// The same sources compiled at build time by the interpreter pyo3 links (see build.rs);
+/// empty if that was not possible.
+const CHECKER_CODE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/checker.marshal"));
+const NUMPY_SHIM_CODE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/numpy_shim.marshal"));
 
 /// The stdlib zip, only in static builds (`--features embedded-stdlib`, with
 /// `NESY_STDLIB_ZIP` pointing at the zip when compiling).
@@ -42,18 +46,39 @@ const EMBEDDED_STDLIB: Option<&[u8]> = Some(include_bytes!(env!("NESY_STDLIB_ZIP
 #[cfg(not(feature = "embedded-stdlib"))]
 const EMBEDDED_STDLIB: Option<&[u8]> = None;
 
-static STARTED: OnceLock<Result<Duration, InitError>> = OnceLock::new();
+static STARTED: OnceLock<Result<StartupTimes, InitError>> = OnceLock::new();
 
-/// Starts the interpreter once per process and returns how long start-up took (including
-/// the preparation imports).
-pub fn initialize() -> Result<Duration, InitError> {
+/// How long the interpreter took to start, measured once per process.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StartupTimes {
+    /// `Py_InitializeFromConfig` with the isolated config (and the memfd stdlib, if embedded).
+    pub interpreter: Duration,
+    /// Preparing the policy runtime: importing `robot`, `math`, the static checker (with
+    /// `ast` and `string`) and compiling the `numpy` subset.
+    pub prepare: Duration,
+}
+
+impl StartupTimes {
+    /// Both phases together.
+    pub fn total(&self) -> Duration {
+        self.interpreter + self.prepare
+    }
+}
+
+/// Starts the interpreter once per process; later calls return the times of the first.
+pub fn initialize() -> Result<StartupTimes, InitError> {
     STARTED
         .get_or_init(|| {
             let t0 = Instant::now();
             // SAFETY: runs once, before anything else touches the interpreter.
             unsafe { start()? };
+            let interpreter = t0.elapsed();
+            let t1 = Instant::now();
             Python::attach(|py| prepared(py).map(|_| ()))?;
-            Ok(t0.elapsed())
+            Ok(StartupTimes {
+                interpreter,
+                prepare: t1.elapsed(),
+            })
         })
         .clone()
 }
@@ -184,28 +209,19 @@ fn prepare(py: Python<'_>) -> PyResult<Prepared> {
     builtins::register_module(py, "robot", robot.as_any())?;
     builtins::register_module(py, "math", math.as_any())?;
     // The checker runs with the real builtins: it is nesy's code and never sees the policy run.
-    let checker_module = PyModule::from_code(
+    let checker_module = PyModule::new(py, "nesy_checker")?;
+    run_module_code(
         py,
-        &std::ffi::CString::new(CHECKER_SOURCE)?,
-        c"<nesy-checker>",
-        c"nesy_checker",
+        &checker_module,
+        CHECKER_CODE,
+        CHECKER_SOURCE,
+        "<nesy-checker>",
     )?;
     let checker = checker_module.getattr("check")?.unbind();
     // The numpy subset runs with the policy's curated builtins.
     let numpy = PyModule::new(py, "numpy")?;
-    let globals: Bound<'_, PyDict> = numpy.dict();
-    globals.set_item("__builtins__", builtins::curated(py)?)?;
-    let code =
-        py.import("builtins")?
-            .getattr("compile")?
-            .call1((NUMPY_SHIM_SOURCE, "<numpy-subset>", "exec"))?;
-    // SAFETY: GIL held; `code` is a code object and `globals` a dict.
-    let ran = unsafe { ffi::PyEval_EvalCode(code.as_ptr(), globals.as_ptr(), globals.as_ptr()) };
-    if ran.is_null() {
-        return Err(PyErr::fetch(py));
-    }
-    // SAFETY: `ran` is a new reference we own.
-    unsafe { ffi::Py_DECREF(ran) };
+    numpy.dict().set_item("__builtins__", builtins::curated(py)?)?;
+    run_module_code(py, &numpy, NUMPY_SHIM_CODE, NUMPY_SHIM_SOURCE, "<numpy-subset>")?;
     builtins::register_module(py, "numpy", numpy.as_any())?;
     robot_module::set_array_constructor(py, numpy.getattr("array")?.unbind());
     budget::set_violation_type(py.get_type::<robot_module::SandboxViolation>().as_ptr());
@@ -225,4 +241,42 @@ fn prepare(py: Python<'_>) -> PyResult<Prepared> {
         api,
         noop,
     })
+}
+
+/// Executes nesy's own module code in `module`: the build-time compiled code object when it
+/// loads (same interpreter version), else the source compiled now.
+fn run_module_code(
+    py: Python<'_>,
+    module: &Bound<'_, PyModule>,
+    marshalled: &[u8],
+    source: &str,
+    file: &str,
+) -> PyResult<()> {
+    let precompiled = if marshalled.is_empty() {
+        None
+    } else {
+        py.import("marshal")?
+            .getattr("loads")?
+            .call1((pyo3::types::PyBytes::new(py, marshalled),))
+            .ok()
+    };
+    let code = match precompiled {
+        Some(code) => code,
+        None => py
+            .import("builtins")?
+            .getattr("compile")?
+            .call1((source, file, "exec"))?,
+    };
+    let globals: Bound<'_, PyDict> = module.dict();
+    if !globals.contains("__builtins__")? {
+        globals.set_item("__builtins__", py.import("builtins")?)?;
+    }
+    // SAFETY: GIL held; `code` is a code object and `globals` a dict.
+    let ran = unsafe { ffi::PyEval_EvalCode(code.as_ptr(), globals.as_ptr(), globals.as_ptr()) };
+    if ran.is_null() {
+        return Err(PyErr::fetch(py));
+    }
+    // SAFETY: `ran` is a new reference we own.
+    unsafe { ffi::Py_DECREF(ran) };
+    Ok(())
 }

@@ -6,7 +6,8 @@
 
 use std::io;
 
-/// Installs the filter on every thread of the process.
+/// Installs the filter on every thread of the process (and sets no-new-privs, which an
+/// unprivileged process needs for that).
 #[cfg(target_arch = "x86_64")]
 pub fn install() -> io::Result<()> {
     use libc::sock_filter;
@@ -139,6 +140,11 @@ pub fn install() -> io::Result<()> {
     }
     debug_assert_eq!(prog.len(), check_openat + 4);
 
+    // Unprivileged processes may only install filters with no-new-privs set.
+    // SAFETY: prctl with integer arguments.
+    if unsafe { libc::prctl(libc::PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) } != 0 {
+        return Err(io::Error::last_os_error());
+    }
     let fprog = libc::sock_fprog {
         len: prog.len() as u16,
         filter: prog.as_mut_ptr(),
