@@ -12,6 +12,13 @@
 //!   replays or records around an optional inner transport; an offline responder can be
 //!   added as another implementation without touching the client.
 //!
+//! On top of the client, the NeSyCR prompts (minijinja templates under `prompts/`, see
+//! [`prompts`]):
+//! - [`VlmReasoner`] implements nesy-core's `Reasoner` (operator induction with keyframe
+//!   images from a [`KeyframeImages`] source, refinement proposals) and offers
+//!   [`VlmReasoner::translate_state`] and [`VlmReasoner::generate_code`];
+//! - every request carries a typed [`VlmTask`] context for offline responders.
+//!
 //! ```no_run
 //! # async fn demo() -> Result<(), nesy_vlm::VlmError> {
 //! use nesy_vlm::{ChatRequest, Image, Message, Part, VlmClient, VlmConfig};
@@ -31,27 +38,44 @@
 pub mod accounting;
 pub mod cassette;
 pub mod client;
+pub mod codegen;
 pub mod config;
+pub mod context;
 pub mod error;
+pub mod keyframes;
 pub mod profile;
+pub mod prompts;
+pub mod reasoner;
 pub mod request;
 pub mod response;
 pub mod retry;
 pub mod secret;
+pub mod settings;
 mod timefmt;
+pub mod translate;
 pub mod transport;
 
 pub use accounting::{CallRecord, ModelPrice, PriceTable, RunUsage, UsageTotals};
 pub use cassette::{CassetteError, CassetteMode, CassetteOptions, CassetteTransport};
 pub use client::VlmClient;
+pub use codegen::{CodeGenerationRequest, CodegenError, PolicySource, generate_code};
 pub use config::{
     CassetteSettings, ConfigError, ConfigOverrides, EnvSource, ProcessEnv, Timeouts, VlmConfig,
 };
+pub use context::{
+    CodeGenerationContext, ContextError, Embodiment, InductionContext, PatchContext, StateTranslationContext,
+    VlmTask,
+};
 pub use error::{ProviderError, TimeoutPhase, TransportError, VlmError};
+pub use keyframes::{KeyframeImages, KeyframeList, NoKeyframes, Views};
 pub use profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, TokenCapField};
+pub use prompts::{PromptError, Prompts};
+pub use reasoner::VlmReasoner;
 pub use request::{ChatRequest, Image, ImageDetail, Message, Part, ReasoningEffort, Role, TaskContext};
 pub use response::{ChatResponse, FinishReason, Usage};
 pub use retry::RetryPolicy;
 pub use secret::SecretString;
+pub use settings::{CallSettings, PurposeSettings};
+pub use translate::{StateTranslationRequest, TranslateError, TranslatedState, translate_state};
 pub use transport::http::Auth;
 pub use transport::{BoxFuture, HttpTransport, Origin, Transport, WireRequest, WireResponse};

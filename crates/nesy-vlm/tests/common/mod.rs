@@ -2,6 +2,8 @@
 //! pointing at it, and real PNG images.
 #![allow(dead_code)]
 
+pub mod scenario;
+
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;

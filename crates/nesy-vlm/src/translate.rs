@@ -1,0 +1,202 @@
+//! State translation (the paper's Eq. 2): three marked views of a scene, the objects and
+//! the atoms already known go to the model; the reply's atom list, read with nesy-core's
+//! state-list parser and checked against the vocabulary and the objects, is added to the
+//! known atoms.
+
+use nesy_core::atom::Atom;
+use nesy_core::predicates::{Tier, Vocabulary};
+use nesy_core::state::State;
+use nesy_core::text::{ParseError, parse_state_list};
+use serde::{Deserialize, Serialize};
+
+use crate::client::VlmClient;
+use crate::context::{StateTranslationContext, VlmTask};
+use crate::error::VlmError;
+use crate::keyframes::Views;
+use crate::prompts::{PromptError, Prompts, StateTranslationPrompt};
+use crate::request::{ChatRequest, Message, Part};
+use crate::settings::CallSettings;
+
+/// What state translation needs.
+#[derive(Debug, Clone)]
+pub struct StateTranslationRequest {
+    /// Which views these are, for the task context and logs (e.g. `demo/keyframe/3`).
+    pub view_set: String,
+    /// The instruction.
+    pub instruction: String,
+    /// The scene's objects, in order.
+    pub objects: Vec<String>,
+    /// Which predicates the prompt defines (the paper uses `partial`; the world model needs
+    /// `full` or `extended`).
+    pub tier: Tier,
+    /// The vocabulary.
+    pub vocabulary: Vocabulary,
+    /// Atoms known without looking (for example the gripper's state); they are part of the
+    /// result.
+    pub known: State,
+    /// The three marked views; `None` sends a text-only request.
+    pub views: Option<Views>,
+    /// The true state when the caller has it (simulated scenes): only for offline
+    /// responders, never shown to the model.
+    pub ground_truth: Option<State>,
+}
+
+/// Why a predicted atom was not accepted.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "reason", rename_all = "snake_case")]
+pub enum Rejection {
+    /// The predicate is not in the vocabulary.
+    UnknownPredicate,
+    /// The predicate takes another number of arguments.
+    WrongArity {
+        /// Its arity.
+        expected: usize,
+    },
+    /// The predicate exists but the prompt's tier does not define it.
+    NotInTier,
+    /// An argument is not an object of the scene.
+    UnknownObject {
+        /// The argument.
+        object: String,
+    },
+}
+
+/// A predicted atom that was not accepted, and why.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RejectedAtom {
+    /// The atom as predicted.
+    pub atom: Atom,
+    /// Why it was rejected.
+    pub rejection: Rejection,
+}
+
+/// The result of a translation.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct TranslatedState {
+    /// The known atoms plus every accepted predicted atom.
+    pub state: State,
+    /// The accepted predicted atoms.
+    pub predicted: State,
+    /// Predicted atoms that were not accepted (never silently dropped: they are listed here
+    /// and logged).
+    pub rejected: Vec<RejectedAtom>,
+    /// The reply.
+    pub reply: String,
+}
+
+/// Why translation failed.
+#[derive(Debug, thiserror::Error)]
+pub enum TranslateError {
+    /// The call failed.
+    #[error("state translation call failed: {0}")]
+    Vlm(#[from] VlmError),
+    /// A prompt template failed (a defect of nesy's own files).
+    #[error(transparent)]
+    Prompt(#[from] PromptError),
+    /// The reply is not a state list.
+    #[error("state translation reply for {view_set} is not a state list: {error}")]
+    Parse {
+        /// Which views.
+        view_set: String,
+        /// The parse error, with line and column in the reply.
+        error: ParseError,
+        /// The reply.
+        reply: String,
+    },
+}
+
+/// Builds the state-translation chat request without sending it.
+pub fn build_request(
+    prompts: &Prompts,
+    request: &StateTranslationRequest,
+    settings: &CallSettings,
+) -> Result<ChatRequest, PromptError> {
+    let rendered = prompts.state_translation(&StateTranslationPrompt {
+        instruction: &request.instruction,
+        objects: &request.objects,
+        tier: request.tier,
+        vocabulary: &request.vocabulary,
+        known: &request.known,
+        images: request.views.is_some(),
+    })?;
+    let context = VlmTask::StateTranslation(StateTranslationContext {
+        view_set: request.view_set.clone(),
+        instruction: request.instruction.clone(),
+        objects: request.objects.clone(),
+        tier: request.tier,
+        known: request.known.clone(),
+        ground_truth: request.ground_truth.clone(),
+    });
+    let mut parts = vec![Part::text(rendered.user)];
+    if let Some(views) = &request.views {
+        parts.extend(views.parts("The scene"));
+    }
+    let chat = ChatRequest::new()
+        .purpose(context.purpose())
+        .task(context.to_task_context())
+        .message(Message::system(rendered.system))
+        .message(Message::user(parts));
+    Ok(settings.apply(chat))
+}
+
+/// Checks predicted atoms against the vocabulary, the tier and the objects.
+pub fn check_atoms(
+    predicted: &State,
+    vocabulary: &Vocabulary,
+    tier: Tier,
+    objects: &[String],
+) -> (State, Vec<RejectedAtom>) {
+    let in_tier: Vec<_> = vocabulary.tier(tier).iter().map(|p| p.name).collect();
+    let mut accepted = Vec::new();
+    let mut rejected = Vec::new();
+    for atom in predicted.sorted_by_text() {
+        let rejection = match vocabulary.get(atom.pred()) {
+            None => Some(Rejection::UnknownPredicate),
+            Some(p) if p.arity != atom.args().len() => Some(Rejection::WrongArity { expected: p.arity }),
+            Some(_) if !in_tier.contains(&atom.pred()) => Some(Rejection::NotInTier),
+            Some(_) => atom
+                .args()
+                .iter()
+                .find(|a| !objects.iter().any(|o| o == a.as_str()))
+                .map(|a| Rejection::UnknownObject {
+                    object: a.to_string(),
+                }),
+        };
+        match rejection {
+            None => accepted.push(*atom),
+            Some(rejection) => rejected.push(RejectedAtom {
+                atom: *atom,
+                rejection,
+            }),
+        }
+    }
+    (State::from_atoms(accepted), rejected)
+}
+
+/// Asks the model for the scene's atoms and returns the known atoms plus the accepted
+/// predictions.
+pub async fn translate_state(
+    client: &VlmClient,
+    prompts: &Prompts,
+    request: &StateTranslationRequest,
+    settings: &CallSettings,
+) -> Result<TranslatedState, TranslateError> {
+    let chat = build_request(prompts, request, settings)?;
+    let reply = client.chat(chat).await?.text;
+    let parsed = parse_state_list(&reply).map_err(|error| TranslateError::Parse {
+        view_set: request.view_set.clone(),
+        error,
+        reply: reply.clone(),
+    })?;
+    let (predicted, rejected) = check_atoms(&parsed, &request.vocabulary, request.tier, &request.objects);
+    for r in &rejected {
+        tracing::warn!(view_set = %request.view_set, atom = %r.atom, rejection = ?r.rejection, "rejected a predicted atom");
+    }
+    let state = State::from_atoms(request.known.iter().chain(predicted.iter()).copied());
+    Ok(TranslatedState {
+        state,
+        predicted,
+        rejected,
+        reply,
+    })
+}

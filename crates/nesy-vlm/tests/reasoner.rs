@@ -1,0 +1,321 @@
+//! `VlmReasoner` driven through nesy-core's adaptation loop by an in-process transport that
+//! answers in real-model style: prose around the answers, odd bullets and headers, a wrong
+//! operator the verifier rejects and that is re-predicted, a patch whose SEARCH block
+//! matches nothing and is then fixed; then code generation and state translation on the
+//! same client, with per-purpose accounting and typed task contexts.
+
+mod common;
+
+use std::collections::{BTreeMap, VecDeque};
+use std::sync::{Arc, Mutex};
+
+use common::scenario;
+use nesy_core::adapt::{Outcome, Problem, TraceEvent, Verdict, run};
+use nesy_core::predicates::{Tier, Vocabulary};
+use nesy_vlm::{
+    BackendKind, BoxFuture, CodeGenerationRequest, CodegenError, Embodiment, Image, Origin,
+    StateTranslationRequest, TranslateError, Transport, TransportError, Views, VlmClient, VlmReasoner,
+    VlmTask, WireRequest, WireResponse,
+};
+
+/// Answers each purpose from its own queue of replies and keeps every request.
+#[derive(Debug, Default)]
+struct Scripted {
+    replies: Mutex<BTreeMap<String, VecDeque<String>>>,
+    seen: Mutex<Vec<WireRequest>>,
+}
+
+impl Scripted {
+    fn with(replies: &[(&str, &[&str])]) -> Arc<Self> {
+        let map = replies
+            .iter()
+            .map(|(purpose, texts)| (purpose.to_string(), texts.iter().map(|t| t.to_string()).collect()))
+            .collect();
+        Arc::new(Scripted {
+            replies: Mutex::new(map),
+            seen: Mutex::default(),
+        })
+    }
+
+    fn requests(&self, purpose: &str) -> Vec<WireRequest> {
+        self.seen
+            .lock()
+            .unwrap()
+            .iter()
+            .filter(|r| r.purpose.as_deref() == Some(purpose))
+            .cloned()
+            .collect()
+    }
+}
+
+impl Transport for Scripted {
+    fn send<'a>(&'a self, request: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
+        Box::pin(async move {
+            self.seen.lock().unwrap().push(request.clone());
+            let purpose = request.purpose.clone().unwrap_or_default();
+            let reply = self
+                .replies
+                .lock()
+                .unwrap()
+                .get_mut(&purpose)
+                .and_then(VecDeque::pop_front)
+                .ok_or_else(|| TransportError::Failed {
+                    message: format!("script has no reply left for purpose {purpose:?}"),
+                    retryable: false,
+                })?;
+            let body = common::completion(&reply);
+            Ok(WireResponse::new(
+                200,
+                serde_json::to_vec(&body).unwrap(),
+                Origin::Offline,
+            ))
+        })
+    }
+
+    fn label(&self) -> String {
+        "scripted".into()
+    }
+}
+
+fn client(transport: Arc<Scripted>) -> VlmClient {
+    let config = common::config(BackendKind::OpenAi, "gpt-5", "http://127.0.0.1:9");
+    VlmClient::with_transport(&config, transport)
+}
+
+fn messages(request: &WireRequest) -> &Vec<serde_json::Value> {
+    request.body["messages"].as_array().unwrap()
+}
+
+fn image_count(message: &serde_json::Value) -> usize {
+    message["content"].as_array().map_or(0, |parts| {
+        parts.iter().filter(|p| p["type"] == "image_url").count()
+    })
+}
+
+fn text_of(message: &serde_json::Value) -> String {
+    match &message["content"] {
+        serde_json::Value::String(s) => s.clone(),
+        serde_json::Value::Array(parts) => parts
+            .iter()
+            .filter_map(|p| p["text"].as_str())
+            .collect::<Vec<_>>()
+            .join("\n"),
+        other => panic!("unexpected content {other}"),
+    }
+}
+
+#[tokio::test]
+async fn the_loop_recovers_from_a_rejected_operator_and_a_non_matching_patch() {
+    let transport = Scripted::with(&[
+        (
+            "induce",
+            &[
+                scenario::APPROACH,
+                scenario::GRASP_WRONG,
+                scenario::GRASP,
+                scenario::CARRY,
+                scenario::DROP,
+            ],
+        ),
+        ("patch", &[scenario::PATCH_NO_MATCH, scenario::PATCH]),
+    ]);
+    let mut reasoner = VlmReasoner::new(client(transport.clone()))
+        .unwrap()
+        .with_keyframes(scenario::keyframes())
+        .with_embodiments(Embodiment::Finger, Embodiment::Finger);
+    let adaptation = run(
+        &mut reasoner,
+        &scenario::demo(),
+        &scenario::target(),
+        &scenario::config(),
+    )
+    .await
+    .unwrap();
+
+    // The world model verified every transition; the wrong grasp was rejected first.
+    assert!(adaptation.world_model.unverified_steps.is_empty());
+    let rejected: Vec<_> = adaptation
+        .trace
+        .events
+        .iter()
+        .filter_map(|e| match e {
+            TraceEvent::Induction {
+                step,
+                verdict: Verdict::Rejected { feedback },
+                ..
+            } => Some((*step, feedback.problem.clone())),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(rejected.len(), 1);
+    assert_eq!(rejected[0].0, 1);
+    assert!(matches!(rejected[0].1, Problem::EffectMismatch { .. }));
+
+    // The closed lid was found, the bad patch rejected, the good one accepted.
+    let Outcome::Adapted {
+        procedure,
+        iterations,
+        ..
+    } = &adaptation.outcome
+    else {
+        panic!("not adapted: {:#?}", adaptation.outcome);
+    };
+    assert_eq!(*iterations, 2);
+    let names: Vec<&str> = procedure.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "GraspHingeHandle",
+            "SwingHingeLidOpen",
+            "ReleaseHingeHandle",
+            "MoveGripperToSurroundApple",
+            "CloseGripperToGraspApple",
+            "MoveHeldAppleOverHingeBody",
+            "OpenGripperToDropAppleIntoHingeBody",
+        ]
+    );
+
+    // Induction requests: six labelled images, the task context with the recorded call, and
+    // on re-prediction the rejected reply and the verifier's message as follow-up turns.
+    let induce = transport.requests("induce");
+    assert_eq!(induce.len(), 5);
+    for request in &induce {
+        assert_eq!(image_count(&messages(request)[1]), 6);
+        let text = text_of(&messages(request)[1]);
+        assert!(
+            text.contains("Before the action, top view:") && text.contains("After the action, back view:")
+        );
+    }
+    let retry = messages(&induce[2]);
+    assert_eq!(retry.len(), 4);
+    assert_eq!(retry[2]["role"], "assistant");
+    assert_eq!(text_of(&retry[2]), scenario::GRASP_WRONG);
+    let feedback = text_of(&retry[3]);
+    assert!(
+        feedback.contains("rejected this answer (attempt 1)"),
+        "{feedback}"
+    );
+    assert!(feedback.contains("- (GripperSurrounding apple)"), "{feedback}");
+    let VlmTask::Induction(context) = VlmTask::from_task_context(induce[2].task.as_ref().unwrap()).unwrap()
+    else {
+        panic!("an induction request carries an induction context");
+    };
+    assert_eq!((context.request.step, context.request.attempt), (1, 1));
+    assert_eq!(context.demo_call.unwrap()["call"], "close_gripper");
+    assert_eq!(context.embodiment, Embodiment::Finger);
+    assert_eq!(context.request.feedback.len(), 1);
+
+    // Patch requests are text only; the second carries the failed proposal and why.
+    let patch = transport.requests("patch");
+    assert_eq!(patch.len(), 2);
+    assert!(
+        patch
+            .iter()
+            .all(|r| messages(r).iter().all(|m| image_count(m) == 0))
+    );
+    let first = text_of(&messages(&patch[0])[1]);
+    assert!(
+        first.contains("- Unfulfilled preconditions:\n- (Open hinge_lid)"),
+        "{first}"
+    );
+    assert!(
+        first.contains("- Erroneous action:\nOpenGripperToDropAppleIntoHingeBody\n"),
+        "{first}"
+    );
+    let second = messages(&patch[1]);
+    assert_eq!(second.len(), 4);
+    assert!(
+        text_of(&second[3]).contains("The patch was not applied"),
+        "{}",
+        text_of(&second[3])
+    );
+    let VlmTask::Patch(context) = VlmTask::from_task_context(patch[1].task.as_ref().unwrap()).unwrap() else {
+        panic!("a patch request carries a patch context");
+    };
+    assert_eq!(context.request.failing_step, Some(3));
+    assert_eq!(context.target_embodiment, Embodiment::Finger);
+
+    // Code generation on the adapted procedure; the foreign import is stripped and recorded.
+    let codegen = Scripted::with(&[("codegen", &[scenario::CODE, "Sorry, I cannot help with that."])]);
+    let reasoner = VlmReasoner::new(client(codegen.clone())).unwrap();
+    let request = CodeGenerationRequest {
+        instruction: "Put the fruits in the hinge box.".into(),
+        objects: scenario::OBJECTS.iter().map(|o| o.to_string()).collect(),
+        procedure: procedure.clone(),
+        embodiment: Embodiment::Finger,
+        extended: false,
+    };
+    let policy = reasoner.generate_code(&request).await.unwrap();
+    assert!(
+        policy
+            .code
+            .starts_with("import numpy as np\n\nmove_gripper_to(\"hinge_handle\"")
+    );
+    assert!(policy.code.ends_with("open_gripper()\n"));
+    assert_eq!(policy.stripped.len(), 1);
+    assert!(policy.stripped[0].text.starts_with("from robot_api import"));
+    assert!(!policy.extended);
+    let sent = &codegen.requests("codegen")[0];
+    let user = text_of(&messages(sent)[1]);
+    assert!(
+        user.contains("- Demonstration summary:\n1. GraspHingeHandle\n2. SwingHingeLidOpen\n"),
+        "{user}"
+    );
+    let VlmTask::CodeGeneration(context) = VlmTask::from_task_context(sent.task.as_ref().unwrap()).unwrap()
+    else {
+        panic!("a code generation context");
+    };
+    assert_eq!(context.action_names[6], "7. OpenGripperToDropAppleIntoHingeBody");
+    assert_eq!(context.procedure, *procedure);
+    // A reply without code is a typed error that keeps the reply.
+    match reasoner.generate_code(&request).await {
+        Err(CodegenError::NoProgram { reply, .. }) => assert!(reply.starts_with("Sorry")),
+        other => panic!("{other:?}"),
+    }
+    let usage = reasoner.client().usage();
+    assert_eq!(usage.by_purpose["codegen"].calls, 2);
+}
+
+#[tokio::test]
+async fn state_translation_adds_checked_atoms_to_the_known_ones() {
+    let transport = Scripted::with(&[("translate", &[scenario::TRANSLATION, "I see a table."])]);
+    let reasoner = VlmReasoner::new(client(transport.clone())).unwrap();
+    let png = |seed| Image::png(common::png(16, seed)).unwrap();
+    let request = StateTranslationRequest {
+        view_set: "target/initial".into(),
+        instruction: "Put the fruits in the hinge box.".into(),
+        objects: scenario::OBJECTS.iter().map(|o| o.to_string()).collect(),
+        tier: Tier::Full,
+        vocabulary: Vocabulary::new(),
+        known: scenario::state(&["(GripperOpen)"]),
+        views: Some(Views {
+            top: png(1),
+            front: png(2),
+            back: png(3),
+        }),
+        ground_truth: Some(scenario::target().init),
+    };
+    let translated = reasoner.translate_state(&request).await.unwrap();
+    assert_eq!(translated.state, scenario::target().init);
+    assert_eq!(translated.rejected.len(), 1);
+    assert_eq!(translated.rejected[0].atom.to_string(), "(OnTopOf banana floor)");
+    let sent = &transport.requests("translate")[0];
+    assert_eq!(image_count(&messages(sent)[1]), 3);
+    let VlmTask::StateTranslation(context) = VlmTask::from_task_context(sent.task.as_ref().unwrap()).unwrap()
+    else {
+        panic!("a state translation context");
+    };
+    assert_eq!(context.ground_truth, Some(scenario::target().init));
+    // The ground truth never reaches the wire.
+    assert!(!sent.body.to_string().contains("Closed hinge_lid"));
+
+    match reasoner.translate_state(&request).await {
+        Err(TranslateError::Parse { error, reply, .. }) => {
+            assert_eq!(reply, "I see a table.");
+            assert_eq!(error.line, 1);
+        }
+        other => panic!("{other:?}"),
+    }
+    let usage = reasoner.client().usage();
+    assert_eq!(usage.by_purpose["translate"].calls, 2);
+}
