@@ -264,7 +264,12 @@ fn prompts(c: &mut Criterion) {
         }
     }
     let mut recorder = Recorder {
-        replies: vec![scenario::APPROACH, scenario::GRASP, scenario::CARRY, scenario::DROP],
+        replies: vec![
+            scenario::APPROACH,
+            scenario::GRASP,
+            scenario::CARRY,
+            scenario::DROP,
+        ],
         patches: vec![scenario::PATCH],
         ..Recorder::default()
     };
@@ -290,7 +295,9 @@ fn prompts(c: &mut Criterion) {
         &VlmConfig::new(BackendKind::OpenAi, "gpt-5"),
         Arc::new(common::InFlightCounter::new(Arc::new(NeverSends))),
     );
-    let reasoner = nesy_vlm::VlmReasoner::new(client).expect("prompts").with_keyframes(keyframes);
+    let reasoner = nesy_vlm::VlmReasoner::new(client)
+        .expect("prompts")
+        .with_keyframes(keyframes);
     let prompts = nesy_vlm::Prompts::builtin().expect("prompts");
     let codegen = nesy_vlm::CodeGenerationRequest {
         instruction: "Put the fruits in the hinge box.".into(),
@@ -301,7 +308,11 @@ fn prompts(c: &mut Criterion) {
     };
     let mut group = c.benchmark_group("prompts");
     group.bench_function("induction_request_6_rendered_images", |b| {
-        b.iter(|| reasoner.induction_request(&recorder.induction[3]).expect("renders"))
+        b.iter(|| {
+            reasoner
+                .induction_request(&recorder.induction[3])
+                .expect("renders")
+        })
     });
     group.bench_function("refinement_request", |b| {
         b.iter(|| reasoner.patch_request(&recorder.patch[0]).expect("renders"))

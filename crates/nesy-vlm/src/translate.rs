@@ -34,8 +34,8 @@ pub struct StateTranslationRequest {
     /// Atoms known without looking (for example the gripper's state); they are part of the
     /// result.
     pub known: State,
-    /// The three marked views; `None` sends a text-only request.
-    pub views: Option<Views>,
+    /// The three marked views of the scene.
+    pub views: Views,
     /// The true state when the caller has it (simulated scenes): only for offline
     /// responders, never shown to the model.
     pub ground_truth: Option<State>,
@@ -117,7 +117,7 @@ pub fn build_request(
         tier: request.tier,
         vocabulary: &request.vocabulary,
         known: &request.known,
-        images: request.views.is_some(),
+        images: true,
     })?;
     let context = VlmTask::StateTranslation(StateTranslationContext {
         view_set: request.view_set.clone(),
@@ -128,9 +128,7 @@ pub fn build_request(
         ground_truth: request.ground_truth.clone(),
     });
     let mut parts = vec![Part::text(rendered.user)];
-    if let Some(views) = &request.views {
-        parts.extend(views.parts("The scene"));
-    }
+    parts.extend(request.views.parts("The scene"));
     let chat = ChatRequest::new()
         .purpose(context.purpose())
         .task(context.to_task_context())

@@ -323,17 +323,16 @@ fn state_translation_prompts() {
         tier: Tier::Full,
         vocabulary: Vocabulary::new(),
         known: scenario::state(&["(GripperOpen)"]),
-        views: Some(views(5)),
+        views: views(5),
         ground_truth: Some(scenario::target().init),
     };
     let full = nesy_vlm::translate::build_request(prompts, &request, &Default::default()).unwrap();
     roundtrip(&full);
     assert_snapshot("state_translation_full_images", &render(&full));
     request.tier = Tier::Partial;
-    request.views = None;
     request.known = Default::default();
     let partial = nesy_vlm::translate::build_request(prompts, &request, &Default::default()).unwrap();
-    assert_snapshot("state_translation_partial_text_only", &render(&partial));
+    assert_snapshot("state_translation_partial", &render(&partial));
     assert!(
         !render(&partial).contains("Open hinge_lid"),
         "partial tier examples hold no Open/Closed"

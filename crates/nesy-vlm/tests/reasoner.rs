@@ -288,11 +288,11 @@ async fn state_translation_adds_checked_atoms_to_the_known_ones() {
         tier: Tier::Full,
         vocabulary: Vocabulary::new(),
         known: scenario::state(&["(GripperOpen)"]),
-        views: Some(Views {
+        views: Views {
             top: png(1),
             front: png(2),
             back: png(3),
-        }),
+        },
         ground_truth: Some(scenario::target().init),
     };
     let translated = reasoner.translate_state(&request).await.unwrap();

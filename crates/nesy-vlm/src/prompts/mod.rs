@@ -123,7 +123,8 @@ pub struct StateTranslationPrompt<'a> {
     pub vocabulary: &'a Vocabulary,
     /// Atoms given as already known (may be empty).
     pub known: &'a State,
-    /// Whether images follow the text.
+    /// Whether images follow the text (always, for requests built by
+    /// [`crate::translate::build_request`]).
     pub images: bool,
 }
 
