@@ -13,6 +13,11 @@ use crate::sim::{FLOOR_AABB, HandleGrasp, Sim, TABLE_TOP};
 
 /// Largest distance between the tool and a handle's centre for a grasp (spec §4).
 pub const HANDLE_REACH: f64 = 0.1;
+/// Deepest `move_gripper_to` depth for the finger gripper (m): the palm's underside is
+/// 3.4 cm above the pads' centre, so a deeper target would drive the palm into the object's
+/// top (the kinematic arm would crush it). Deeper requests stop here, as a real hand stops on
+/// contact.
+pub const MAX_FINGER_DEPTH: f64 = 0.027;
 /// Control steps for the fingers to open or close (0.04 m at 0.2 m/s takes 20).
 const GRIPPER_STEPS: u32 = 25;
 
@@ -263,7 +268,8 @@ impl Sim {
         let depth = match self.scene.embodiment {
             Embodiment::Vacuum if is_handle => -0.01,
             Embodiment::Vacuum => 0.0,
-            Embodiment::Finger => depth,
+            // The palm is 3.4 cm above the pads' centre: deeper, it would press on the object.
+            Embodiment::Finger => depth.min(MAX_FINGER_DEPTH),
         };
         let dir = pointing.unit();
         let axis = dir.iter().position(|v| v.abs() > 0.5).unwrap_or(2);
@@ -312,7 +318,7 @@ impl Sim {
             }],
             dir,
         )?;
-        self.execute(&plan, SETTLE_STEPS);
+        self.execute_at_least(&plan, SETTLE_STEPS, crate::motion::PARALLEL_MIN_DURATION);
         self.moved_since_reset = true;
         Ok(())
     }

@@ -9,16 +9,20 @@
 
 pub mod api;
 mod api_impl;
+pub mod expert;
 pub mod floor;
 pub mod geometry;
+pub mod goal;
 pub mod kinematics;
 pub mod motion;
 pub mod objects;
 pub mod observer;
 pub mod render;
+pub mod rng;
 pub mod robot;
 pub mod scene;
 pub mod sim;
+pub mod task;
 
 pub use api::{ApiCall, ApiError, ApiValue, Direction, Embodiment, RobotApi, TraceEntry};
 pub use api_impl::HANDLE_REACH;

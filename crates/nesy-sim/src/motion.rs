@@ -24,6 +24,9 @@ const TOOL_SPEED: f64 = 0.2;
 const JOINT_SPEED: f64 = 0.8;
 /// Shortest segment duration (s).
 const MIN_SEGMENT: f64 = 0.25;
+/// Shortest duration of a `move_parallel` (s): the authors' 80 interpolation steps. Pushes
+/// (sweeping) then accelerate gently enough that tall pieces slide instead of tipping.
+pub const PARALLEL_MIN_DURATION: f64 = 0.8;
 /// Spacing of IK samples along a straight segment (m).
 const SAMPLE_SPACING: f64 = 0.015;
 /// Control steps the world runs after a motion so objects come to rest.
@@ -149,6 +152,11 @@ impl Sim {
 
     /// Plays planned segments back with eased timing, then settles.
     pub(crate) fn execute(&mut self, segments: &[Vec<Vec<f64>>], settle: u32) {
+        self.execute_at_least(segments, settle, MIN_SEGMENT);
+    }
+
+    /// [`Sim::execute`] with a longer shortest segment duration (s).
+    pub(crate) fn execute_at_least(&mut self, segments: &[Vec<Vec<f64>>], settle: u32, min_segment: f64) {
         for path in segments {
             let (cumulative, total) = path_lengths(path);
             let tool_len = {
@@ -164,7 +172,7 @@ impl Sim {
             let joint_len = path.windows(2).map(|w| max_delta(&w[0], &w[1])).sum::<f64>();
             let duration = (tool_len / TOOL_SPEED)
                 .max(joint_len / JOINT_SPEED)
-                .max(MIN_SEGMENT);
+                .max(min_segment);
             let steps = (duration / CONTROL_DT).ceil() as usize;
             for k in 1..=steps {
                 let s = ease(k as f64 / steps as f64);

@@ -12,6 +12,23 @@ pub const DENSITY: f32 = 200.0;
 /// Friction coefficient of every object.
 pub const FRICTION: f32 = 1.0;
 
+/// Friction coefficient of chess pieces, combined with the other collider's by `Min`: a
+/// pushed piece must slide across the board and into its box rather than tip over its
+/// leading edge (with friction 1.0 the tall pieces tipped whenever the push started), while
+/// 0.3 still lets them stop within a few millimetres once the push ends.
+pub const PIECE_FRICTION: f32 = 0.3;
+
+/// Friction of a kind's colliders and how it combines with the other collider's.
+pub fn friction(kind: ObjectKind) -> (f32, rapier3d::prelude::CoefficientCombineRule) {
+    use rapier3d::prelude::CoefficientCombineRule;
+    match kind {
+        ObjectKind::Rook | ObjectKind::Knight | ObjectKind::Bishop => {
+            (PIECE_FRICTION, CoefficientCombineRule::Min)
+        }
+        _ => (FRICTION, CoefficientCombineRule::Average),
+    }
+}
+
 /// How a part moves.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PartMotion {
@@ -126,6 +143,29 @@ fn upright_cylinder(radius: f32, z0: f32, z1: f32, colour: [f32; 3]) -> ShapeBui
     }
 }
 
+/// An upright "rounded" column built from `count` square cuboids turned by 90°/count
+/// against each other (a star with `4·count` points on a circle of `radius`). Chess pieces use
+/// it instead of cylinders: Rapier re-uses cylinder–box contact manifolds, normals included,
+/// while the relative motion stays small, so a piece pushed along the board kept a tilted
+/// normal, sank and tipped; box–box manifolds are exact every step.
+fn upright_star(radius: f32, z0: f32, z1: f32, count: usize, colour: [f32; 3]) -> Vec<ShapeBuild> {
+    let half = radius * std::f32::consts::FRAC_1_SQRT_2;
+    (0..count)
+        .map(|k| {
+            let yaw = k as f32 * std::f32::consts::FRAC_PI_2 / count as f32;
+            ShapeBuild {
+                shape: SharedShape::cuboid(half, half, (z1 - z0) / 2.0),
+                local: Pose::from_parts(
+                    v(0.0, 0.0, (z0 + z1) / 2.0),
+                    rapier3d::prelude::Rotation::from_rotation_z(yaw),
+                ),
+                colour,
+                pattern: Pattern::Plain,
+            }
+        })
+        .collect()
+}
+
 fn upright() -> rapier3d::prelude::Rotation {
     rapier3d::prelude::Rotation::from_rotation_x(std::f32::consts::FRAC_PI_2)
 }
@@ -142,6 +182,28 @@ fn open_box(s: [f32; 3], t: f32, colour: [f32; 3]) -> Vec<ShapeBuild> {
     ]
 }
 
+/// A chess box: a tray whose floor is just below the chess board's top, walled on three
+/// sides and open on its local +y side, which faces the board (the right box is turned by
+/// π). Pieces swept off the board slide straight in; a step down would make them tip.
+fn chess_box(s: [f32; 3], colour: [f32; 3]) -> Vec<ShapeBuild> {
+    let t = 0.003_f32;
+    let [sx, sy, sz] = s;
+    let floor = (CHESS_FLOOR - CHESS_BOX_STEP) as f32;
+    vec![
+        cuboid([sx, sy, floor], [0.0, 0.0, floor / 2.0], colour),
+        cuboid([t, sy, sz], [-(sx - t) / 2.0, 0.0, sz / 2.0], colour),
+        cuboid([t, sy, sz], [(sx - t) / 2.0, 0.0, sz / 2.0], colour),
+        cuboid([sx - 2.0 * t, t, sz], [0.0, -(sy - t) / 2.0, sz / 2.0], colour),
+    ]
+}
+
+/// Height of the chess board's top above the table (m).
+pub const CHESS_FLOOR: f64 = 0.007;
+/// How far a chess box's floor lies below the board's top (m): a flush seam catches the
+/// leading edge of a sliding piece and tips it, while a small step lets the base drop onto
+/// the floor as it slides in (3 mm is the value the sweep tests were tuned with).
+pub const CHESS_BOX_STEP: f64 = 0.003;
+
 /// Nominal outer size of a kind `[x, y, z]`.
 pub fn nominal_size(kind: ObjectKind) -> [f64; 3] {
     match kind {
@@ -153,7 +215,7 @@ pub fn nominal_size(kind: ObjectKind) -> [f64; 3] {
         ObjectKind::Rook => [0.0295, 0.0295, 0.051],
         ObjectKind::Knight => [0.0295, 0.0295, 0.059],
         ObjectKind::Bishop => [0.0295, 0.0295, 0.065],
-        ObjectKind::ChessBoard => [0.17, 0.09, 0.03],
+        ObjectKind::ChessBoard => [0.17, 0.094, CHESS_FLOOR],
         ObjectKind::ChessBox => [0.16, 0.08, 0.0245],
         ObjectKind::ToyBox => [0.139, 0.0985, 0.045],
         ObjectKind::HingeBox => [0.1025, 0.205, 0.1165],
@@ -235,14 +297,14 @@ fn chess_piece(kind: ObjectKind, size: [f32; 3], colour: [f32; 3]) -> Vec<ShapeB
     let h = size[2];
     let base = 0.22 * h;
     let neck_r = r * 0.62;
-    let mut shapes = vec![upright_cylinder(r, 0.0, base, colour)];
+    let mut shapes = upright_star(r, 0.0, base, 3, colour);
     match kind {
         ObjectKind::Rook => {
-            shapes.push(upright_cylinder(neck_r, base, h * 0.75, colour));
-            shapes.push(upright_cylinder(r * 0.85, h * 0.75, h, colour));
+            shapes.extend(upright_star(neck_r, base, h * 0.75, 2, colour));
+            shapes.extend(upright_star(r * 0.85, h * 0.75, h, 2, colour));
         }
         ObjectKind::Knight => {
-            shapes.push(upright_cylinder(neck_r, base, h * 0.6, colour));
+            shapes.extend(upright_star(neck_r, base, h * 0.6, 2, colour));
             shapes.push(cuboid(
                 [r * 1.3, r * 1.9, h * 0.4],
                 [0.0, r * 0.25, h * 0.8],
@@ -250,8 +312,9 @@ fn chess_piece(kind: ObjectKind, size: [f32; 3], colour: [f32; 3]) -> Vec<ShapeB
             ));
         }
         _ => {
-            shapes.push(upright_cylinder(neck_r * 0.9, base, h * 0.7, colour));
-            let head = r * 0.62;
+            shapes.extend(upright_star(neck_r * 0.9, base, h * 0.7, 2, colour));
+            // No wider than the neck, so a finger pushing the neck does not catch the head.
+            let head = neck_r * 0.9;
             shapes.push(ShapeBuild {
                 shape: SharedShape::ball(head),
                 local: at(0.0, 0.0, h - head),
@@ -289,7 +352,7 @@ pub fn build_object(spec: &ObjectSpec) -> Vec<PartBuild> {
             };
             vec![fixed(&spec.name, PartRole::Fixed, vec![board])]
         }
-        ObjectKind::ChessBox => vec![fixed(&spec.name, PartRole::Fixed, open_box(s, 0.003, colour))],
+        ObjectKind::ChessBox => vec![fixed(&spec.name, PartRole::Fixed, chess_box(s, colour))],
         ObjectKind::ToyBox => vec![fixed(&spec.name, PartRole::Fixed, open_box(s, 0.004, colour))],
         ObjectKind::HingeBox => hinge_box(colour),
         ObjectKind::DrawerCabinet => drawer_cabinet(colour),

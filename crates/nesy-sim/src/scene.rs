@@ -254,6 +254,47 @@ pub struct Placement {
 }
 
 impl SubtaskGoal {
+    /// The subtask type.
+    pub fn kind(&self) -> crate::task::SubtaskKind {
+        use crate::task::SubtaskKind;
+        match self {
+            SubtaskGoal::PickPlace { .. } => SubtaskKind::PickPlace,
+            SubtaskGoal::Sweep { .. } => SubtaskKind::Sweep,
+            SubtaskGoal::PutInHinge { .. } => SubtaskKind::PutInHinge,
+            SubtaskGoal::PutInPrismatic { .. } => SubtaskKind::PutInPrismatic,
+        }
+    }
+
+    /// The objects to be placed, in label order.
+    pub fn objects(&self) -> Vec<&str> {
+        match self {
+            SubtaskGoal::PickPlace { objects, .. }
+            | SubtaskGoal::PutInHinge { objects, .. }
+            | SubtaskGoal::PutInPrismatic { objects, .. } => objects.iter().map(String::as_str).collect(),
+            SubtaskGoal::Sweep { placements } => placements.iter().map(|p| p.object.as_str()).collect(),
+        }
+    }
+
+    /// The name recorded when the articulated container is closed after its objects:
+    /// `hinge` for the hinge box, the drawer's name (`bottom_drawer`) for the cabinet.
+    pub fn closure_label(&self) -> Option<&str> {
+        match self {
+            SubtaskGoal::PutInHinge { .. } => Some("hinge"),
+            SubtaskGoal::PutInPrismatic { drawer, .. } => Some(drawer),
+            _ => None,
+        }
+    }
+
+    /// The goal label of spec §2: the objects in order, then the closure for the
+    /// articulated subtasks.
+    pub fn label(&self) -> Vec<String> {
+        self.objects()
+            .into_iter()
+            .chain(self.closure_label())
+            .map(str::to_owned)
+            .collect()
+    }
+
     /// Every object name the goal refers to, with the JSON field holding it.
     pub fn referenced_names(&self) -> Vec<(String, &str)> {
         match self {

@@ -1,0 +1,369 @@
+//! Scripted experts: one per subtask, driving only the public [`RobotApi`] on either
+//! embodiment and at every obstruction level. They follow the authors' demo recipes
+//! (spec §2, "Demo") adapted to this simulator; the README lists the differences.
+//!
+//! The experts decide what to do from perception calls (`get_obj_bbox`, ...), not from the
+//! generator's obstruction level: a stack is cleared when something rests on a cube, a piece
+//! is lifted back to the board when it is in a box, the fruit on the lid is moved away when
+//! there is one, and lids and drawers are opened when they are closed.
+
+use crate::api::{ApiError, Direction, Embodiment, RobotApi};
+use crate::scene::SubtaskGoal;
+use crate::task::SubtaskKind;
+
+/// Why an expert stopped.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{subtask} expert: {step} failed: {error}")]
+pub struct ExpertError {
+    /// The subtask it was working on.
+    pub subtask: SubtaskKind,
+    /// The call that failed, e.g. `move_gripper_to(red_cube)`.
+    pub step: String,
+    /// The robot's answer.
+    pub error: ApiError,
+}
+
+/// Cells of the toy box the cubes are dropped into (offsets from its centre, m): three
+/// along the long side, two across; placed cubes are square to the box (the wrist turns to
+/// yaw 0 on the way), so they fit side by side.
+const TOY_BOX_CELLS: [[f64; 2]; 6] = [
+    [-0.042, -0.022],
+    [0.0, -0.022],
+    [0.042, -0.022],
+    [-0.042, 0.022],
+    [0.0, 0.022],
+    [0.042, 0.022],
+];
+/// Fruit drop spots along the hinge box's long side (y offsets, m): fruits are round with a
+/// flat base and do not roll aside when dropped onto each other.
+const HINGE_SPOTS: [f64; 3] = [-0.06, 0.0, 0.06];
+/// Cylinder drop spots in the bottom drawer (x offset, outward y offset from the drawer's
+/// centre, m), 4.5 cm or more apart: a cylinder dropped onto another one tips over, and one
+/// lying on its side rolls on without stopping (Rapier has no rolling resistance).
+const DRAWER_SPOTS: [[f64; 2]; 3] = [[-0.045, 0.0], [0.045, 0.0], [0.0, 0.04]];
+/// Height above the release point at which a carried object is let go over a container.
+const DROP_CLEARANCE: f64 = 0.01;
+/// Height of the table top.
+const TABLE: f64 = 0.5;
+
+/// The robot with the subtask being worked on, for error reports.
+struct Hand<'a, R: RobotApi + ?Sized> {
+    robot: &'a mut R,
+    subtask: SubtaskKind,
+    vacuum: bool,
+}
+
+type Bbox = [[f64; 3]; 2];
+
+fn centre(b: &Bbox) -> [f64; 3] {
+    std::array::from_fn(|i| (b[0][i] + b[1][i]) / 2.0)
+}
+
+fn size(b: &Bbox) -> [f64; 3] {
+    std::array::from_fn(|i| b[1][i] - b[0][i])
+}
+
+fn overlaps_xy(a: &Bbox, b: &Bbox, margin: f64) -> bool {
+    (0..2).all(|i| a[0][i] < b[1][i] + margin && b[0][i] < a[1][i] + margin)
+}
+
+impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
+    fn new(robot: &'a mut R, subtask: SubtaskKind) -> Self {
+        let vacuum = robot.embodiment() == Embodiment::Vacuum;
+        Hand {
+            robot,
+            subtask,
+            vacuum,
+        }
+    }
+
+    fn fail(&self, step: String, error: ApiError) -> ExpertError {
+        ExpertError {
+            subtask: self.subtask,
+            step,
+            error,
+        }
+    }
+
+    fn bbox(&mut self, name: &str) -> Result<Bbox, ExpertError> {
+        self.robot
+            .get_obj_bbox(name)
+            .map_err(|e| self.fail(format!("get_obj_bbox({name})"), e))
+    }
+
+    /// How far below the tool point a held object's bottom hangs: suction holds it by the
+    /// top, the fingers by the middle (the pick depth is half its height).
+    fn hang(&self, height: f64) -> f64 {
+        if self.vacuum { height } else { height / 2.0 }
+    }
+
+    fn move_to_object(&mut self, name: &str, depth: f64) -> Result<(), ExpertError> {
+        self.robot
+            .move_gripper_to(name, Direction::Down, depth)
+            .map_err(|e| self.fail(format!("move_gripper_to({name}, depth {depth:.3})"), e))
+    }
+
+    fn move_to(&mut self, pos: [f64; 3], clearance: f64) -> Result<(), ExpertError> {
+        self.robot
+            .move_to_position(pos, Direction::Down, clearance, 0.0)
+            .map_err(|e| {
+                self.fail(
+                    format!("move_to_position(({:.3}, {:.3}, {:.3}))", pos[0], pos[1], pos[2]),
+                    e,
+                )
+            })
+    }
+
+    fn slide(&mut self, dir: Direction, offset: f64) -> Result<(), ExpertError> {
+        self.robot
+            .move_parallel(dir, offset, Direction::Down)
+            .map_err(|e| self.fail(format!("move_parallel({}, {offset:.3})", dir.as_str()), e))
+    }
+
+    fn grasp(&mut self) -> Result<(), ExpertError> {
+        let (name, result) = if self.vacuum {
+            ("activate_vacuum", self.robot.activate_vacuum())
+        } else {
+            ("close_gripper", self.robot.close_gripper())
+        };
+        result.map_err(|e| self.fail(format!("{name}()"), e))
+    }
+
+    fn release(&mut self) -> Result<(), ExpertError> {
+        let (name, result) = if self.vacuum {
+            ("deactivate_vacuum", self.robot.deactivate_vacuum())
+        } else {
+            ("open_gripper", self.robot.open_gripper())
+        };
+        result.map_err(|e| self.fail(format!("{name}()"), e))
+    }
+
+    /// Moves to a handle and grasps it.
+    fn grab_handle(&mut self, handle: &str) -> Result<(), ExpertError> {
+        self.move_to_object(handle, 0.0)?;
+        let (name, result) = if self.vacuum {
+            ("attach_vacuum_handle", self.robot.attach_vacuum_handle(handle))
+        } else {
+            ("grasp_handle", self.robot.grasp_handle(handle))
+        };
+        result.map_err(|e| self.fail(format!("{name}({handle})"), e))
+    }
+
+    fn let_go_handle(&mut self) -> Result<(), ExpertError> {
+        let (name, result) = if self.vacuum {
+            ("detach_vacuum_handle", self.robot.detach_vacuum_handle())
+        } else {
+            ("release_handle", self.robot.release_handle())
+        };
+        result.map_err(|e| self.fail(format!("{name}()"), e))
+    }
+
+    /// Picks an object from above at half its height; returns its height.
+    fn pick(&mut self, name: &str) -> Result<f64, ExpertError> {
+        let h = size(&self.bbox(name)?)[2];
+        self.move_to_object(name, h / 2.0)?;
+        self.grasp()?;
+        Ok(h)
+    }
+
+    /// Puts the held object (of height `h`) down with its bottom `lift` above `floor_z` at
+    /// `(x, y)`, and lets go.
+    fn put(&mut self, x: f64, y: f64, floor_z: f64, h: f64, lift: f64) -> Result<(), ExpertError> {
+        self.move_to(
+            [x, y, floor_z + self.hang(h) + lift],
+            crate::api::DEFAULT_LIFT_CLEARANCE,
+        )?;
+        self.release()
+    }
+
+    /// Moves an object to a free table spot (`get_empty_floor_xy`).
+    fn move_aside(&mut self, name: &str) -> Result<(), ExpertError> {
+        let h = self.pick(name)?;
+        let [x, y] = self
+            .robot
+            .get_empty_floor_xy(name)
+            .map_err(|e| self.fail(format!("get_empty_floor_xy({name})"), e))?;
+        self.put(x, y, TABLE, h, DROP_CLEARANCE)
+    }
+}
+
+/// Runs the expert of every goal of the scene, in order.
+pub fn run<R: RobotApi + ?Sized>(robot: &mut R, goals: &[SubtaskGoal]) -> Result<(), ExpertError> {
+    for goal in goals {
+        run_subtask(robot, goal)?;
+    }
+    Ok(())
+}
+
+/// Runs the expert of one subtask.
+pub fn run_subtask<R: RobotApi + ?Sized>(robot: &mut R, goal: &SubtaskGoal) -> Result<(), ExpertError> {
+    let mut hand = Hand::new(robot, goal.kind());
+    match goal {
+        SubtaskGoal::PickPlace { objects, container } => pick_place(&mut hand, objects, container),
+        SubtaskGoal::Sweep { placements } => {
+            let pairs: Vec<(&str, &str)> = placements
+                .iter()
+                .map(|p| (p.object.as_str(), p.container.as_str()))
+                .collect();
+            sweep(&mut hand, &pairs)
+        }
+        SubtaskGoal::PutInHinge {
+            objects,
+            container,
+            lid,
+        } => put_in_hinge(&mut hand, objects, container, lid),
+        SubtaskGoal::PutInPrismatic { objects, drawer } => put_in_prismatic(&mut hand, objects, drawer),
+    }
+}
+
+/// Cubes into the box in label order; whatever rests on a cube is moved to the table first,
+/// top down.
+fn pick_place<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    cubes: &[String],
+    container: &str,
+) -> Result<(), ExpertError> {
+    for (k, cube) in cubes.iter().enumerate() {
+        loop {
+            let me = hand.bbox(cube)?;
+            let mut above = Vec::new();
+            for other in cubes.iter().filter(|c| *c != cube) {
+                let b = hand.bbox(other)?;
+                if overlaps_xy(&b, &me, 0.005) && b[0][2] >= me[1][2] - 0.004 {
+                    above.push((b[0][2], other.clone()));
+                }
+            }
+            // The highest one first.
+            let Some((_, top)) = above.into_iter().max_by(|a, b| a.0.total_cmp(&b.0)) else {
+                break;
+            };
+            hand.move_aside(&top)?;
+        }
+        let h = hand.pick(cube)?;
+        let b = hand.bbox(container)?;
+        let c = centre(&b);
+        let cell = TOY_BOX_CELLS[k % TOY_BOX_CELLS.len()];
+        hand.put(c[0] + cell[0], c[1] + cell[1], b[1][2], h, DROP_CLEARANCE)?;
+    }
+    Ok(())
+}
+
+/// Pieces pushed (finger) or carried (suction) across into their boxes; a piece found in a
+/// box is first lifted back onto the board at its x.
+fn sweep<R: RobotApi + ?Sized>(hand: &mut Hand<'_, R>, pieces: &[(&str, &str)]) -> Result<(), ExpertError> {
+    let board = hand.bbox("board")?;
+    let board_y = centre(&board)[1];
+    for &(piece, home) in pieces {
+        let b = hand.bbox(piece)?;
+        let on_board = b[0][2] >= board[1][2] - 0.005 && overlaps_xy(&b, &board, 0.0);
+        if !on_board {
+            let h = hand.pick(piece)?;
+            let x = centre(&b)[0];
+            hand.put(x, board_y, board[1][2], h, DROP_CLEARANCE)?;
+        }
+        let h = size(&hand.bbox(piece)?)[2];
+        hand.move_to_object(piece, h / 1.3)?;
+        if hand.vacuum {
+            hand.grasp()?;
+        }
+        let py = centre(&hand.bbox(piece)?)[1];
+        let by = centre(&hand.bbox(home)?)[1];
+        let dir = if py > by {
+            Direction::Left
+        } else {
+            Direction::Right
+        };
+        hand.slide(dir, (py - by).abs() + 0.02)?;
+        if hand.vacuum {
+            hand.release()?;
+        }
+    }
+    Ok(())
+}
+
+/// Fruits into the hinge box: a fruit on the lid is moved to the table, a closed lid is
+/// opened by its handle, the fruits are dropped in along the box, the lid is closed.
+fn put_in_hinge<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    fruits: &[String],
+    body: &str,
+    lid: &str,
+) -> Result<(), ExpertError> {
+    let lid_box = hand.bbox(lid)?;
+    for fruit in fruits {
+        let b = hand.bbox(fruit)?;
+        if overlaps_xy(&b, &lid_box, 0.0) && (b[0][2] - lid_box[1][2]).abs() < 0.01 {
+            hand.move_aside(fruit)?;
+        }
+    }
+    // A closed lid lies flat (1 cm thick); an open one stands up.
+    if size(&lid_box)[2] < 0.05 {
+        hand.grab_handle("hinge_handle")?;
+        let l = hand.bbox(lid)?;
+        let (c, r) = (centre(&l), size(&l)[0]);
+        hand.move_to([c[0] + 0.5 * r, c[1], c[2] + r], 0.0)?;
+        hand.let_go_handle()?;
+    }
+    for (k, fruit) in fruits.iter().enumerate() {
+        let h = hand.pick(fruit)?;
+        let b = hand.bbox(body)?;
+        let c = centre(&b);
+        hand.put(c[0], c[1] + HINGE_SPOTS[k % HINGE_SPOTS.len()], b[1][2], h, 0.03)?;
+    }
+    hand.grab_handle("hinge_handle")?;
+    let b = hand.bbox(body)?;
+    let (c, s) = (centre(&b), size(&b));
+    hand.move_to([c[0] - 0.5 * s[0], c[1], c[2] + 0.5 * s[2]], 0.0)?;
+    hand.let_go_handle()
+}
+
+/// Cylinders into the bottom drawer: an open top drawer (which covers the bottom handle) is
+/// closed, a closed bottom drawer opened, the cylinders dropped in, the drawer closed.
+fn put_in_prismatic<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    cylinders: &[String],
+    drawer: &str,
+) -> Result<(), ExpertError> {
+    let body = hand.bbox("drawer_body")?;
+    let body_y = centre(&body)[1];
+    let handle_y = centre(&hand.bbox("bottom_drawer_handle")?)[1];
+    // Drawers open toward the side their handles are on.
+    let (open_dir, close_dir, outward) = if handle_y < body_y {
+        (Direction::Left, Direction::Right, -1.0)
+    } else {
+        (Direction::Right, Direction::Left, 1.0)
+    };
+    let is_open = |b: &Bbox| {
+        if outward < 0.0 {
+            b[0][1] < body[0][1] - 0.03
+        } else {
+            b[1][1] > body[1][1] + 0.03
+        }
+    };
+    let travel = size(&hand.bbox(drawer)?)[1] * 0.85;
+    if is_open(&hand.bbox("top_drawer")?) {
+        hand.grab_handle("top_drawer_handle")?;
+        hand.slide(close_dir, travel)?;
+        hand.let_go_handle()?;
+    }
+    if !is_open(&hand.bbox(drawer)?) {
+        hand.grab_handle("bottom_drawer_handle")?;
+        hand.slide(open_dir, travel)?;
+        hand.let_go_handle()?;
+        hand.slide(Direction::Up, 0.05)?;
+    }
+    for (k, cylinder) in cylinders.iter().enumerate() {
+        let h = hand.pick(cylinder)?;
+        let b = hand.bbox(drawer)?;
+        let (c, s) = (centre(&b), size(&b));
+        // Released high enough that the hand clears the cylinders still on the cabinet.
+        let [dx, dy] = DRAWER_SPOTS[k % DRAWER_SPOTS.len()];
+        let x = c[0] + dx;
+        let y = c[1] + (0.01 + dy) * outward;
+        hand.move_to([x, y, c[2] + s[2] + h + 0.05], crate::api::DEFAULT_LIFT_CLEARANCE)?;
+        hand.release()?;
+    }
+    hand.grab_handle("bottom_drawer_handle")?;
+    hand.slide(close_dir, travel)?;
+    hand.let_go_handle()
+}
