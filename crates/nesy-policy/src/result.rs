@@ -188,6 +188,14 @@ pub struct SubtaskResult {
     pub subtask: String,
     /// The verdict.
     pub status: SubtaskStatus,
+    /// The subtask's goal label (spec §2): its objects in the demonstrated order, then the
+    /// closure (`hinge`, `bottom_drawer`) for the articulated subtasks.
+    #[serde(default)]
+    pub label: Vec<String>,
+    /// What it achieved, in time order, each with the control step of the check that saw it
+    /// (for the procedure deviation, PD, over all subtasks merged in time order).
+    #[serde(default)]
+    pub achieved: Vec<(String, u64)>,
 }
 
 /// Verdict of a subtask goal check (spec §7 metrics: partial counts as success).
