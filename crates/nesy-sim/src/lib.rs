@@ -9,6 +9,7 @@
 
 pub mod api;
 mod api_impl;
+pub mod demo;
 pub mod expert;
 pub mod floor;
 pub mod geometry;
@@ -20,6 +21,7 @@ pub mod observer;
 pub mod render;
 pub mod rng;
 pub mod robot;
+pub mod scenario;
 pub mod scene;
 pub mod sim;
 pub mod task;

@@ -1,0 +1,674 @@
+//! `demo.mcap`: a demo as an MCAP file that Foxglove opens and any MCAP reader can parse.
+//!
+//! All messages are JSON (`message_encoding = "json"`) with a JSON Schema
+//! (`schema encoding = "jsonschema"`); chunks are zstd-compressed. Every keyframe `k`
+//! publishes one message on each topic below, all with `sequence = k` and
+//! `log_time = publish_time =` the keyframe's simulated time in nanoseconds:
+//!
+//! | topic | schema | payload |
+//! |---|---|---|
+//! | `/camera/top`, `/camera/front`, `/camera/back` | `foxglove.CompressedImage` | the plain view, PNG |
+//! | `/camera/{top,front,back}/marked` | `foxglove.CompressedImage` | the labelled view, PNG (may be absent for a keyframe) |
+//! | `/nesy/state` | `nesy.KeyframeState` | `{keyframe, timestamp, atoms}`: ground-truth atoms, or `null` if unknown |
+//! | `/nesy/action` | `nesy.KeyframeAction` | `{keyframe, timestamp, entry}`: the API call and result that led here (`null` for keyframe 0) |
+//!
+//! One metadata record named [`METADATA_NAME`] holds the demo's metadata as strings
+//! (see [`MetadataKey`]).
+
+use std::collections::{BTreeMap, HashMap};
+use std::io::{Seek, Write};
+use std::path::Path;
+use std::sync::Arc;
+
+use base64::Engine as _;
+use base64::engine::general_purpose::STANDARD as BASE64;
+use mcap::records::{MessageHeader, Metadata, Record};
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::{
+    CameraImages, CameraName, Demo, DemoError, DemoMetadata, Keyframe, KeyframeViews, NESY_VERSION, check_png,
+};
+use crate::api::{Embodiment, TraceEntry};
+use crate::scene::SceneSpec;
+
+/// Name of the metadata record.
+pub const METADATA_NAME: &str = "nesy.demo";
+/// Version of this layout, stored under `format_version` in the metadata.
+pub const FORMAT_VERSION: u32 = 1;
+/// Topic of the ground-truth states.
+pub const STATE_TOPIC: &str = "/nesy/state";
+/// Topic of the API calls.
+pub const ACTION_TOPIC: &str = "/nesy/action";
+/// Schema name of image messages (Foxglove's well-known image type).
+pub const IMAGE_SCHEMA_NAME: &str = "foxglove.CompressedImage";
+/// Schema name of state messages.
+pub const STATE_SCHEMA_NAME: &str = "nesy.KeyframeState";
+/// Schema name of action messages.
+pub const ACTION_SCHEMA_NAME: &str = "nesy.KeyframeAction";
+
+/// The image topic of a camera: `/camera/<name>` or `/camera/<name>/marked`.
+pub fn image_topic(camera: CameraName, marked: bool) -> String {
+    if marked {
+        format!("/camera/{}/marked", camera.as_str())
+    } else {
+        format!("/camera/{}", camera.as_str())
+    }
+}
+
+/// Every topic a nesy demo has, in channel order.
+pub fn topics() -> Vec<String> {
+    let mut all: Vec<String> = CameraName::ALL.iter().map(|&c| image_topic(c, false)).collect();
+    all.extend(CameraName::ALL.iter().map(|&c| image_topic(c, true)));
+    all.push(STATE_TOPIC.to_owned());
+    all.push(ACTION_TOPIC.to_owned());
+    all
+}
+
+/// Keys of the metadata record. Values are strings; lists and scenes are JSON.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MetadataKey {
+    /// `format_version`: [`FORMAT_VERSION`].
+    FormatVersion,
+    /// `instruction`.
+    Instruction,
+    /// `objects`: JSON array of names.
+    Objects,
+    /// `embodiment`: `finger` or `vacuum`.
+    Embodiment,
+    /// `keyframes`: the keyframe count, decimal.
+    Keyframes,
+    /// `scenario_id` (optional).
+    ScenarioId,
+    /// `side` (optional): `source` or `target`.
+    Side,
+    /// `nesy_version` (optional).
+    NesyVersion,
+    /// `target_scene` (optional): a `scene.json` document.
+    TargetScene,
+}
+
+impl MetadataKey {
+    /// The key string.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            MetadataKey::FormatVersion => "format_version",
+            MetadataKey::Instruction => "instruction",
+            MetadataKey::Objects => "objects",
+            MetadataKey::Embodiment => "embodiment",
+            MetadataKey::Keyframes => "keyframes",
+            MetadataKey::ScenarioId => "scenario_id",
+            MetadataKey::Side => "side",
+            MetadataKey::NesyVersion => "nesy_version",
+            MetadataKey::TargetScene => "target_scene",
+        }
+    }
+}
+
+/// A timestamp as Foxglove writes it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Timestamp {
+    /// Whole seconds.
+    pub sec: u32,
+    /// Nanoseconds within the second.
+    pub nsec: u32,
+}
+
+impl Timestamp {
+    fn from_nanos(ns: u64) -> Timestamp {
+        Timestamp {
+            sec: u32::try_from(ns / 1_000_000_000).unwrap_or(u32::MAX),
+            nsec: (ns % 1_000_000_000) as u32,
+        }
+    }
+}
+
+/// `foxglove.CompressedImage` in its JSON encoding.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct ImageMessage {
+    timestamp: Timestamp,
+    frame_id: String,
+    /// Base64 of the PNG bytes.
+    data: String,
+    format: String,
+}
+
+/// A keyframe's ground-truth symbolic state (`/nesy/state`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+#[schemars(rename = "nesy.KeyframeState")]
+pub struct StateMessage {
+    /// Keyframe index, from 0.
+    pub keyframe: usize,
+    /// Simulated time of the keyframe.
+    pub timestamp: Timestamp,
+    /// The true atoms in the authors' notation, e.g. `(OnTopOf red_cube floor)`, sorted;
+    /// `null` when the demo has no ground truth.
+    #[schemars(with = "Option<Vec<String>>")]
+    pub atoms: Option<nesy_core::State>,
+}
+
+/// The API call that led to a keyframe (`/nesy/action`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+#[schemars(rename = "nesy.KeyframeAction")]
+pub struct ActionMessage {
+    /// Keyframe index, from 0.
+    pub keyframe: usize,
+    /// Simulated time of the keyframe.
+    pub timestamp: Timestamp,
+    /// The call as a nesy-sim trace entry: `index` (position in the robot's full call
+    /// trace), `call` (the API function name) with its arguments, `result` (`{"Ok": ...}`
+    /// or `{"Err": ...}`) and `sim_time`; `null` for keyframe 0.
+    #[schemars(with = "Option<serde_json::Map<String, serde_json::Value>>")]
+    pub entry: Option<TraceEntry>,
+}
+
+/// JSON Schema of `foxglove.CompressedImage` (JSON encoding), as the channel carries it.
+pub fn image_schema() -> String {
+    let schema = serde_json::json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": IMAGE_SCHEMA_NAME,
+        "description": "A compressed image (Foxglove's well-known schema); nesy writes PNG.",
+        "type": "object",
+        "properties": {
+            "timestamp": {
+                "type": "object",
+                "description": "Time of the image",
+                "properties": {
+                    "sec": {"type": "integer", "minimum": 0},
+                    "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999}
+                },
+                "required": ["sec", "nsec"]
+            },
+            "frame_id": {"type": "string", "description": "Camera name"},
+            "data": {"type": "string", "contentEncoding": "base64", "description": "Compressed image data"},
+            "format": {"type": "string", "description": "Image format: png"}
+        },
+        "required": ["timestamp", "frame_id", "data", "format"]
+    });
+    pretty(&schema)
+}
+
+/// JSON Schema of `/nesy/state` messages.
+pub fn state_schema() -> String {
+    pretty(&schemars::schema_for!(StateMessage))
+}
+
+/// JSON Schema of `/nesy/action` messages.
+pub fn action_schema() -> String {
+    pretty(&schemars::schema_for!(ActionMessage))
+}
+
+fn pretty<T: Serialize>(value: &T) -> String {
+    let mut text = serde_json::to_string_pretty(value).unwrap_or_default();
+    text.push('\n');
+    text
+}
+
+/// A keyframe time as the file stores it (whole nanoseconds), so that recorded demos and
+/// demos read back compare equal.
+pub fn stored_time(seconds: f64) -> f64 {
+    time_ns(seconds) as f64 / 1e9
+}
+
+fn time_ns(seconds: f64) -> u64 {
+    if seconds.is_finite() && seconds > 0.0 {
+        (seconds * 1e9).round() as u64
+    } else {
+        0
+    }
+}
+
+/// Writes `demo` as MCAP into `w` and returns the writer.
+pub fn write_mcap<W: Write + Seek>(demo: &Demo, w: W) -> Result<W, mcap::McapError> {
+    let options = mcap::WriteOptions::new()
+        .compression(Some(mcap::Compression::Zstd))
+        .profile("")
+        .library(format!("nesy {NESY_VERSION}"));
+    let mut out = options.create(w)?;
+    let no_meta = BTreeMap::new();
+    let image_schema_id = out.add_schema(IMAGE_SCHEMA_NAME, "jsonschema", image_schema().as_bytes())?;
+    let state_schema_id = out.add_schema(STATE_SCHEMA_NAME, "jsonschema", state_schema().as_bytes())?;
+    let action_schema_id = out.add_schema(ACTION_SCHEMA_NAME, "jsonschema", action_schema().as_bytes())?;
+    let mut image_channels = Vec::new();
+    for marked in [false, true] {
+        for camera in CameraName::ALL {
+            let id = out.add_channel(image_schema_id, &image_topic(camera, marked), "json", &no_meta)?;
+            image_channels.push((camera, marked, id));
+        }
+    }
+    let state_channel = out.add_channel(state_schema_id, STATE_TOPIC, "json", &no_meta)?;
+    let action_channel = out.add_channel(action_schema_id, ACTION_TOPIC, "json", &no_meta)?;
+
+    for keyframe in &demo.keyframes {
+        let ns = time_ns(keyframe.time);
+        let header = |channel_id| MessageHeader {
+            channel_id,
+            sequence: u32::try_from(keyframe.index).unwrap_or(u32::MAX),
+            log_time: ns,
+            publish_time: ns,
+        };
+        let timestamp = Timestamp::from_nanos(ns);
+        for &(camera, marked, channel) in &image_channels {
+            let images = keyframe.views.get(camera);
+            let png = if marked {
+                images.marked.as_deref()
+            } else {
+                Some(&images.raw[..])
+            };
+            let Some(png) = png else { continue };
+            let message = ImageMessage {
+                timestamp,
+                frame_id: camera.as_str().to_owned(),
+                data: BASE64.encode(png),
+                format: "png".to_owned(),
+            };
+            out.write_to_known_channel(&header(channel), &json_bytes(&message))?;
+        }
+        let state = StateMessage {
+            keyframe: keyframe.index,
+            timestamp,
+            atoms: keyframe.state.clone(),
+        };
+        out.write_to_known_channel(&header(state_channel), &json_bytes(&state))?;
+        let action = ActionMessage {
+            keyframe: keyframe.index,
+            timestamp,
+            entry: keyframe.action.clone(),
+        };
+        out.write_to_known_channel(&header(action_channel), &json_bytes(&action))?;
+    }
+
+    out.write_metadata(&Metadata {
+        name: METADATA_NAME.to_owned(),
+        metadata: metadata_map(&demo.metadata, demo.keyframes.len()),
+    })?;
+    out.finish()?;
+    Ok(out.into_inner())
+}
+
+fn json_bytes<T: Serialize>(value: &T) -> Vec<u8> {
+    // The message types hold only strings, numbers and finite floats: serialisation cannot fail.
+    serde_json::to_vec(value).unwrap_or_default()
+}
+
+fn metadata_map(meta: &DemoMetadata, keyframes: usize) -> BTreeMap<String, String> {
+    let mut map = BTreeMap::new();
+    let mut put = |key: MetadataKey, value: String| {
+        map.insert(key.as_str().to_owned(), value);
+    };
+    put(MetadataKey::FormatVersion, FORMAT_VERSION.to_string());
+    put(MetadataKey::Instruction, meta.instruction.clone());
+    put(
+        MetadataKey::Objects,
+        serde_json::to_string(&meta.objects).unwrap_or_default(),
+    );
+    put(MetadataKey::Embodiment, meta.embodiment.as_str().to_owned());
+    put(MetadataKey::Keyframes, keyframes.to_string());
+    if let Some(id) = &meta.scenario_id {
+        put(MetadataKey::ScenarioId, id.clone());
+    }
+    if let Some(side) = &meta.side {
+        put(MetadataKey::Side, side.clone());
+    }
+    if let Some(version) = &meta.nesy_version {
+        put(MetadataKey::NesyVersion, version.clone());
+    }
+    if let Some(scene) = &meta.target_scene {
+        put(
+            MetadataKey::TargetScene,
+            serde_json::to_string(scene).unwrap_or_default(),
+        );
+    }
+    map
+}
+
+/// Writes `demo` to `path` (creating parent folders).
+pub fn write_mcap_file(demo: &Demo, path: &Path) -> Result<(), DemoError> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(|e| DemoError::io(parent, e))?;
+    }
+    let buffer = write_mcap(demo, std::io::Cursor::new(Vec::new())).map_err(|source| DemoError::Mcap {
+        path: path.to_owned(),
+        source,
+    })?;
+    std::fs::write(path, buffer.into_inner()).map_err(|e| DemoError::io(path, e))
+}
+
+/// Reads a `demo.mcap` file.
+pub fn read_mcap(path: &Path) -> Result<Demo, DemoError> {
+    let bytes = std::fs::read(path).map_err(|e| DemoError::io(path, e))?;
+    read_mcap_bytes(&bytes, path)
+}
+
+/// A message's log time and payload.
+type Stamped = (u64, Vec<u8>);
+
+/// The records of an MCAP file that a demo is made of.
+#[derive(Default)]
+struct Records {
+    schemas: HashMap<u16, String>,
+    /// Channel id → (topic, schema id, encoding).
+    channels: HashMap<u16, (String, u16, String)>,
+    messages: Vec<(MessageHeader, Vec<u8>)>,
+    metadata: Option<BTreeMap<String, String>>,
+}
+
+/// Decompressed chunks may be larger than the file, but not absurdly so: a corrupt length
+/// field must give an error, not a giant allocation.
+fn record_limit(file_len: usize) -> usize {
+    file_len.saturating_mul(16).max(64 << 20)
+}
+
+fn scan(bytes: &[u8], path: &Path) -> Result<Records, DemoError> {
+    let mcap_err = |source| DemoError::Mcap {
+        path: path.to_owned(),
+        source,
+    };
+    let options = LinearReaderOptions::default()
+        .with_record_length_limit(record_limit(bytes.len()))
+        .with_validate_chunk_crcs(true)
+        .with_validate_data_section_crc(true)
+        .with_validate_summary_section_crc(true);
+    let mut reader = LinearReader::new_with_options(options);
+    let mut rest = bytes;
+    let mut records = Records::default();
+    while let Some(event) = reader.next_event() {
+        match event.map_err(mcap_err)? {
+            LinearReadEvent::ReadRequest(need) => {
+                let n = need.min(rest.len());
+                reader.insert(n).copy_from_slice(&rest[..n]);
+                reader.notify_read(n);
+                rest = &rest[n..];
+            }
+            LinearReadEvent::Record { data, opcode } => {
+                match mcap::parse_record(opcode, data).map_err(mcap_err)? {
+                    Record::Schema { header, data: _ } => {
+                        records.schemas.insert(header.id, header.name);
+                    }
+                    Record::Channel(c) => {
+                        records
+                            .channels
+                            .insert(c.id, (c.topic, c.schema_id, c.message_encoding));
+                    }
+                    Record::Message { header, data } => records.messages.push((header, data.into_owned())),
+                    Record::Metadata(m) if m.name == METADATA_NAME => records.metadata = Some(m.metadata),
+                    _ => {}
+                }
+            }
+        }
+    }
+    Ok(records)
+}
+
+/// Reads a demo from the bytes of a `demo.mcap`; `path` names it in errors.
+pub fn read_mcap_bytes(bytes: &[u8], path: &Path) -> Result<Demo, DemoError> {
+    let records = scan(bytes, path)?;
+    let meta_map = records.metadata.ok_or_else(|| DemoError::MissingMetadata {
+        path: path.to_owned(),
+        name: METADATA_NAME.to_owned(),
+    })?;
+    let (metadata, count) = parse_metadata(&meta_map, path)?;
+
+    // Topic → channel id, with schema and encoding checked.
+    let mut by_topic: HashMap<&str, u16> = HashMap::new();
+    for (id, (topic, schema_id, encoding)) in &records.channels {
+        by_topic.insert(topic.as_str(), *id);
+        let expected_schema = if topic.starts_with("/camera/") {
+            Some(IMAGE_SCHEMA_NAME)
+        } else if topic == STATE_TOPIC {
+            Some(STATE_SCHEMA_NAME)
+        } else if topic == ACTION_TOPIC {
+            Some(ACTION_SCHEMA_NAME)
+        } else {
+            None
+        };
+        let Some(expected_schema) = expected_schema else {
+            continue;
+        };
+        if encoding != "json" {
+            return Err(DemoError::invalid(
+                path,
+                format!("channel {topic}"),
+                "message encoding \"json\"",
+                format!("{encoding:?}"),
+            ));
+        }
+        let schema = records.schemas.get(schema_id).map(String::as_str).unwrap_or("");
+        if schema != expected_schema {
+            return Err(DemoError::invalid(
+                path,
+                format!("channel {topic}"),
+                format!("schema {expected_schema:?}"),
+                format!("{schema:?}"),
+            ));
+        }
+    }
+    let all_topics = topics();
+    for topic in &all_topics {
+        if !by_topic.contains_key(topic.as_str()) {
+            return Err(DemoError::MissingTopic {
+                path: path.to_owned(),
+                topic: topic.clone(),
+                expected: all_topics.join(", "),
+            });
+        }
+    }
+
+    // Messages per channel, indexed by keyframe (the message sequence).
+    let topic_of: HashMap<u16, &str> = records
+        .channels
+        .iter()
+        .map(|(id, (topic, _, _))| (*id, topic.as_str()))
+        .collect();
+    let mut slots: HashMap<&str, Vec<Option<Stamped>>> = all_topics
+        .iter()
+        .map(|t| (t.as_str(), vec![None; count]))
+        .collect();
+    for (header, data) in records.messages {
+        let Some(topic) = topic_of.get(&header.channel_id).copied() else {
+            return Err(DemoError::invalid(
+                path,
+                format!("message {} ", header.sequence),
+                "a channel defined before the message",
+                format!("unknown channel id {}", header.channel_id),
+            ));
+        };
+        let Some(slot) = slots.get_mut(topic) else {
+            continue;
+        };
+        let k = header.sequence as usize;
+        if k >= count {
+            return Err(DemoError::invalid(
+                path,
+                format!("{topic} message"),
+                format!("keyframe sequence below the metadata's keyframe count {count}"),
+                format!("sequence {k}"),
+            ));
+        }
+        if slot[k].is_some() {
+            return Err(DemoError::invalid(
+                path,
+                format!("{topic} keyframe {k}"),
+                "one message per keyframe",
+                "a second message",
+            ));
+        }
+        slot[k] = Some((header.log_time, data));
+    }
+
+    let mut keyframes = Vec::with_capacity(count);
+    for k in 0..count {
+        let mut take = |topic: &str| slots.get_mut(topic).and_then(|s| s[k].take());
+        let missing = |topic: &str| {
+            DemoError::invalid(
+                path,
+                format!("{topic} keyframe {k}"),
+                format!("one message for each of the {count} keyframes"),
+                "no message",
+            )
+        };
+        let (log_time, state_bytes) = take(STATE_TOPIC).ok_or_else(|| missing(STATE_TOPIC))?;
+        let state: StateMessage =
+            DemoError::parse_json(path, &format!("{STATE_TOPIC} keyframe {k}"), &state_bytes)?;
+        check_keyframe_field(path, STATE_TOPIC, k, state.keyframe)?;
+        let (_, action_bytes) = take(ACTION_TOPIC).ok_or_else(|| missing(ACTION_TOPIC))?;
+        let action: ActionMessage =
+            DemoError::parse_json(path, &format!("{ACTION_TOPIC} keyframe {k}"), &action_bytes)?;
+        check_keyframe_field(path, ACTION_TOPIC, k, action.keyframe)?;
+        let views = KeyframeViews::from_fn(|camera| {
+            let raw_topic = image_topic(camera, false);
+            let (_, raw) = take(&raw_topic).ok_or_else(|| missing(&raw_topic))?;
+            let raw = decode_image(path, &raw_topic, k, &raw)?;
+            let marked_topic = image_topic(camera, true);
+            let marked = match take(&marked_topic) {
+                Some((_, bytes)) => Some(decode_image(path, &marked_topic, k, &bytes)?),
+                None => None,
+            };
+            Ok(CameraImages { raw, marked })
+        })?;
+        keyframes.push(Keyframe {
+            index: k,
+            time: log_time as f64 / 1e9,
+            views,
+            state: state.atoms,
+            action: action.entry,
+        });
+    }
+    Ok(Demo { metadata, keyframes })
+}
+
+fn check_keyframe_field(path: &Path, topic: &str, k: usize, found: usize) -> Result<(), DemoError> {
+    if found == k {
+        Ok(())
+    } else {
+        Err(DemoError::invalid(
+            path,
+            format!("{topic} keyframe {k}: field keyframe"),
+            format!("{k} (the message sequence)"),
+            found.to_string(),
+        ))
+    }
+}
+
+fn decode_image(path: &Path, topic: &str, k: usize, bytes: &[u8]) -> Result<Vec<u8>, DemoError> {
+    let location = format!("{topic} keyframe {k}");
+    let message: ImageMessage = DemoError::parse_json(path, &location, bytes)?;
+    if message.format != "png" {
+        return Err(DemoError::invalid(
+            path,
+            format!("{location}: field format"),
+            "\"png\"",
+            format!("{:?}", message.format),
+        ));
+    }
+    let png = BASE64.decode(message.data.as_bytes()).map_err(|e| {
+        DemoError::invalid(
+            path,
+            format!("{location}: field data"),
+            "base64 text",
+            e.to_string(),
+        )
+    })?;
+    check_png(path, &format!("{location}: field data"), &png)?;
+    Ok(png)
+}
+
+fn parse_metadata(map: &BTreeMap<String, String>, path: &Path) -> Result<(DemoMetadata, usize), DemoError> {
+    let location = |key: MetadataKey| format!("metadata {METADATA_NAME} key {}", key.as_str());
+    let get = |key: MetadataKey| map.get(key.as_str()).map(String::as_str);
+    let require = |key: MetadataKey| {
+        get(key).ok_or_else(|| DemoError::invalid(path, location(key), "a value", "no such key"))
+    };
+    let version = require(MetadataKey::FormatVersion)?;
+    if version != FORMAT_VERSION.to_string() {
+        return Err(DemoError::invalid(
+            path,
+            location(MetadataKey::FormatVersion),
+            FORMAT_VERSION.to_string(),
+            format!("{version:?}"),
+        ));
+    }
+    let instruction = require(MetadataKey::Instruction)?.to_owned();
+    let objects: Vec<String> = DemoError::parse_json(
+        path,
+        &location(MetadataKey::Objects),
+        require(MetadataKey::Objects)?.as_bytes(),
+    )?;
+    let embodiment = match require(MetadataKey::Embodiment)? {
+        "finger" => Embodiment::Finger,
+        "vacuum" => Embodiment::Vacuum,
+        other => {
+            return Err(DemoError::invalid(
+                path,
+                location(MetadataKey::Embodiment),
+                "\"finger\" or \"vacuum\"",
+                format!("{other:?}"),
+            ));
+        }
+    };
+    let count_text = require(MetadataKey::Keyframes)?;
+    let count: usize = count_text
+        .parse()
+        .ok()
+        .filter(|n| (1..=100_000).contains(n))
+        .ok_or_else(|| {
+            DemoError::invalid(
+                path,
+                location(MetadataKey::Keyframes),
+                "a keyframe count from 1 to 100000",
+                format!("{count_text:?}"),
+            )
+        })?;
+    let target_scene = match get(MetadataKey::TargetScene) {
+        Some(text) => Some(
+            SceneSpec::from_json_str(
+                text,
+                &format!("{}: {}", path.display(), location(MetadataKey::TargetScene)),
+            )
+            .map_err(|e| {
+                DemoError::invalid(
+                    path,
+                    location(MetadataKey::TargetScene),
+                    "a valid scene",
+                    e.to_string(),
+                )
+            })?,
+        ),
+        None => None,
+    };
+    let metadata = DemoMetadata {
+        instruction,
+        objects,
+        embodiment,
+        scenario_id: get(MetadataKey::ScenarioId).map(str::to_owned),
+        side: get(MetadataKey::Side).map(str::to_owned),
+        nesy_version: get(MetadataKey::NesyVersion).map(str::to_owned),
+        target_scene,
+    };
+    Ok((metadata, count))
+}
+
+/// The channels of a file by topic, with their message counts (for tools and tests).
+pub fn channel_summary(bytes: &[u8], path: &Path) -> Result<BTreeMap<String, usize>, DemoError> {
+    let records = scan(bytes, path)?;
+    let mut counts: BTreeMap<String, usize> = records
+        .channels
+        .values()
+        .map(|(topic, _, _)| (topic.clone(), 0))
+        .collect();
+    let topic_of: HashMap<u16, Arc<str>> = records
+        .channels
+        .iter()
+        .map(|(id, (topic, _, _))| (*id, Arc::from(topic.as_str())))
+        .collect();
+    for (header, _) in &records.messages {
+        if let Some(topic) = topic_of.get(&header.channel_id) {
+            *counts.entry(topic.to_string()).or_default() += 1;
+        }
+    }
+    Ok(counts)
+}
