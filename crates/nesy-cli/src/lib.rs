@@ -11,6 +11,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 pub mod commands;
+pub mod pipeline;
 
 /// Turn a demonstration recorded in one setting into a verified robot program for another.
 #[derive(Debug, Parser)]
@@ -24,6 +25,8 @@ pub struct Cli {
 /// The subcommands. Each lives in its own module under [`commands`].
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Adapt a demonstration to a target scene and synthesize (and run) a verified code policy.
+    Adapt(Box<commands::adapt::AdaptArgs>),
     /// Inspect, prune or verify VLM cassettes (recorded model calls for offline replay).
     Cassette(commands::cassette::CassetteArgs),
     /// Render a scene's top, front and back views as PNG (plain and labelled).
@@ -53,6 +56,7 @@ pub fn main() -> ExitCode {
 /// Runs a parsed command line and maps errors to exit code 2 with their full context.
 pub fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
+        Command::Adapt(args) => commands::adapt::run(*args),
         Command::Cassette(args) => commands::cassette::run(args),
         Command::Render(args) => commands::render::run(args),
         Command::Run(args) => commands::run::run(args),

@@ -1,5 +1,6 @@
 //! One module per subcommand: its clap arguments and its `run` function.
 
+pub mod adapt;
 pub mod cassette;
 pub mod render;
 pub mod run;

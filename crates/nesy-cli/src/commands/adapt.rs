@@ -1,0 +1,344 @@
+//! `nesy adapt`: adapt a demonstration to a target scene (NeSyCR) and synthesize, and
+//! optionally execute, a verified code policy. The work is done by [`crate::pipeline`]; this
+//! module parses flags, shows progress and prints the summary.
+
+use std::io::IsTerminal as _;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::Duration;
+
+use nesy_policy::Limits;
+use nesy_vlm::ConfigOverrides;
+
+use crate::pipeline::output::{induction_counts, proposals, violations};
+use crate::pipeline::progress::LogProgress;
+use crate::pipeline::{
+    self, AdaptOptions, AdaptRun, CodegenMode, DemoInput, NoProgress, Progress, StateSource, StatesMode,
+    TargetInput, VlmSetup, VlmSource,
+};
+
+/// Arguments of `nesy adapt`.
+#[derive(Debug, clap::Args)]
+pub struct AdaptArgs {
+    /// The demonstration: `demo.mcap`, a folder holding it, or a folder with `manifest.json`.
+    #[arg(long, value_name = "DIR")]
+    pub demo: PathBuf,
+    /// The target scene (`scene.json`); defaults to the target scene recorded in the demo.
+    #[arg(long, value_name = "SCENE")]
+    pub target: Option<PathBuf>,
+    /// Who answers: `oracle` (offline reference responder), `replay:CASSETTE`, or the URL of
+    /// an OpenAI-compatible server. Default: the configured VLM (NESY_VLM_* settings).
+    #[arg(long, value_name = "URL|replay:CASSETTE|oracle")]
+    pub vlm: Option<String>,
+    /// Record every model call to this cassette (replay it later with `--vlm replay:FILE`).
+    #[arg(long, value_name = "CASSETTE")]
+    pub record: Option<PathBuf>,
+    /// Noise for `--vlm oracle`, e.g. `drop=0.1,flip=0.1,bad-patch=0.2`.
+    #[arg(long, value_name = "SPEC", default_value = "")]
+    pub oracle_noise: String,
+    /// Symbolic states: ground truth (`observed`), the VLM's state translation (`vlm`), or
+    /// ground truth when the demo has it (`auto`).
+    #[arg(long, value_enum, default_value_t = StatesMode::Auto)]
+    pub states: StatesMode,
+    /// Code synthesis: the VLM's code-generation prompt, or the deterministic template compiler.
+    #[arg(long, value_enum, default_value_t = CodegenMode::Vlm)]
+    pub codegen: CodegenMode,
+    /// Run the policy in the sandbox against the target scene and score it.
+    #[arg(long)]
+    pub execute: bool,
+    /// Output directory (default `runs/adapt/<demo name>`).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Print the run summary as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Patch-proposal budget (default: 10, 15 for combined factors, doubled at high complexity).
+    #[arg(long, value_name = "N")]
+    pub budget: Option<usize>,
+    /// Induction attempts per demonstrated transition.
+    #[arg(long, value_name = "N", default_value_t = 5)]
+    pub induction_tries: usize,
+    /// Wall-clock budget of the policy in seconds (with `--execute`).
+    #[arg(long, value_name = "SECS", default_value_t = 300.0)]
+    pub timeout: f64,
+    /// VLM settings (also from the environment and `--vlm-config`).
+    #[command(flatten)]
+    pub vlm_config: ConfigOverrides,
+}
+
+/// Runs `nesy adapt`: exit 0 when the procedure was adapted, compiled and (with `--execute`)
+/// succeeded; 1 when the adaptation is unresolved, code generation failed or the policy
+/// failed; 2 on bad input.
+pub fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
+    let options = options(&args)?;
+    let setup = VlmSetup {
+        source: match &args.vlm {
+            Some(text) => VlmSource::parse(text, args.vlm_config.clone(), args.oracle_noise.clone())?,
+            None => VlmSource::Configured(Box::new(args.vlm_config.clone())),
+        },
+        record: args.record.clone(),
+    };
+    if !args.oracle_noise.is_empty() && !matches!(setup.source, VlmSource::Oracle { .. }) {
+        anyhow::bail!("--oracle-noise only applies to --vlm oracle");
+    }
+    let progress = make_progress(args.json);
+    progress.stage("reading the demo");
+    let demo = DemoInput::load(&args.demo)?;
+    progress.stage("building the target scene");
+    let target = TargetInput::load(args.target.as_deref(), &demo)?;
+    let run = pipeline::run(demo, target, setup, &options, progress.clone())?;
+    progress.stage("");
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&run)?);
+    } else {
+        print!("{}", summary(&run));
+    }
+    if let Some(error @ pipeline::SynthError::Call { .. }) = &run.codegen_error {
+        eprintln!("error: {error} (outputs written to {})", run.out_dir.display());
+    }
+    Ok(ExitCode::from(run.exit_code()))
+}
+
+fn options(args: &AdaptArgs) -> anyhow::Result<AdaptOptions> {
+    if !(args.timeout.is_finite() && args.timeout > 0.0) {
+        anyhow::bail!(
+            "--timeout must be a positive number of seconds, got {}",
+            args.timeout
+        );
+    }
+    if args.induction_tries == 0 {
+        anyhow::bail!("--induction-tries must be at least 1");
+    }
+    if args.budget == Some(0) {
+        anyhow::bail!("--budget must be at least 1");
+    }
+    let out_dir = match &args.out {
+        Some(dir) => dir.clone(),
+        None => {
+            let name = args
+                .demo
+                .file_stem()
+                .filter(|n| *n != "demo")
+                .or_else(|| args.demo.parent().and_then(|p| p.file_name()))
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "demo".into());
+            PathBuf::from("runs/adapt").join(name)
+        }
+    };
+    Ok(AdaptOptions {
+        states: args.states,
+        codegen: args.codegen,
+        execute: args.execute,
+        budget: args.budget,
+        induction_tries: args.induction_tries,
+        limits: Limits {
+            wall_time_ms: (args.timeout * 1000.0) as u64,
+            ..Limits::default()
+        },
+        worker: None,
+        out_dir,
+    })
+}
+
+/// A spinner on a terminal; log events otherwise; nothing with `--json`.
+fn make_progress(json: bool) -> Arc<dyn Progress> {
+    if json {
+        Arc::new(NoProgress)
+    } else if std::io::stderr().is_terminal() {
+        Arc::new(Spinner::new())
+    } else {
+        Arc::new(LogProgress)
+    }
+}
+
+struct Spinner {
+    bar: indicatif::ProgressBar,
+}
+
+impl Spinner {
+    fn new() -> Spinner {
+        let bar = indicatif::ProgressBar::new_spinner();
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {prefix}: {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+        );
+        bar.enable_steady_tick(Duration::from_millis(120));
+        Spinner { bar }
+    }
+}
+
+impl Progress for Spinner {
+    fn stage(&self, name: &str) {
+        if name.is_empty() {
+            self.bar.finish_and_clear();
+        } else {
+            self.bar.set_prefix(name.to_owned());
+            self.bar.set_message("");
+        }
+    }
+
+    fn detail(&self, message: &str) {
+        self.bar.set_message(message.to_owned());
+    }
+}
+
+/// The terminal summary.
+pub fn summary(run: &AdaptRun) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let s = &run.setting;
+    let _ = writeln!(out, "nesy adapt: {}", run.status.as_str().to_uppercase());
+    let _ = writeln!(
+        out,
+        "  demo      {} ({} keyframes, {})",
+        run.demo_path.display(),
+        run.demo_states.len(),
+        s.source_embodiment
+    );
+    let _ = writeln!(
+        out,
+        "  target    {} ({}{})",
+        run.target_path.display(),
+        s.target_embodiment,
+        if s.source_embodiment != s.target_embodiment {
+            ", embodiment changed"
+        } else {
+            ""
+        }
+    );
+    let states = match &run.states {
+        StateSource::Observed => "observed (ground truth)".to_owned(),
+        StateSource::Vlm { agreement, .. } => format!(
+            "VLM state translation{}",
+            agreement
+                .map(|a| format!(" (F1 {:.2} vs ground truth)", a.f1))
+                .unwrap_or_default()
+        ),
+    };
+    let _ = writeln!(out, "  states    {states}");
+    let wm = &run.adaptation.world_model;
+    let (calls, rejected) = induction_counts(&run.adaptation);
+    let _ = writeln!(
+        out,
+        "  world     {} operators, {} ({} induction calls, {} rejected by the verifier)",
+        wm.procedure.len(),
+        if wm.is_verified() {
+            "all verified".to_owned()
+        } else {
+            format!("UNVERIFIED steps {:?}", wm.unverified_steps)
+        },
+        calls,
+        rejected
+    );
+    let found = violations(&run.adaptation);
+    let props = proposals(&run.adaptation);
+    let accepted = props.iter().filter(|p| p.verdict == "accepted").count();
+    let _ = writeln!(
+        out,
+        "  adapt     {} violation(s), {} proposal(s) ({} accepted, {} rejected), budget {}",
+        found.len(),
+        props.len(),
+        accepted,
+        props.len() - accepted,
+        s.budget
+    );
+    for v in &found {
+        let _ = match v.kind {
+            "precondition" => writeln!(
+                out,
+                "            step {} {}: unmet {}",
+                v.step.map(|s| s + 1).unwrap_or_default(),
+                v.action.as_deref().unwrap_or(""),
+                v.unmet.join(" ")
+            ),
+            _ => writeln!(out, "            goal: unmet {}", v.unmet.join(" ")),
+        };
+    }
+    match run.adapted() {
+        Some(p) => {
+            let _ = writeln!(
+                out,
+                "  procedure {} -> {} actions, verified",
+                run.demonstrated().len(),
+                p.len()
+            );
+        }
+        None => {
+            let _ = writeln!(
+                out,
+                "  procedure UNRESOLVED: no verified procedure; no policy was produced"
+            );
+        }
+    }
+    if let Some(p) = &run.policy {
+        let _ = writeln!(
+            out,
+            "  policy    policy.py ({:?}, {} lines)",
+            p.mode,
+            p.code.lines().count()
+        );
+    }
+    if let Some(e) = &run.codegen_error {
+        let first = e.to_string();
+        let _ = writeln!(
+            out,
+            "  policy    FAILED: {}",
+            first.lines().next().unwrap_or_default()
+        );
+    }
+    if let Some(x) = &run.execution {
+        let r = &x.result;
+        let _ = writeln!(
+            out,
+            "  execute   {} ({} API calls, {:.1} s)",
+            r.outcome.kind(),
+            r.trace.len(),
+            r.wall_time_s
+        );
+        match &x.metrics {
+            Some(m) => {
+                let results: Vec<String> = m
+                    .subtasks
+                    .iter()
+                    .map(|s| {
+                        format!(
+                            "{} {}",
+                            s.subtask,
+                            serde_json::to_value(s.status)
+                                .ok()
+                                .and_then(|v| v.as_str().map(str::to_owned))
+                                .unwrap_or_default()
+                        )
+                    })
+                    .collect();
+                let _ = writeln!(out, "            {}", results.join(", "));
+                let _ = writeln!(
+                    out,
+                    "            SR {:.0}  GC {:.2}  PD {}",
+                    m.sr,
+                    m.gc,
+                    m.pd.map(|p| format!("{p:.2}")).unwrap_or_else(|| "n/a".into())
+                );
+            }
+            None => {
+                let _ = writeln!(out, "            no goal checks reported");
+            }
+        }
+    }
+    let t = &run.timing;
+    let _ = writeln!(
+        out,
+        "  time      VLM {:.3} s, symbolic {:.2} ms, sim {:.2} s, total {:.2} s",
+        t.vlm_s,
+        t.symbolic_s * 1e3,
+        t.sim_s,
+        t.total_s
+    );
+    let _ = writeln!(
+        out,
+        "  outputs   {}/ (report.md, adaptation.json, ...)",
+        run.out_dir.display()
+    );
+    out
+}

@@ -1,0 +1,119 @@
+//! Step 6 (`--execute`): the policy runs in the sandboxed worker against the target scene;
+//! the goal checks' subtask results give SR, GC and PD (spec §7).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use nesy_core::metrics::levenshtein;
+use nesy_policy::{EpisodeSpec, ExecutionResult, Limits, SubtaskStatus, WorkerCommand, run_policy};
+use serde::Serialize;
+
+/// The execution and its scores.
+#[derive(Debug, Clone, Serialize)]
+pub struct ExecutionReport {
+    /// The scene file the worker ran.
+    pub scene_path: PathBuf,
+    /// Everything the sandbox reported (outcome, API trace, output, subtasks, final state).
+    pub result: ExecutionResult,
+    /// SR, GC and PD, when the episode had goal checks.
+    pub metrics: Option<EpisodeMetrics>,
+}
+
+impl ExecutionReport {
+    /// True if every subtask succeeded (full or partial, spec §7).
+    pub fn success(&self) -> bool {
+        self.metrics.as_ref().is_some_and(|m| m.sr == 1.0)
+    }
+
+    /// True if every subtask reached `full_success`.
+    pub fn full_success(&self) -> bool {
+        self.metrics.as_ref().is_some_and(|m| {
+            !m.subtasks.is_empty() && m.subtasks.iter().all(|s| s.status == SubtaskStatus::FullSuccess)
+        })
+    }
+}
+
+/// One subtask's verdict.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct SubtaskVerdict {
+    /// The subtask type.
+    pub subtask: String,
+    /// Its result.
+    pub status: SubtaskStatus,
+}
+
+/// The episode's scores (spec §7).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EpisodeMetrics {
+    /// The subtask verdicts.
+    pub subtasks: Vec<SubtaskVerdict>,
+    /// 1 if every subtask succeeded (partial counts), else 0.
+    pub sr: f64,
+    /// Fraction of successful subtasks.
+    pub gc: f64,
+    /// Normalised Levenshtein distance of the achieved sequence to the goal label, when the
+    /// goal checks report the sequences.
+    pub pd: Option<f64>,
+    /// The goal label (subtask labels in config order).
+    pub label: Vec<String>,
+    /// What was achieved, in time order.
+    pub achieved: Vec<String>,
+}
+
+impl EpisodeMetrics {
+    /// Scores from the sandbox's subtask results.
+    pub fn from_result(result: &ExecutionResult) -> Option<EpisodeMetrics> {
+        let subtasks = result.subtasks.as_ref()?;
+        let verdicts: Vec<SubtaskVerdict> = subtasks
+            .iter()
+            .map(|s| SubtaskVerdict {
+                subtask: s.subtask.clone(),
+                status: s.status,
+            })
+            .collect();
+        let ok = verdicts
+            .iter()
+            .filter(|v| v.status != SubtaskStatus::Failure)
+            .count();
+        let n = verdicts.len();
+        // Spec §7: the goal label is the subtask labels in config order; the achieved
+        // sequence merges every subtask's achievements in time order (ties in config order).
+        let label: Vec<String> = subtasks.iter().flat_map(|s| s.label.iter().cloned()).collect();
+        let mut achieved: Vec<(String, u64)> =
+            subtasks.iter().flat_map(|s| s.achieved.iter().cloned()).collect();
+        achieved.sort_by_key(|(_, step)| *step);
+        let achieved: Vec<String> = achieved.into_iter().map(|(name, _)| name).collect();
+        let pd = (!label.is_empty())
+            .then(|| levenshtein(&label, &achieved) as f64 / label.len().max(achieved.len()).max(1) as f64);
+        Some(EpisodeMetrics {
+            sr: if n > 0 && ok == n { 1.0 } else { 0.0 },
+            gc: if n == 0 { 0.0 } else { ok as f64 / n as f64 },
+            pd,
+            label,
+            achieved,
+            subtasks: verdicts,
+        })
+    }
+}
+
+/// Runs `code` against the scene at `scene_path` in the sandboxed worker.
+pub fn execute(
+    worker: &WorkerCommand,
+    code: &str,
+    scene_path: &Path,
+    limits: &Limits,
+) -> anyhow::Result<ExecutionReport> {
+    let spec = EpisodeSpec::Scene {
+        path: std::path::absolute(scene_path).unwrap_or_else(|_| scene_path.to_owned()),
+        embodiment: None,
+        render_every: 0,
+    };
+    let result = run_policy(worker, code, &spec, limits)
+        .with_context(|| format!("running the policy on {}", scene_path.display()))?;
+    let metrics = EpisodeMetrics::from_result(&result);
+    Ok(ExecutionReport {
+        scene_path: scene_path.to_owned(),
+        result,
+        metrics,
+    })
+}

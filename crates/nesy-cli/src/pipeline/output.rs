@@ -1,0 +1,443 @@
+//! The run directory:
+//!
+//! | file | what it holds |
+//! |---|---|
+//! | `world_model.json` | the demonstrated states, the verified operators (structured and as action blocks), the goal, unverified steps |
+//! | `adaptation.json` | status and budget; every violation found, every proposal with its verdict and feedback, every induction attempt; the outcome; the full nesy-core trace |
+//! | `procedure.txt` | the demonstrated procedure and the adapted one, as action blocks |
+//! | `policy.py` | the synthesized program (only when the adaptation resolved) |
+//! | `execution.json` | the sandbox's result (outcome, API trace, output, subtasks, final state) and SR/GC/PD |
+//! | `target_scene.json` | the scene as run (the input plus `embodiment_in_state` when embodiments differ) |
+//! | `target_{top,front,back}[_marked].png` | the rendered target views |
+//! | `report.md` | a readable summary embedding the target views |
+//! | `summary.json` | what `--json` prints |
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::Context as _;
+use nesy_core::adapt::{Adaptation, Outcome, TraceEvent, Verdict};
+use nesy_core::format_procedure;
+use serde::Serialize;
+use serde_json::json;
+
+use super::inputs::TargetInput;
+use super::{AdaptRun, StateSource};
+
+/// `world_model.json`.
+pub const WORLD_MODEL_FILE: &str = "world_model.json";
+/// `adaptation.json`.
+pub const ADAPTATION_FILE: &str = "adaptation.json";
+/// `procedure.txt`.
+pub const PROCEDURE_FILE: &str = "procedure.txt";
+/// `policy.py`.
+pub const POLICY_FILE: &str = "policy.py";
+/// `execution.json`.
+pub const EXECUTION_FILE: &str = "execution.json";
+/// `target_scene.json`.
+pub const TARGET_SCENE_FILE: &str = "target_scene.json";
+/// `report.md`.
+pub const REPORT_FILE: &str = "report.md";
+/// `summary.json`.
+pub const SUMMARY_FILE: &str = "summary.json";
+
+/// Writes a file, naming it on failure.
+pub fn write(path: &Path, contents: &str) -> anyhow::Result<()> {
+    std::fs::write(path, contents).with_context(|| format!("writing {}", path.display()))
+}
+
+fn write_json(path: &Path, value: &impl Serialize) -> anyhow::Result<()> {
+    let text =
+        serde_json::to_string_pretty(value).with_context(|| format!("serialising {}", path.display()))?;
+    write(path, &(text + "\n"))
+}
+
+/// One violation the symbolic executor found while identifying (Eq. 6).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct FoundViolation {
+    /// Loop iteration.
+    pub iteration: usize,
+    /// `precondition` or `goal`.
+    pub kind: &'static str,
+    /// 0-based failing step (precondition violations).
+    pub step: Option<usize>,
+    /// The failing action.
+    pub action: Option<String>,
+    /// The unmet literals, as written.
+    pub unmet: Vec<String>,
+}
+
+/// One patch proposal and its verdict.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct ProposalSummary {
+    /// Loop iteration.
+    pub iteration: usize,
+    /// `accepted` or `rejected`.
+    pub verdict: &'static str,
+    /// Why it was rejected (the verifier's message).
+    pub feedback: Option<String>,
+    /// Number of actions after the patch, when accepted.
+    pub actions_after: Option<usize>,
+    /// The model's reply.
+    pub reply: String,
+}
+
+/// Every violation identification found, in order.
+pub fn violations(adaptation: &Adaptation) -> Vec<FoundViolation> {
+    let mut found = Vec::new();
+    for event in &adaptation.trace.events {
+        let TraceEvent::Identification {
+            iteration,
+            procedure,
+            report,
+        } = event
+        else {
+            continue;
+        };
+        if let Some(v) = report.first_violation() {
+            found.push(FoundViolation {
+                iteration: *iteration,
+                kind: "precondition",
+                step: report.first_failure,
+                action: report
+                    .first_failure
+                    .and_then(|i| procedure.get(i))
+                    .map(|o| o.display_name())
+                    .or_else(|| Some(v.action.clone())),
+                unmet: v.unmet.iter().map(|u| u.literal.to_string()).collect(),
+            });
+        } else if let Some(goal) = report.goal.as_ref().filter(|g| !g.satisfied) {
+            found.push(FoundViolation {
+                iteration: *iteration,
+                kind: "goal",
+                step: None,
+                action: None,
+                unmet: goal.unmet.iter().map(|u| u.literal.to_string()).collect(),
+            });
+        }
+    }
+    found
+}
+
+/// Every proposal, in order.
+pub fn proposals(adaptation: &Adaptation) -> Vec<ProposalSummary> {
+    adaptation
+        .trace
+        .events
+        .iter()
+        .filter_map(|event| match event {
+            TraceEvent::Proposal {
+                iteration,
+                reply,
+                verdict,
+                procedure_after,
+                ..
+            } => Some(ProposalSummary {
+                iteration: *iteration,
+                verdict: match verdict {
+                    Verdict::Accepted { .. } => "accepted",
+                    Verdict::Rejected { .. } => "rejected",
+                },
+                feedback: match verdict {
+                    Verdict::Rejected { feedback } => Some(feedback.message.clone()),
+                    Verdict::Accepted { .. } => None,
+                },
+                actions_after: procedure_after.as_ref().map(Vec::len),
+                reply: reply.clone(),
+            }),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Induction attempts: (transition, attempt, accepted, feedback).
+fn inductions(adaptation: &Adaptation) -> Vec<serde_json::Value> {
+    adaptation
+        .trace
+        .events
+        .iter()
+        .filter_map(|event| match event {
+            TraceEvent::Induction {
+                step,
+                attempt,
+                reply,
+                verdict,
+                ..
+            } => Some(json!({
+                "step": step,
+                "attempt": attempt,
+                "verdict": match verdict { Verdict::Accepted { .. } => "accepted", Verdict::Rejected { .. } => "rejected" },
+                "feedback": match verdict { Verdict::Rejected { feedback } => Some(feedback.message.clone()), _ => None },
+                "reply": reply,
+            })),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Counts (calls, rejected) of induction attempts.
+pub fn induction_counts(adaptation: &Adaptation) -> (usize, usize) {
+    let mut calls = 0;
+    let mut rejected = 0;
+    for event in &adaptation.trace.events {
+        if let TraceEvent::Induction { verdict, .. } = event {
+            calls += 1;
+            rejected += usize::from(matches!(verdict, Verdict::Rejected { .. }));
+        }
+    }
+    (calls, rejected)
+}
+
+/// `procedure.txt`.
+pub fn procedure_text(run: &AdaptRun) -> String {
+    let mut text = String::new();
+    let demonstrated = run.demonstrated();
+    let _ = writeln!(
+        text,
+        "# Demonstrated procedure ({} actions)\n",
+        demonstrated.len()
+    );
+    text.push_str(&format_procedure(demonstrated));
+    text.push_str("\n\n");
+    match &run.adaptation.outcome {
+        Outcome::Adapted {
+            procedure,
+            iterations,
+            ..
+        } => {
+            let _ = writeln!(
+                text,
+                "# Adapted procedure ({} actions, verified from the target's initial state; {iterations} proposal(s))\n",
+                procedure.len()
+            );
+            text.push_str(&format_procedure(procedure));
+        }
+        Outcome::Unresolved { best, iterations, .. } => {
+            let _ = writeln!(
+                text,
+                "# UNRESOLVED after {iterations} proposal(s): no verified procedure. The one that got furthest ({} actions), NOT verified:\n",
+                best.len()
+            );
+            text.push_str(&format_procedure(best));
+        }
+    }
+    text.push('\n');
+    text
+}
+
+/// Writes every output of `run` into `dir`.
+pub fn write_all(run: &AdaptRun, target: &TargetInput, dir: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("creating the output directory {}", dir.display()))?;
+    let wm = &run.adaptation.world_model;
+    write_json(
+        &dir.join(WORLD_MODEL_FILE),
+        &json!({
+            "demo": run.demo_path,
+            "tier": run.setting.tier,
+            "states": run.demo_states,
+            "procedure": wm.procedure,
+            "procedure_text": format_procedure(&wm.procedure),
+            "goal": wm.goal.to_string(),
+            "unverified_steps": wm.unverified_steps,
+            "verified": wm.is_verified(),
+        }),
+    )?;
+    let outcome_name = if run.adaptation.outcome.is_adapted() {
+        "adapted"
+    } else {
+        "unresolved"
+    };
+    write_json(
+        &dir.join(ADAPTATION_FILE),
+        &json!({
+            "status": outcome_name,
+            "budget": run.setting.budget,
+            "target_state": run.target_state,
+            "violations": violations(&run.adaptation),
+            "proposals": proposals(&run.adaptation),
+            "inductions": inductions(&run.adaptation),
+            "outcome": run.adaptation.outcome,
+            "trace": run.adaptation.trace,
+        }),
+    )?;
+    write(&dir.join(PROCEDURE_FILE), &procedure_text(run))?;
+    if let Some(execution) = &run.execution {
+        write_json(&dir.join(EXECUTION_FILE), execution)?;
+    }
+    for view in &target.views {
+        for (suffix, image) in [("", &view.image), ("_marked", &view.marked)] {
+            let path = dir.join(format!("target_{}{suffix}.png", view.camera));
+            std::fs::write(&path, image.to_png()).with_context(|| format!("writing {}", path.display()))?;
+        }
+    }
+    write(&dir.join(REPORT_FILE), &report_markdown(run, target))?;
+    write_json(&dir.join(SUMMARY_FILE), run)?;
+    Ok(())
+}
+
+/// `report.md`: the run for a human, with the target views embedded.
+pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
+    let mut md = String::new();
+    let _ = writeln!(md, "# nesy adapt: {}\n", run.status.as_str());
+    let _ = writeln!(md, "- demo: `{}`", run.demo_path.display());
+    let _ = writeln!(md, "- target: `{}`", run.target_path.display());
+    let s = &run.setting;
+    let _ = writeln!(
+        md,
+        "- embodiment: {} → {}; predicate tier `{:?}`; factor {:?}, complexity {:?}; budget {} ({})",
+        s.source_embodiment, s.target_embodiment, s.tier, s.factor, s.complexity, s.budget, s.budget_origin
+    );
+    let states = match &run.states {
+        StateSource::Observed => "observed (simulator ground truth)".to_owned(),
+        StateSource::Vlm {
+            translated,
+            rejected_atoms,
+            agreement,
+        } => format!(
+            "VLM state translation ({translated} states, {rejected_atoms} atoms rejected{})",
+            agreement
+                .map(|a| format!(", F1 {:.2} against ground truth", a.f1))
+                .unwrap_or_default()
+        ),
+    };
+    let _ = writeln!(md, "- states: {states}\n");
+
+    let _ = writeln!(md, "## Target scene\n");
+    let _ = writeln!(md, "Instruction: {}\n", run.instruction);
+    for view in &target.views {
+        let _ = write!(md, "![{0} view](target_{0}_marked.png) ", view.camera);
+    }
+    let _ = writeln!(md, "\n\nInitial state:\n\n```\n{}\n```\n", run.target_state);
+
+    let (calls, rejected) = induction_counts(&run.adaptation);
+    let wm = &run.adaptation.world_model;
+    let _ = writeln!(md, "## World model\n");
+    let _ = writeln!(
+        md,
+        "{} operators from {} keyframes; {} induction call(s), {} rejected by the verifier; {}.\n",
+        wm.procedure.len(),
+        run.demo_states.len(),
+        calls,
+        rejected,
+        if wm.is_verified() {
+            "every operator verified".to_owned()
+        } else {
+            format!("UNVERIFIED transitions: {:?}", wm.unverified_steps)
+        }
+    );
+    let _ = writeln!(md, "Goal: `{}`\n", wm.goal);
+
+    let _ = writeln!(md, "## Counterfactual adaptation\n");
+    for v in violations(&run.adaptation) {
+        match v.kind {
+            "precondition" => {
+                let _ = writeln!(
+                    md,
+                    "- iteration {}: step {} `{}` violates {}",
+                    v.iteration + 1,
+                    v.step.map(|s| s + 1).unwrap_or_default(),
+                    v.action.unwrap_or_default(),
+                    v.unmet.join(", ")
+                );
+            }
+            _ => {
+                let _ = writeln!(
+                    md,
+                    "- iteration {}: goal unmet: {}",
+                    v.iteration + 1,
+                    v.unmet.join(", ")
+                );
+            }
+        }
+    }
+    for p in proposals(&run.adaptation) {
+        let _ = writeln!(
+            md,
+            "- proposal {}: {}{}",
+            p.iteration + 1,
+            p.verdict,
+            p.feedback
+                .map(|f| format!(" — {}", f.lines().next().unwrap_or_default()))
+                .unwrap_or_default()
+        );
+    }
+    let _ = writeln!(md, "\n```\n{}```\n", procedure_text(run));
+
+    let _ = writeln!(md, "## Policy\n");
+    match (&run.policy, &run.codegen_error) {
+        (Some(p), _) => {
+            let _ = writeln!(
+                md,
+                "`policy.py` ({:?} code generation):\n\n```python\n{}\n```\n",
+                p.mode,
+                p.code.trim_end()
+            );
+        }
+        (None, Some(e)) => {
+            let _ = writeln!(md, "Code synthesis failed: {e}\n");
+        }
+        (None, None) => {
+            let _ = writeln!(
+                md,
+                "No policy: the adaptation did not resolve, and an unverified plan is never compiled.\n"
+            );
+        }
+    }
+    if let Some(execution) = &run.execution {
+        let _ = writeln!(md, "## Execution\n");
+        let r = &execution.result;
+        let actions = r.trace.iter().filter(|e| e.call.is_action()).count();
+        let _ = writeln!(
+            md,
+            "Outcome `{}`; {} API calls ({} actions); {:.2} s.\n",
+            r.outcome.kind(),
+            r.trace.len(),
+            actions,
+            r.wall_time_s
+        );
+        match &execution.metrics {
+            Some(m) => {
+                for s in &m.subtasks {
+                    let _ = writeln!(md, "- {}: {:?}", s.subtask, s.status);
+                }
+                let _ = writeln!(
+                    md,
+                    "\nSR {:.0}, GC {:.2}, PD {}\n",
+                    m.sr,
+                    m.gc,
+                    m.pd.map(|p| format!("{p:.2}")).unwrap_or_else(|| "n/a".into())
+                );
+            }
+            None => {
+                let _ = writeln!(md, "No goal checks were reported for this episode.\n");
+            }
+        }
+        let _ = writeln!(md, "API trace:\n\n```");
+        for e in &r.trace {
+            let _ = writeln!(
+                md,
+                "{:>3} {} {}",
+                e.index,
+                serde_json::to_string(&e.call).unwrap_or_default(),
+                match &e.result {
+                    Ok(_) => "ok".to_owned(),
+                    Err(err) => format!("REFUSED: {err}"),
+                }
+            );
+        }
+        let _ = writeln!(md, "```\n");
+    }
+    let t = &run.timing;
+    let _ = writeln!(md, "## Time\n");
+    let _ = writeln!(md, "| VLM | symbolic | simulation | total |\n|---|---|---|---|");
+    let _ = writeln!(
+        md,
+        "| {:.3} s | {:.3} ms | {:.3} s | {:.3} s |",
+        t.vlm_s,
+        t.symbolic_s * 1e3,
+        t.sim_s,
+        t.total_s
+    );
+    md
+}

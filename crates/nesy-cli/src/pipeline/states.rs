@@ -1,0 +1,236 @@
+//! Step 2: symbolic states for the demo's keyframes and the target's initial state.
+//!
+//! - `observed`: the ground-truth states the simulator recorded in the demo and observes in
+//!   the target (the authors' setting, spec §10.1).
+//! - `vlm`: the paper's State Translation (Eq. 2) on the marked views, through
+//!   [`VlmReasoner::translate_state`]. When ground truth exists anyway (simulated demos), the
+//!   translation's precision, recall and F1 against it are reported, as the paper does.
+
+use std::time::{Duration, Instant};
+
+use anyhow::Context as _;
+use nesy_core::predicates::Vocabulary;
+use nesy_core::{Atom, State};
+use nesy_sim::api::Embodiment;
+use nesy_vlm::{StateTranslationRequest, VlmReasoner};
+use serde::Serialize;
+
+use super::Setting;
+use super::inputs::{DemoInput, DemoKeyframes, TargetInput};
+use super::progress::Progress;
+
+/// Where symbolic states come from (`--states`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum StatesMode {
+    /// Ground truth when the demo has it for every keyframe, else the VLM.
+    #[default]
+    Auto,
+    /// Ground truth from the demo and the target simulator.
+    Observed,
+    /// The VLM's State Translation prompt on the marked views.
+    Vlm,
+}
+
+/// Which source was used, with the translation's quality when ground truth was at hand.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "source", rename_all = "snake_case")]
+pub enum StateSource {
+    /// Ground truth.
+    Observed,
+    /// State Translation.
+    Vlm {
+        /// States translated (keyframes + the target).
+        translated: usize,
+        /// Predicted atoms rejected (unknown predicate or object, wrong arity, not in tier).
+        rejected_atoms: usize,
+        /// Micro-averaged precision/recall/F1 against ground truth, where it was known.
+        agreement: Option<Agreement>,
+    },
+}
+
+/// Agreement of translated states with ground truth (micro-averaged over atoms).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Agreement {
+    /// Translated atoms that are true.
+    pub precision: f64,
+    /// True atoms that were translated.
+    pub recall: f64,
+    /// Harmonic mean.
+    pub f1: f64,
+}
+
+/// The states the adaptation runs on.
+#[derive(Debug, Clone)]
+pub struct SymbolicStates {
+    /// s_1 … s_N.
+    pub demo_states: Vec<State>,
+    /// ŝ_1.
+    pub target_state: State,
+    /// Where they came from.
+    pub source: StateSource,
+    /// Time spent in model calls.
+    pub vlm_time: Duration,
+}
+
+/// The embodiment atom the states carry when embodiments differ.
+pub fn embodiment_atom(e: Embodiment) -> Atom {
+    let text = match e {
+        Embodiment::Finger => "(FingerGripper)",
+        Embodiment::Vacuum => "(VacuumSuction)",
+    };
+    text.parse().expect("a built-in nullary atom parses")
+}
+
+/// `state` with `atom` added.
+fn with_atom(state: &State, atom: Atom) -> State {
+    let mut s = state.clone();
+    s.insert(atom);
+    s
+}
+
+/// Produces the states for `mode`.
+pub async fn symbolic_states(
+    reasoner: &VlmReasoner,
+    demo: &DemoInput,
+    target: &TargetInput,
+    setting: &Setting,
+    mode: StatesMode,
+    vocabulary: &Vocabulary,
+    progress: &dyn Progress,
+) -> anyhow::Result<SymbolicStates> {
+    let truth = demo.demo.states();
+    let source_atom = setting
+        .embodiment_in_state
+        .then(|| embodiment_atom(setting.source_embodiment));
+    let truth = truth.map(|states| match source_atom {
+        // A demo recorded without the embodiment atom gets it on every state, as the authors
+        // append `(FingerGripper)` to gripper demos adapted to suction.
+        Some(atom) => states.iter().map(|s| with_atom(s, atom)).collect::<Vec<_>>(),
+        None => states,
+    });
+    let use_vlm = match mode {
+        StatesMode::Observed => false,
+        StatesMode::Vlm => true,
+        StatesMode::Auto => truth.is_none(),
+    };
+    if !use_vlm {
+        let demo_states = truth.with_context(|| {
+            let missing = demo
+                .demo
+                .keyframes
+                .iter()
+                .find(|k| k.state.is_none())
+                .map(|k| k.index)
+                .unwrap_or_default();
+            format!(
+                "{}: keyframe {missing} has no ground-truth state; use --states vlm for demos without ground truth",
+                demo.path.display()
+            )
+        })?;
+        progress.detail("ground-truth states");
+        return Ok(SymbolicStates {
+            demo_states,
+            target_state: target.observed.clone(),
+            source: StateSource::Observed,
+            vlm_time: Duration::ZERO,
+        });
+    }
+
+    let started = Instant::now();
+    let keyframes = DemoKeyframes::from_demo(&demo.demo)?;
+    let known = State::from_atoms(source_atom);
+    let mut requests = Vec::new();
+    for k in &demo.demo.keyframes {
+        let views = keyframes
+            .keyframe_views(k.index)
+            .with_context(|| format!("{}: keyframe {} has no views", demo.path.display(), k.index))?;
+        requests.push(StateTranslationRequest {
+            view_set: format!("demo/keyframe/{}", k.index),
+            instruction: demo.demo.metadata.instruction.clone(),
+            objects: demo.objects(),
+            tier: setting.tier,
+            vocabulary: vocabulary.clone(),
+            known: known.clone(),
+            views: views.clone(),
+            ground_truth: truth.as_ref().and_then(|t| t.get(k.index).cloned()),
+        });
+    }
+    let target_known = State::from_atoms(
+        setting
+            .embodiment_in_state
+            .then(|| embodiment_atom(setting.target_embodiment)),
+    );
+    requests.push(StateTranslationRequest {
+        view_set: "target/initial".into(),
+        instruction: target.instruction(demo),
+        objects: target.objects.clone(),
+        tier: setting.tier,
+        vocabulary: vocabulary.clone(),
+        known: target_known,
+        views: target.marked_views()?,
+        ground_truth: Some(target.observed.clone()),
+    });
+
+    // The calls are independent: run them concurrently (the client caps concurrency).
+    let total = requests.len();
+    let mut set = tokio::task::JoinSet::new();
+    for (i, request) in requests.into_iter().enumerate() {
+        let reasoner = reasoner.clone();
+        set.spawn(async move {
+            let result = reasoner.translate_state(&request).await;
+            (i, request, result)
+        });
+    }
+    let mut results: Vec<Option<(StateTranslationRequest, nesy_vlm::TranslatedState)>> = vec![None; total];
+    let mut done = 0;
+    while let Some(joined) = set.join_next().await {
+        let (i, request, result) = joined.context("a state-translation task panicked")?;
+        let translated = result.with_context(|| format!("translating the states of {}", request.view_set))?;
+        done += 1;
+        progress.detail(&format!("state translation {done}/{total}"));
+        results[i] = Some((request, translated));
+    }
+    let results: Vec<_> = results.into_iter().flatten().collect();
+
+    let mut rejected_atoms = 0;
+    let (mut tp, mut predicted, mut actual) = (0usize, 0usize, 0usize);
+    let mut states = Vec::with_capacity(total);
+    for (request, translated) in &results {
+        rejected_atoms += translated.rejected.len();
+        if let Some(truth) = &request.ground_truth {
+            predicted += translated.state.len();
+            actual += truth.len();
+            tp += translated.state.iter().filter(|a| truth.contains(a)).count();
+        }
+        states.push(translated.state.clone());
+    }
+    let target_state = states.pop().context("no target translation")?;
+    let agreement = (actual > 0).then(|| {
+        let precision = if predicted == 0 {
+            0.0
+        } else {
+            tp as f64 / predicted as f64
+        };
+        let recall = tp as f64 / actual as f64;
+        let f1 = if precision + recall == 0.0 {
+            0.0
+        } else {
+            2.0 * precision * recall / (precision + recall)
+        };
+        Agreement {
+            precision,
+            recall,
+            f1,
+        }
+    });
+    Ok(SymbolicStates {
+        demo_states: states,
+        target_state,
+        source: StateSource::Vlm {
+            translated: total,
+            rejected_atoms,
+            agreement,
+        },
+        vlm_time: started.elapsed(),
+    })
+}

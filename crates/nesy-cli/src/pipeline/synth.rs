@@ -1,0 +1,137 @@
+//! Step 5: the adapted, verified procedure becomes a Python code policy.
+//!
+//! - `vlm`: the paper's Code Generation prompt (finger, or extended with the vacuum
+//!   functions when the embodiment changed or the target is a vacuum tool), the numbered
+//!   action names as the demonstration summary; the program is extracted from the reply.
+//! - `template`: every verified symbolic action compiled deterministically to API calls by
+//!   nesy-sim's template compiler (beyond the paper).
+
+use nesy_core::Operator;
+use nesy_sim::api::Embodiment;
+use nesy_sim::scene::SceneSpec;
+use nesy_vlm::{CodeGenerationRequest, CodegenError, VlmReasoner};
+use serde::Serialize;
+
+use super::to_vlm_embodiment;
+
+/// How code is synthesized (`--codegen`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CodegenMode {
+    /// The VLM's Code Generation prompt.
+    #[default]
+    Vlm,
+    /// The deterministic template compiler.
+    Template,
+}
+
+/// What synthesis needs.
+#[derive(Debug, Clone)]
+pub struct SynthesisRequest<'a> {
+    /// The target's instruction.
+    pub instruction: String,
+    /// The target's objects.
+    pub objects: Vec<String>,
+    /// The adapted procedure.
+    pub procedure: Vec<Operator>,
+    /// The demo's end effector.
+    pub source: Embodiment,
+    /// The target's end effector.
+    pub target: Embodiment,
+    /// The target scene (for the template compiler).
+    pub scene: &'a SceneSpec,
+}
+
+/// A synthesized program and how it was obtained.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct SynthesizedPolicy {
+    /// The program.
+    pub code: String,
+    /// Which synthesizer made it.
+    pub mode: CodegenMode,
+    /// The model's full reply (`vlm` only).
+    pub reply: Option<String>,
+    /// Whether the extended (both end effectors) prompt was used (`vlm` only).
+    pub extended: bool,
+    /// Import lines removed from the model's program, with why.
+    pub stripped: Vec<String>,
+}
+
+/// Why synthesis produced no program.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SynthError {
+    /// The generator answered, but without a usable program (a negative verdict).
+    NoProgram {
+        /// What was wrong.
+        message: String,
+    },
+    /// The generator could not be asked (transport, cassette miss, prompt defect): the run
+    /// fails with an error after writing its outputs.
+    Call {
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl std::fmt::Display for SynthError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SynthError::NoProgram { message } => write!(f, "no program: {message}"),
+            SynthError::Call { message } => write!(f, "code generation failed: {message}"),
+        }
+    }
+}
+
+/// Synthesizes the policy.
+pub async fn synthesize(
+    reasoner: &VlmReasoner,
+    mode: CodegenMode,
+    request: &SynthesisRequest<'_>,
+) -> Result<SynthesizedPolicy, SynthError> {
+    match mode {
+        CodegenMode::Vlm => {
+            let result = reasoner
+                .generate_code(&CodeGenerationRequest {
+                    instruction: request.instruction.clone(),
+                    objects: request.objects.clone(),
+                    procedure: request.procedure.clone(),
+                    embodiment: to_vlm_embodiment(request.target),
+                    extended: request.source != request.target,
+                })
+                .await;
+            let source = match result {
+                Ok(source) => source,
+                Err(e @ CodegenError::NoProgram { .. }) => {
+                    return Err(SynthError::NoProgram {
+                        message: e.to_string(),
+                    });
+                }
+                Err(e) => {
+                    return Err(SynthError::Call {
+                        message: e.to_string(),
+                    });
+                }
+            };
+            Ok(SynthesizedPolicy {
+                code: source.code,
+                mode,
+                reply: Some(source.reply),
+                extended: source.extended,
+                stripped: source
+                    .stripped
+                    .iter()
+                    .map(|s| format!("line {}: {} ({})", s.line, s.text, s.reason))
+                    .collect(),
+            })
+        }
+        CodegenMode::Template => template(request),
+    }
+}
+
+fn template(request: &SynthesisRequest<'_>) -> Result<SynthesizedPolicy, SynthError> {
+    let _ = request;
+    Err(SynthError::Call {
+        message: "--codegen template: the template compiler is not available in this build yet".into(),
+    })
+}
