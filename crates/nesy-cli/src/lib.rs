@@ -29,10 +29,14 @@ pub enum Command {
     Adapt(Box<commands::adapt::AdaptArgs>),
     /// Inspect, prune or verify VLM cassettes (recorded model calls for offline replay).
     Cassette(commands::cassette::CassetteArgs),
+    /// Record a scripted-expert demonstration of a benchmark scenario as MCAP.
+    Record(commands::record::RecordArgs),
     /// Render a scene's top, front and back views as PNG (plain and labelled).
     Render(commands::render::RenderArgs),
     /// Run a code policy against a scene in the sandboxed Python worker.
     Run(commands::run::RunArgs),
+    /// Generate, list, show and sweep the benchmark's 440 scenarios.
+    Scenarios(commands::scenarios::ScenariosArgs),
     /// Verify a plan against a PDDL domain and problem, like VAL.
     Verify(commands::verify::VerifyArgs),
     /// Worker process of `nesy run` (internal).
@@ -58,8 +62,10 @@ pub fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
         Command::Adapt(args) => commands::adapt::run(*args),
         Command::Cassette(args) => commands::cassette::run(args),
+        Command::Record(args) => commands::record::run(args),
         Command::Render(args) => commands::render::run(args),
         Command::Run(args) => commands::run::run(args),
+        Command::Scenarios(args) => commands::scenarios::run(args),
         Command::Verify(args) => commands::verify::run(args),
         Command::PolicyWorker(args) => commands::worker::run(args),
     };

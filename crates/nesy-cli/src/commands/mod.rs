@@ -2,7 +2,9 @@
 
 pub mod adapt;
 pub mod cassette;
+pub mod record;
 pub mod render;
 pub mod run;
+pub mod scenarios;
 pub mod verify;
 pub mod worker;
