@@ -415,3 +415,104 @@ print(json.dumps({"counts": counts, "pngs": pngs, "metadata": {m.name: m.metadat
     assert!(meta["instruction"].as_str().unwrap().contains("cube"));
     let _ = (ACTION_TOPIC, STATE_TOPIC);
 }
+
+/// The committed fixture demos: name, source task, target task (see fixtures/demos/README.md).
+fn fixture_tasks() -> Vec<(&'static str, TaskConfig, TaskConfig)> {
+    let one = |kind, variant, obst, embodiment, in_state| TaskConfig {
+        subtasks: vec![SubtaskConfig {
+            kind,
+            variant,
+            obst_level: obst,
+            multi_level: 0,
+        }],
+        episode: variant,
+        embodiment,
+        embodiment_in_state: in_state,
+    };
+    let files = nesy_sim::scenario::generate_suite();
+    let composite = nesy_sim::scenario::find(&files, FIXTURE_COMPOSITE).unwrap();
+    use nesy_sim::scenario::Side;
+    vec![
+        (
+            "pick_place_obst_0to1_finger",
+            one(SubtaskKind::PickPlace, 11, 0, Embodiment::Finger, false),
+            one(SubtaskKind::PickPlace, 11, 1, Embodiment::Finger, false),
+        ),
+        (
+            "put_in_hinge_obst_0to2_finger",
+            one(SubtaskKind::PutInHinge, 12, 0, Embodiment::Finger, false),
+            one(SubtaskKind::PutInHinge, 12, 2, Embodiment::Finger, false),
+        ),
+        (
+            "pick_place_grip_finger_to_vacuum",
+            one(SubtaskKind::PickPlace, 13, 0, Embodiment::Finger, true),
+            one(SubtaskKind::PickPlace, 13, 0, Embodiment::Vacuum, true),
+        ),
+        (
+            "composite_medium",
+            composite.task(Side::Source),
+            composite.task(Side::Target),
+        ),
+    ]
+}
+
+/// The suite scenario the medium composite fixture is recorded from.
+const FIXTURE_COMPOSITE: &str = "obst_medium_00_s0";
+/// Image side of the fixture demos (reduced from 384 to keep each file small).
+const FIXTURE_IMAGE_SIZE: u32 = 256;
+
+/// Re-records the fixture demos (`cargo test -p nesy-sim --test demo -- --ignored`).
+#[test]
+#[ignore = "rewrites fixtures/demos (about a minute)"]
+fn record_fixture_demos() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/demos");
+    for (name, source, target) in fixture_tasks() {
+        let source_scene = source.generate().unwrap().scene;
+        let target_scene = target.generate().unwrap().scene;
+        let options = RecordOptions {
+            image_size: FIXTURE_IMAGE_SIZE,
+            render_threads: nesy_sim::render::default_threads(),
+            scenario_id: Some(name.to_owned()),
+            side: Some("source".into()),
+            target_scene: Some(target_scene.clone()),
+        };
+        let recording = nesy_sim::demo::record_scene(&source_scene, &options).unwrap();
+        assert!(
+            recording.full_success(),
+            "{name}: {:?} {}",
+            recording.expert_error,
+            recording.outcome.summary()
+        );
+        // The target must be solvable too: the expert reaches full_success on it.
+        let target_run = nesy_sim::demo::run_expert(&target_scene).unwrap();
+        assert!(
+            target_run.full_success(),
+            "{name} target: {:?} {}",
+            target_run.expert_error,
+            target_run.outcome.summary()
+        );
+        let dir = root.join(name);
+        mcap_format::write_mcap_file(&recording.demo, &dir.join("demo.mcap")).unwrap();
+        std::fs::write(dir.join("target.json"), target_scene.to_json_pretty() + "\n").unwrap();
+    }
+}
+
+/// The committed fixture demos read, carry their target scene, and match their tasks.
+#[test]
+fn fixture_demos_read_and_match_their_tasks() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/demos");
+    for (name, source, target) in fixture_tasks() {
+        let dir = root.join(name);
+        let demo = nesy_sim::demo::read(&dir).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let target_scene = target.generate().unwrap().scene;
+        let on_disk = nesy_sim::SceneSpec::from_file(&dir.join("target.json")).unwrap();
+        assert_eq!(on_disk, target_scene, "{name}: target.json is current");
+        assert_eq!(demo.metadata.target_scene.as_ref(), Some(&target_scene), "{name}");
+        assert_eq!(demo.metadata.instruction, source.instruction());
+        assert_eq!(demo.metadata.embodiment, source.embodiment);
+        assert!(demo.states().is_some() && demo.calls().is_some(), "{name}");
+        assert!(demo.keyframes.len() > 4, "{name}");
+        let size = std::fs::metadata(dir.join("demo.mcap")).unwrap().len();
+        assert!(size < 4_000_000, "{name}: {size} bytes");
+    }
+}
