@@ -8,7 +8,9 @@
 //! there is one, and lids and drawers are opened when they are closed.
 
 use crate::api::{ApiError, Direction, Embodiment, RobotApi};
-use crate::scene::SubtaskGoal;
+use crate::goal::{EpisodeOutcome, GoalError, GoalMonitor};
+use crate::scene::{SceneError, SceneSpec, SubtaskGoal};
+use crate::sim::Sim;
 use crate::task::SubtaskKind;
 
 /// Why an expert stopped.
@@ -38,9 +40,22 @@ const TOY_BOX_CELLS: [[f64; 2]; 6] = [
 /// flat base and do not roll aside when dropped onto each other.
 const HINGE_SPOTS: [f64; 3] = [-0.06, 0.0, 0.06];
 /// Cylinder drop spots in the bottom drawer (x offset, outward y offset from the drawer's
-/// centre, m), 4.5 cm or more apart: a cylinder dropped onto another one tips over, and one
-/// lying on its side rolls on without stopping (Rapier has no rolling resistance).
-const DRAWER_SPOTS: [[f64; 2]; 3] = [[-0.045, 0.0], [0.045, 0.0], [0.0, 0.04]];
+/// centre, m). They are 5 cm or more apart, because a cylinder dropped onto another one tips
+/// over and, lying on its side, rolls on without stopping (Rapier has no rolling
+/// resistance); and 1.5 cm or more inside the walls, because a cylinder falling 19 cm that
+/// clips a wall's top edge is flung out of the drawer.
+const DRAWER_SPOTS: [[f64; 2]; 3] = [[-0.035, -0.005], [0.035, -0.005], [0.0, 0.035]];
+/// Waypoints of the tool around the hinge axis when opening the lid (degrees from +x in
+/// the x–z plane; the closed lid points at 180°, the open one at 90°). A grasped lid follows
+/// the tool's angle about the axis, and the handle slips when the tool gets more than
+/// 10 cm from it: a single straight move (the authors' recipe) cuts the arc short, and with
+/// the tool holding the handle a little above its centre it left the lid short of vertical or
+/// lost the handle. Short arcs keep the tool near the handle; the last one is 30° past
+/// vertical so the lid stops at its limit (q = 0.8).
+const LID_OPENING_ARC: [f64; 3] = [135.0, 90.0, 60.0];
+/// Waypoints when closing the lid (the last one is the authors' target, the body's −x top
+/// edge).
+const LID_CLOSING_ARC: [f64; 2] = [135.0, 180.0];
 /// Height above the release point at which a carried object is let go over a container.
 const DROP_CLEARANCE: f64 = 0.01;
 /// Height of the table top.
@@ -104,8 +119,13 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
     }
 
     fn move_to(&mut self, pos: [f64; 3], clearance: f64) -> Result<(), ExpertError> {
+        self.move_to_turned(pos, clearance, 0.0)
+    }
+
+    /// [`Hand::move_to`] with the wrist turned by `angle` (rad) about the vertical.
+    fn move_to_turned(&mut self, pos: [f64; 3], clearance: f64, angle: f64) -> Result<(), ExpertError> {
         self.robot
-            .move_to_position(pos, Direction::Down, clearance, 0.0)
+            .move_to_position(pos, Direction::Down, clearance, angle)
             .map_err(|e| {
                 self.fail(
                     format!("move_to_position(({:.3}, {:.3}, {:.3}))", pos[0], pos[1], pos[2]),
@@ -115,8 +135,18 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
     }
 
     fn slide(&mut self, dir: Direction, offset: f64) -> Result<(), ExpertError> {
+        self.slide_pointing(dir, offset, Direction::Down)
+    }
+
+    /// [`Hand::slide`] with the tool pointing along `pointing`.
+    fn slide_pointing(
+        &mut self,
+        dir: Direction,
+        offset: f64,
+        pointing: Direction,
+    ) -> Result<(), ExpertError> {
         self.robot
-            .move_parallel(dir, offset, Direction::Down)
+            .move_parallel(dir, offset, pointing)
             .map_err(|e| self.fail(format!("move_parallel({}, {offset:.3})", dir.as_str()), e))
     }
 
@@ -138,9 +168,16 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
         result.map_err(|e| self.fail(format!("{name}()"), e))
     }
 
-    /// Moves to a handle and grasps it.
+    /// Moves to a handle from above and grasps it.
     fn grab_handle(&mut self, handle: &str) -> Result<(), ExpertError> {
-        self.move_to_object(handle, 0.0)?;
+        self.grab_handle_pointing(handle, Direction::Down)
+    }
+
+    /// Moves to a handle with the tool pointing along `pointing` and grasps it.
+    fn grab_handle_pointing(&mut self, handle: &str, pointing: Direction) -> Result<(), ExpertError> {
+        self.robot
+            .move_gripper_to(handle, pointing, 0.0)
+            .map_err(|e| self.fail(format!("move_gripper_to({handle}, {})", pointing.as_str()), e))?;
         let (name, result) = if self.vacuum {
             ("attach_vacuum_handle", self.robot.attach_vacuum_handle(handle))
         } else {
@@ -156,6 +193,22 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
             ("release_handle", self.robot.release_handle())
         };
         result.map_err(|e| self.fail(format!("{name}()"), e))
+    }
+
+    /// Moves a grasped lid's handle through `arc` (degrees) about the hinge `axis` (x, z)
+    /// at distance `reach`, one short move per waypoint.
+    fn swing_lid(&mut self, axis: [f64; 2], y: f64, reach: f64, arc: &[f64]) -> Result<(), ExpertError> {
+        for angle in arc.iter().map(|a| a.to_radians()) {
+            // At the far offsets the hinge is 2 cm inside the workspace's +x edge (spec §1
+            // FLOOR_AABB); the last waypoint then comes in along x, still past vertical.
+            let x = (axis[0] + reach * angle.cos()).min(crate::sim::FLOOR_AABB.max[0] - 0.005);
+            let target = [x, y, axis[1] + reach * angle.sin()];
+            // Keep the wrist as it grasped the handle (fingers across the handle's thin side,
+            // turned by 90°): turning it on the way makes the arm leave the straight line, and
+            // the tool strays from the handle.
+            self.move_to_turned(target, 0.0, std::f64::consts::FRAC_PI_2)?;
+        }
+        Ok(())
     }
 
     /// Picks an object from above at half its height; returns its height.
@@ -185,6 +238,65 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
             .map_err(|e| self.fail(format!("get_empty_floor_xy({name})"), e))?;
         self.put(x, y, TABLE, h, DROP_CLEARANCE)
     }
+}
+
+/// Why an expert episode could not be run at all.
+#[derive(Debug, thiserror::Error)]
+pub enum EpisodeError {
+    /// The scene does not build.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The goals cannot be checked.
+    #[error(transparent)]
+    Goal(#[from] GoalError),
+}
+
+/// One expert run on a scene, judged by the goal checks.
+#[derive(Debug)]
+pub struct ExpertEpisode {
+    /// The goal checks' verdict after the post-run settle.
+    pub outcome: EpisodeOutcome,
+    /// Why the expert stopped early, if it did.
+    pub error: Option<ExpertError>,
+    /// Robot API action calls made.
+    pub actions: usize,
+    /// Simulated time at the end of the episode (s).
+    pub sim_time: f64,
+}
+
+impl ExpertEpisode {
+    /// The expert finished and every subtask is `full_success`.
+    pub fn full_success(&self) -> bool {
+        self.error.is_none() && self.outcome.full_success()
+    }
+
+    /// Why the episode is not a full success (`None` when it is).
+    pub fn failure(&self) -> Option<String> {
+        match &self.error {
+            Some(e) => Some(format!("{e} ({})", self.outcome.summary())),
+            None if !self.outcome.full_success() => Some(format!(
+                "{}; achieved {:?}",
+                self.outcome.summary(),
+                self.outcome.achieved_sequence
+            )),
+            None => None,
+        }
+    }
+}
+
+/// Builds the scene, runs the experts of all its goals with goal checks attached, and
+/// finishes the episode (spec §7's settle and final call).
+pub fn run_scene(scene: &SceneSpec) -> Result<ExpertEpisode, EpisodeError> {
+    let mut sim = Sim::new(scene)?;
+    let monitor = GoalMonitor::attach(&mut sim)?;
+    let error = run(&mut sim, &scene.goals).err();
+    let outcome = monitor.finish(&mut sim);
+    Ok(ExpertEpisode {
+        outcome,
+        error,
+        actions: sim.actions_used(),
+        sim_time: sim.time(),
+    })
 }
 
 /// Runs the expert of every goal of the scene, in order.
@@ -296,12 +408,15 @@ fn put_in_hinge<R: RobotApi + ?Sized>(
             hand.move_aside(fruit)?;
         }
     }
+    // The hinge runs along y at the body's +x top edge (the box is never turned).
+    let b = hand.bbox(body)?;
+    let axis = [b[1][0], b[1][2]];
+    let y = centre(&lid_box)[1];
+    let reach = size(&lid_box)[0].max(size(&lid_box)[2]);
     // A closed lid lies flat (1 cm thick); an open one stands up.
     if size(&lid_box)[2] < 0.05 {
         hand.grab_handle("hinge_handle")?;
-        let l = hand.bbox(lid)?;
-        let (c, r) = (centre(&l), size(&l)[0]);
-        hand.move_to([c[0] + 0.5 * r, c[1], c[2] + r], 0.0)?;
+        hand.swing_lid(axis, y, reach, &LID_OPENING_ARC)?;
         hand.let_go_handle()?;
     }
     for (k, fruit) in fruits.iter().enumerate() {
@@ -311,9 +426,7 @@ fn put_in_hinge<R: RobotApi + ?Sized>(
         hand.put(c[0], c[1] + HINGE_SPOTS[k % HINGE_SPOTS.len()], b[1][2], h, 0.03)?;
     }
     hand.grab_handle("hinge_handle")?;
-    let b = hand.bbox(body)?;
-    let (c, s) = (centre(&b), size(&b));
-    hand.move_to([c[0] - 0.5 * s[0], c[1], c[2] + 0.5 * s[2]], 0.0)?;
+    hand.swing_lid(axis, y, reach, &LID_CLOSING_ARC)?;
     hand.let_go_handle()
 }
 
@@ -341,16 +454,25 @@ fn put_in_prismatic<R: RobotApi + ?Sized>(
         }
     };
     let travel = size(&hand.bbox(drawer)?)[1] * 0.85;
+    // The suction tool reaches the bottom handle pointing at the cabinet: from above, its
+    // wrist (6 cm above the tip and wider than the 2.5 cm between the handle and the cabinet
+    // face) sweeps cylinders off the cabinet's front edge. The fingers come from above, as in
+    // the authors' demo.
+    let pointing = match (hand.vacuum, outward < 0.0) {
+        (false, _) => Direction::Down,
+        (true, true) => Direction::Right,
+        (true, false) => Direction::Left,
+    };
     if is_open(&hand.bbox("top_drawer")?) {
         hand.grab_handle("top_drawer_handle")?;
         hand.slide(close_dir, travel)?;
         hand.let_go_handle()?;
     }
     if !is_open(&hand.bbox(drawer)?) {
-        hand.grab_handle("bottom_drawer_handle")?;
-        hand.slide(open_dir, travel)?;
+        hand.grab_handle_pointing("bottom_drawer_handle", pointing)?;
+        hand.slide_pointing(open_dir, travel, pointing)?;
         hand.let_go_handle()?;
-        hand.slide(Direction::Up, 0.05)?;
+        hand.slide_pointing(Direction::Up, 0.05, pointing)?;
     }
     for (k, cylinder) in cylinders.iter().enumerate() {
         let h = hand.pick(cylinder)?;
@@ -359,7 +481,7 @@ fn put_in_prismatic<R: RobotApi + ?Sized>(
         // Released high enough that the hand clears the cylinders still on the cabinet.
         let [dx, dy] = DRAWER_SPOTS[k % DRAWER_SPOTS.len()];
         let x = c[0] + dx;
-        let y = c[1] + (0.01 + dy) * outward;
+        let y = c[1] + dy * outward;
         hand.move_to([x, y, c[2] + s[2] + h + 0.05], crate::api::DEFAULT_LIFT_CLEARANCE)?;
         hand.release()?;
     }

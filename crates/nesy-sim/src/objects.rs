@@ -114,6 +114,9 @@ pub struct PartBuild {
     pub rides_on: Option<usize>,
     /// Yaw to add to the object's yaw when the fingers grasp it (handles: across the bar).
     pub grasp_yaw: f64,
+    /// False for visual-only parts: their colliders are sensors that give the part its AABB
+    /// and looks but touch nothing (the drawer handles, spec §2.4).
+    pub solid: bool,
 }
 
 fn v(x: f32, y: f32, z: f32) -> Vector {
@@ -262,6 +265,7 @@ fn loose(name: &str, shapes: Vec<ShapeBuild>) -> Vec<PartBuild> {
         joint: None,
         rides_on: None,
         grasp_yaw: 0.0,
+        solid: true,
     }]
 }
 
@@ -275,6 +279,7 @@ fn fixed(name: &str, role: PartRole, shapes: Vec<ShapeBuild>) -> PartBuild {
         joint: None,
         rides_on: None,
         grasp_yaw: 0.0,
+        solid: true,
     }
 }
 
@@ -385,6 +390,7 @@ fn hinge_box(colour: [f32; 3]) -> Vec<PartBuild> {
         joint: Some(JointBuild::Revolute { closed_q: -0.785 }),
         rides_on: None,
         grasp_yaw: 0.0,
+        solid: true,
     };
     let handle = PartBuild {
         name: "hinge_handle".into(),
@@ -400,13 +406,18 @@ fn hinge_box(colour: [f32; 3]) -> Vec<PartBuild> {
         rides_on: Some(1),
         // Fingers close along x, across the handle's thin side.
         grasp_yaw: std::f64::consts::FRAC_PI_2,
+        solid: true,
     };
     vec![body, lid, handle]
 }
 
+/// Distance of a drawer handle's bar in front of its drawer's face (m).
+const HANDLE_STANDOFF: f32 = 0.025;
+
 /// Drawer cabinet geometry: body 0.154 × 0.148 × 0.194 open at the front (−y) with a
 /// middle shelf; two drawers (open boxes 0.142 × 0.142, 0.085 tall with a front panel)
-/// sliding out toward −y by up to 0.1232; a bar handle 2.5 cm in front of each face.
+/// sliding out toward −y by up to 0.1232; a visual-only bar handle 2.5 cm in front of each
+/// face.
 fn drawer_cabinet(colour: [f32; 3]) -> Vec<PartBuild> {
     let [sx, sy, sz] = [0.154_f32, 0.148, 0.194];
     let t = 0.005_f32;
@@ -439,6 +450,7 @@ fn drawer_cabinet(colour: [f32; 3]) -> Vec<PartBuild> {
             joint: Some(JointBuild::Prismatic),
             rides_on: None,
             grasp_yaw: 0.0,
+            solid: true,
         }
     };
     let handle = |name: &str, z: f32, link: usize| -> PartBuild {
@@ -449,14 +461,25 @@ fn drawer_cabinet(colour: [f32; 3]) -> Vec<PartBuild> {
             motion: PartMotion::Articulated,
             offset: Pose::IDENTITY,
             shapes: vec![
-                cuboid([0.09, 0.01, 0.01], [0.0, front - 0.025, z], dark),
-                cuboid([0.008, 0.02, 0.008], [-0.035, front - 0.01, z], dark),
-                cuboid([0.008, 0.02, 0.008], [0.035, front - 0.01, z], dark),
+                cuboid([0.09, 0.01, 0.01], [0.0, front - HANDLE_STANDOFF, z], dark),
+                cuboid(
+                    [0.008, HANDLE_STANDOFF, 0.008],
+                    [-0.035, front - HANDLE_STANDOFF / 2.0, z],
+                    dark,
+                ),
+                cuboid(
+                    [0.008, HANDLE_STANDOFF, 0.008],
+                    [0.035, front - HANDLE_STANDOFF / 2.0, z],
+                    dark,
+                ),
             ],
             joint: Some(JointBuild::Prismatic),
             rides_on: Some(link),
             // The bar runs along x, so the fingers close along y.
             grasp_yaw: 0.0,
+            // Visual only, as in the authors' asset: grasping is the proximity rule, and a
+            // solid bar standing out over the open drawer below would catch dropped objects.
+            solid: false,
         }
     };
     let tint = [colour[0] * 0.85 + 0.1, colour[1] * 0.85 + 0.05, colour[2] * 0.85];

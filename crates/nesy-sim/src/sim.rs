@@ -333,7 +333,8 @@ impl Sim {
                         .position(shape.local)
                         .density(objects::DENSITY)
                         .friction(friction)
-                        .friction_combine_rule(rule);
+                        .friction_combine_rule(rule)
+                        .sensor(!build.solid);
                     colliders.push(add_collider(
                         &mut world,
                         &mut looks,

@@ -505,12 +505,13 @@ fn composite(embodiment: nesy_sim::Embodiment) {
     let_go_handle(&mut sim);
     expect(&sim, "close lid", &["(Closed hinge_lid)"], &[]);
     // Cylinders from the cabinet top into the open bottom drawer (opening toward +y here).
-    // Spots 4.5 cm apart: a cylinder dropped onto another one tips over, and a cylinder lying
-    // on its side rolls on without stopping (Rapier has no rolling resistance).
+    // Spots 5 cm or more apart and 1.5 cm inside the walls: a cylinder dropped onto another
+    // one tips over, and one lying on its side rolls on without stopping (Rapier has no
+    // rolling resistance); one clipping a wall's top edge is flung out.
     for (cyl, dx, dy) in [
-        ("red_cylinder", -0.045, 0.0),
-        ("green_cylinder", 0.045, 0.0),
-        ("blue_cylinder", 0.0, 0.04),
+        ("red_cylinder", -0.035, -0.005),
+        ("green_cylinder", 0.035, -0.005),
+        ("blue_cylinder", 0.0, 0.035),
     ] {
         let h = sim.get_obj_size(cyl).unwrap()[2];
         sim.move_gripper_to(cyl, Direction::Down, h / 2.0).unwrap();
@@ -519,7 +520,7 @@ fn composite(embodiment: nesy_sim::Embodiment) {
         let s = sim.get_obj_size("bottom_drawer").unwrap();
         // High enough that the 20 cm wide hand clears the other cylinders on the cabinet top.
         sim.move_to_position(
-            [c[0] + dx, c[1] + 0.01 + dy, c[2] + s[2] + h + 0.05],
+            [c[0] + dx, c[1] + dy, c[2] + s[2] + h + 0.05],
             Direction::Down,
             0.12,
             0.0,

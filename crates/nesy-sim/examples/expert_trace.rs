@@ -1,0 +1,96 @@
+//! Runs the scripted expert on one generated single-subtask task and prints every action
+//! call with its result, the final symbolic state and the goal checks' verdict: the tool
+//! for finding out why the expert sweep reports a failure.
+//!
+//! ```text
+//! cargo run -p nesy-sim --example expert_trace -- KIND OBST MULTI VARIANT finger|vacuum [SCENE_OUT.json]
+//! ```
+
+use nesy_sim::goal::GoalMonitor;
+use nesy_sim::sim::SimHook;
+use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
+use nesy_sim::{Embodiment, Sim, TraceEntry};
+
+/// Prints every action call with its result and the articulations' joint positions after it.
+struct PrintActions {
+    articulations: Vec<String>,
+}
+
+impl SimHook for PrintActions {
+    fn on_call(&mut self, sim: &Sim, entry: &TraceEntry) {
+        if !entry.call.is_action() {
+            return;
+        }
+        let verdict = match &entry.result {
+            Ok(_) => "ok".to_owned(),
+            Err(e) => format!("refused: {e}"),
+        };
+        let joints: Vec<String> = self
+            .articulations
+            .iter()
+            .map(|name| format!("{name} {:.3}", sim.articulation_q(name).unwrap_or(f64::NAN)))
+            .collect();
+        let tool = sim.tool_pose().translation.vector;
+        println!(
+            "{:7.2} s  {:?} -> {verdict}  [{}; tool ({:.3}, {:.3}, {:.3})]",
+            entry.sim_time,
+            entry.call,
+            joints.join(", "),
+            tool.x,
+            tool.y,
+            tool.z
+        );
+    }
+}
+
+const USAGE: &str = "usage: expert_trace KIND OBST MULTI VARIANT finger|vacuum [SCENE_OUT.json]";
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.len() < 5 {
+        return Err(USAGE.into());
+    }
+    let kind = SubtaskKind::ALL
+        .into_iter()
+        .find(|k| k.as_str() == args[0])
+        .ok_or_else(|| format!("unknown subtask {:?}; {USAGE}", args[0]))?;
+    let embodiment = match args[4].as_str() {
+        "finger" => Embodiment::Finger,
+        "vacuum" => Embodiment::Vacuum,
+        other => return Err(format!("unknown embodiment {other:?}; {USAGE}").into()),
+    };
+    let variant: u64 = args[3].parse()?;
+    let config = TaskConfig {
+        subtasks: vec![SubtaskConfig {
+            kind,
+            variant,
+            obst_level: args[1].parse()?,
+            multi_level: args[2].parse()?,
+        }],
+        episode: variant,
+        embodiment,
+        embodiment_in_state: false,
+    };
+    let task = config.generate()?;
+    if let Some(path) = args.get(5) {
+        std::fs::write(path, task.scene.to_json_pretty())?;
+    }
+    let mut sim = Sim::new(&task.scene)?;
+    let monitor = GoalMonitor::attach(&mut sim)?;
+    sim.add_hook(Box::new(PrintActions {
+        articulations: task.scene.articulations.keys().cloned().collect(),
+    }));
+    let result = nesy_sim::expert::run(&mut sim, &task.scene.goals);
+    println!("\n{}", nesy_sim::observe(&sim));
+    for name in task.scene.goals.iter().flat_map(|g| g.objects()) {
+        println!("{name}: {:?}", sim.object_aabb(name));
+    }
+    let outcome = monitor.finish(&mut sim);
+    println!(
+        "\nexpert: {}\ngoal checks: {}\nachieved: {:?}",
+        result.map_or_else(|e| e.to_string(), |()| "finished".to_owned()),
+        outcome.summary(),
+        outcome.achieved_sequence
+    );
+    Ok(())
+}
