@@ -130,7 +130,6 @@ fn every_scenario_generates_both_scenes() {
 /// all 880 scenes is `nesy scenarios sweep`; one per factor × complexity is the ignored
 /// test below).
 #[test]
-#[ignore = "fails while the hinge expert is being finished (grip_low_00_s0 source: put_in_hinge fail); run with --ignored"]
 fn expert_succeeds_on_one_low_scenario_per_factor() {
     let all = scenario::scenarios(&scenario::generate_suite());
     for factor in Factor::ALL {
