@@ -272,10 +272,13 @@ pub fn summary(run: &AdaptRun) -> String {
         }
     }
     if let Some(p) = &run.policy {
+        let mode = match p.mode {
+            CodegenMode::Vlm => "VLM code generation",
+            CodegenMode::Template => "template compiler",
+        };
         let _ = writeln!(
             out,
-            "  policy    policy.py ({:?}, {} lines)",
-            p.mode,
+            "  policy    policy.py ({mode}, {} lines)",
             p.code.lines().count()
         );
     }

@@ -367,10 +367,13 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
     let _ = writeln!(md, "## Policy\n");
     match (&run.policy, &run.codegen_error) {
         (Some(p), _) => {
+            let how = match p.mode {
+                super::CodegenMode::Vlm => "the VLM's code generation",
+                super::CodegenMode::Template => "the template compiler",
+            };
             let _ = writeln!(
                 md,
-                "`policy.py` ({:?} code generation):\n\n```python\n{}\n```\n",
-                p.mode,
+                "`policy.py`, from {how}:\n\n```python\n{}\n```\n",
                 p.code.trim_end()
             );
         }
