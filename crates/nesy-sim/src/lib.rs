@@ -9,6 +9,7 @@
 
 pub mod api;
 mod api_impl;
+pub mod codegen;
 pub mod demo;
 pub mod expert;
 pub mod floor;

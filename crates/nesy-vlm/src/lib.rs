@@ -43,6 +43,7 @@ pub mod config;
 pub mod context;
 pub mod error;
 pub mod keyframes;
+pub mod oracle;
 pub mod profile;
 pub mod prompts;
 pub mod reasoner;
@@ -68,6 +69,7 @@ pub use context::{
 };
 pub use error::{ProviderError, TimeoutPhase, TransportError, VlmError};
 pub use keyframes::{KeyframeImages, KeyframeList, NoKeyframes, Views};
+pub use oracle::{OracleNoise, OracleTransport, PolicyCompiler};
 pub use profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, TokenCapField};
 pub use prompts::{PromptError, Prompts};
 pub use reasoner::VlmReasoner;

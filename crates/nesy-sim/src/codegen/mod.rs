@@ -1,0 +1,682 @@
+//! The template compiler (`--codegen template`): each verified symbolic action of an
+//! adapted procedure, named after a schema of nesy's true domain
+//! (`assets/pddl/nesy-world.pddl`), becomes fixed Python calls against the robot API of the
+//! target end effector. The result is a complete program of the kind nesy-policy runs.
+//!
+//! Actions are recognised by name: the CamelCase form of a schema name followed by the
+//! CamelCase forms of its arguments, e.g. `MoveToSurroundRedCube` is `move-to-surround`
+//! bound to `red_cube` and `CarryIntoBlueCubeToyBox` is `carry-into` bound to
+//! `(blue_cube, toy_box)` (the names the reference responder writes). A finger schema on the
+//! vacuum robot, or the reverse, compiles to the same motion with the other end effector's
+//! calls (`close_gripper` ↔ `activate_vacuum`, ...). The placement rules (box cells, drop
+//! heights, drawer directions) are those of nesy-sim's scripted experts.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use nesy_core::operator::Operator;
+use serde::{Deserialize, Serialize};
+
+use crate::api::Embodiment;
+
+/// What an action does, independent of the end effector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Motion {
+    /// `move_gripper_to(item)`: around it (finger) or onto it (vacuum).
+    MoveToObject,
+    /// `close_gripper` / `activate_vacuum`.
+    Take,
+    /// `move_to_position` onto a free spot of a surface (table or board).
+    CarryOnto,
+    /// `move_to_position` into an open-topped box.
+    CarryInto,
+    /// `move_to_position` over the hinge box.
+    CarryOverHinge,
+    /// `move_to_position` over the bottom drawer.
+    CarryOverDrawer,
+    /// `open_gripper` / `deactivate_vacuum`.
+    Release,
+    /// `move_parallel` across the board into a box.
+    Push,
+    /// `move_parallel("up")`.
+    Retreat,
+    /// `move_gripper_to(handle)`.
+    MoveToHandle,
+    /// `grasp_handle` / `attach_vacuum_handle` (moving to the handle first if needed).
+    GraspHandle,
+    /// `move_to_position` swinging the lid open.
+    OpenLid,
+    /// `move_to_position` swinging the lid closed.
+    CloseLid,
+    /// `release_handle` / `detach_vacuum_handle`.
+    ReleaseHandle,
+    /// `move_parallel` pulling a drawer open.
+    OpenDrawer,
+    /// `move_parallel` pushing a drawer closed.
+    CloseDrawer,
+}
+
+/// Argument kinds of a schema (the domain's types).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Item,
+    Surface,
+    Box,
+}
+
+/// One schema of the true domain: name, what it does, its parameters, and the part it
+/// works on (handles, drawers).
+struct Schema {
+    name: &'static str,
+    motion: Motion,
+    params: &'static [Kind],
+    part: Option<&'static str>,
+}
+
+const fn s(
+    name: &'static str,
+    motion: Motion,
+    params: &'static [Kind],
+    part: Option<&'static str>,
+) -> Schema {
+    Schema {
+        name,
+        motion,
+        params,
+        part,
+    }
+}
+
+use Kind::{Box as B, Item as I, Surface as S};
+use Motion::*;
+
+/// Every schema of `nesy-world.pddl` (finger, then vacuum); `tests/codegen_domain.rs`
+/// checks the table against the file.
+const SCHEMAS: &[Schema] = &[
+    s("move-to-surround", MoveToObject, &[I], None),
+    s("grasp", Take, &[I], None),
+    s("carry-onto", CarryOnto, &[I, S], None),
+    s("carry-into", CarryInto, &[I, B], None),
+    s("carry-over-hinge-body", CarryOverHinge, &[I], None),
+    s("carry-over-bottom-drawer", CarryOverDrawer, &[I], None),
+    s("put-down", Release, &[I, S], None),
+    s("release-into", Release, &[I, B], None),
+    s("drop-into-hinge-body", Release, &[I], None),
+    s("drop-into-bottom-drawer", Release, &[I], None),
+    s("sweep-into", Push, &[I, B], None),
+    s("retreat", Retreat, &[], None),
+    s("move-to-hinge-handle", MoveToHandle, &[], Some("hinge_handle")),
+    s("grasp-hinge-handle", GraspHandle, &[], Some("hinge_handle")),
+    s("open-hinge-lid", OpenLid, &[], None),
+    s("close-hinge-lid", CloseLid, &[], None),
+    s("release-hinge-handle", ReleaseHandle, &[], None),
+    s(
+        "move-to-bottom-drawer-handle",
+        MoveToHandle,
+        &[],
+        Some("bottom_drawer_handle"),
+    ),
+    s(
+        "grasp-bottom-drawer-handle",
+        GraspHandle,
+        &[],
+        Some("bottom_drawer_handle"),
+    ),
+    s("open-bottom-drawer", OpenDrawer, &[], Some("bottom_drawer")),
+    s("close-bottom-drawer", CloseDrawer, &[], Some("bottom_drawer")),
+    s("release-bottom-drawer-handle", ReleaseHandle, &[], None),
+    s(
+        "move-to-top-drawer-handle",
+        MoveToHandle,
+        &[],
+        Some("top_drawer_handle"),
+    ),
+    s(
+        "grasp-top-drawer-handle",
+        GraspHandle,
+        &[],
+        Some("top_drawer_handle"),
+    ),
+    s("open-top-drawer", OpenDrawer, &[], Some("top_drawer")),
+    s("close-top-drawer", CloseDrawer, &[], Some("top_drawer")),
+    s("release-top-drawer-handle", ReleaseHandle, &[], None),
+    s("move-to-align", MoveToObject, &[I], None),
+    s("attach", Take, &[I], None),
+    s("suction-carry-onto", CarryOnto, &[I, S], None),
+    s("suction-carry-into", CarryInto, &[I, B], None),
+    s("suction-carry-over-hinge-body", CarryOverHinge, &[I], None),
+    s("suction-carry-over-bottom-drawer", CarryOverDrawer, &[I], None),
+    s("suction-put-down", Release, &[I, S], None),
+    s("suction-release-into", Release, &[I, B], None),
+    s("suction-drop-into-hinge-body", Release, &[I], None),
+    s("suction-drop-into-bottom-drawer", Release, &[I], None),
+    s("slide-into", Push, &[I, B], None),
+    s("suction-retreat", Retreat, &[], None),
+    s(
+        "suction-move-to-hinge-handle",
+        MoveToHandle,
+        &[],
+        Some("hinge_handle"),
+    ),
+    s("attach-hinge-handle", GraspHandle, &[], Some("hinge_handle")),
+    s("suction-open-hinge-lid", OpenLid, &[], None),
+    s("suction-close-hinge-lid", CloseLid, &[], None),
+    s("detach-hinge-handle", ReleaseHandle, &[], None),
+    s(
+        "suction-move-to-bottom-drawer-handle",
+        MoveToHandle,
+        &[],
+        Some("bottom_drawer_handle"),
+    ),
+    s(
+        "attach-bottom-drawer-handle",
+        GraspHandle,
+        &[],
+        Some("bottom_drawer_handle"),
+    ),
+    s(
+        "suction-open-bottom-drawer",
+        OpenDrawer,
+        &[],
+        Some("bottom_drawer"),
+    ),
+    s(
+        "suction-close-bottom-drawer",
+        CloseDrawer,
+        &[],
+        Some("bottom_drawer"),
+    ),
+    s("detach-bottom-drawer-handle", ReleaseHandle, &[], None),
+    s(
+        "suction-move-to-top-drawer-handle",
+        MoveToHandle,
+        &[],
+        Some("top_drawer_handle"),
+    ),
+    s(
+        "attach-top-drawer-handle",
+        GraspHandle,
+        &[],
+        Some("top_drawer_handle"),
+    ),
+    s("suction-open-top-drawer", OpenDrawer, &[], Some("top_drawer")),
+    s("suction-close-top-drawer", CloseDrawer, &[], Some("top_drawer")),
+    s("detach-top-drawer-handle", ReleaseHandle, &[], None),
+];
+
+/// The schema names the compiler knows, in the domain file's order.
+pub fn schema_names() -> impl Iterator<Item = &'static str> {
+    SCHEMAS.iter().map(|s| s.name)
+}
+
+/// Cells of the toy box (offsets from its centre, m), as the pick-and-place expert uses.
+const TOY_BOX_CELLS: [[f64; 2]; 6] = [
+    [-0.042, -0.022],
+    [0.0, -0.022],
+    [0.042, -0.022],
+    [-0.042, 0.022],
+    [0.0, 0.022],
+    [0.042, 0.022],
+];
+/// Fruit spots along the hinge box (y offsets, m).
+const HINGE_SPOTS: [f64; 3] = [-0.06, 0.0, 0.06];
+/// Cylinder spots in the bottom drawer (x offset, outward y offset, m).
+const DRAWER_SPOTS: [[f64; 2]; 3] = [[-0.035, -0.005], [0.035, -0.005], [0.0, 0.035]];
+/// Tool waypoints about the hinge axis (degrees from +x in the x–z plane) when opening and
+/// closing the lid, as the hinge expert swings it: a grasped lid follows the tool's angle,
+/// and short arcs keep the tool within the handle's 0.1 m grasp range.
+const LID_OPENING_ARC: [f64; 3] = [135.0, 90.0, 60.0];
+const LID_CLOSING_ARC: [f64; 2] = [135.0, 180.0];
+
+/// One action recognised in a procedure.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ResolvedAction {
+    /// The action's name as given.
+    pub name: String,
+    /// The schema it names.
+    pub schema: String,
+    /// What it does.
+    pub motion: Motion,
+    /// Its arguments.
+    pub args: Vec<String>,
+}
+
+/// Why a procedure could not be compiled.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error, Serialize, Deserialize)]
+pub enum CodegenError {
+    /// An action's name names no schema of the true domain with objects of the scene.
+    #[error(
+        "action {index} ({name}) names no schema of the nesy world domain with objects of this scene; expected a schema name followed by its arguments, e.g. MoveToSurroundRedCube"
+    )]
+    UnknownAction {
+        /// 1-based position in the procedure.
+        index: usize,
+        /// Its name.
+        name: String,
+    },
+}
+
+/// The compiled program with the action each part came from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CompiledPolicy {
+    /// The Python program.
+    pub code: String,
+    /// The recognised actions, in order.
+    pub actions: Vec<ResolvedAction>,
+    /// The end effector it was compiled for.
+    pub embodiment: Embodiment,
+}
+
+fn camel(text: &str) -> String {
+    text.split(|c: char| !c.is_alphanumeric())
+        .filter(|w| !w.is_empty())
+        .map(|w| {
+            let mut cs = w.chars();
+            cs.next()
+                .map(|f| f.to_uppercase().chain(cs).collect::<String>())
+                .unwrap_or_default()
+        })
+        .collect()
+}
+
+fn kind_of(object: &str) -> Option<Kind> {
+    match object {
+        "floor" | "board" => Some(Kind::Surface),
+        "toy_box" => Some(Kind::Box),
+        o if o.ends_with("chess_box") => Some(Kind::Box),
+        o if o.starts_with("hinge_") || o.contains("drawer") || o.contains("gripper") => None,
+        _ => Some(Kind::Item),
+    }
+}
+
+fn match_args(rest: &str, params: &[Kind], objects: &[String]) -> Option<Vec<String>> {
+    let Some((first, more)) = params.split_first() else {
+        return rest.is_empty().then(Vec::new);
+    };
+    // Longest names first, so `RedCube` never shadows `RedCubeTwo`.
+    let mut candidates: Vec<&String> = objects.iter().filter(|o| kind_of(o) == Some(*first)).collect();
+    candidates.sort_by_key(|o| std::cmp::Reverse(camel(o).len()));
+    for o in candidates {
+        if let Some(tail) = rest.strip_prefix(camel(o).as_str())
+            && let Some(mut args) = match_args(tail, more, objects)
+        {
+            args.insert(0, o.clone());
+            return Some(args);
+        }
+    }
+    None
+}
+
+/// Recognises an action name (CamelCase or the semantic words) as a schema and its
+/// arguments among `objects`.
+pub fn resolve_action(name: &str, objects: &[String]) -> Option<ResolvedAction> {
+    let key = camel(name);
+    let mut schemas: Vec<&Schema> = SCHEMAS.iter().collect();
+    schemas.sort_by_key(|s| std::cmp::Reverse(camel(s.name).len()));
+    schemas.into_iter().find_map(|schema| {
+        let rest = key.strip_prefix(camel(schema.name).as_str())?;
+        let args = match_args(rest, schema.params, objects)?;
+        Some(ResolvedAction {
+            name: name.to_owned(),
+            schema: schema.name.to_owned(),
+            motion: schema.motion,
+            args,
+        })
+    })
+}
+
+fn schema(name: &str) -> &'static Schema {
+    SCHEMAS
+        .iter()
+        .find(|s| s.name == name)
+        .expect("resolved actions name table schemas")
+}
+
+/// Compiles a verified procedure into a policy program for `embodiment`.
+pub fn compile_policy(
+    procedure: &[Operator],
+    objects: &[String],
+    embodiment: Embodiment,
+) -> Result<CompiledPolicy, CodegenError> {
+    let actions = procedure
+        .iter()
+        .enumerate()
+        .map(|(i, op)| {
+            resolve_action(&op.name, objects).ok_or_else(|| CodegenError::UnknownAction {
+                index: i + 1,
+                name: op.name.clone(),
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let code = emit(&actions, embodiment);
+    Ok(CompiledPolicy {
+        code,
+        actions,
+        embodiment,
+    })
+}
+
+struct Emitter {
+    out: String,
+    vacuum: bool,
+    /// Drops so far per container (for cells and spots).
+    drops: BTreeMap<String, usize>,
+    /// The tool points sideways (`pointing` in the program) since the last handle approach.
+    pointing: bool,
+}
+
+impl Emitter {
+    fn line(&mut self, text: &str) {
+        self.out.push_str(text);
+        self.out.push('\n');
+    }
+
+    /// How far below the tool point a held object's bottom hangs (`h` is a Python
+    /// expression for its height): the fingers hold it at mid-height, suction by its top.
+    fn hang(&self, h: &str) -> String {
+        if self.vacuum {
+            h.to_owned()
+        } else {
+            format!("{h} / 2")
+        }
+    }
+
+    fn next_drop(&mut self, container: &str) -> usize {
+        let n = self.drops.entry(container.to_owned()).or_insert(0);
+        *n += 1;
+        *n - 1
+    }
+
+    fn take(&self) -> &'static str {
+        if self.vacuum {
+            "activate_vacuum()"
+        } else {
+            "close_gripper()"
+        }
+    }
+
+    fn release(&self) -> &'static str {
+        if self.vacuum {
+            "deactivate_vacuum()"
+        } else {
+            "open_gripper()"
+        }
+    }
+
+    fn move_to_handle(&mut self, handle: &str, sideways: bool) {
+        if sideways {
+            // The suction tool reaches the bottom handle pointing at the cabinet: from above
+            // its wrist would sweep cylinders off the cabinet's front edge (as the expert).
+            self.line("pointing = \"right\" if get_obj_pos(\"bottom_drawer_handle\")[1] < get_obj_pos(\"drawer_body\")[1] else \"left\"");
+            self.line(&format!("move_gripper_to({handle:?}, pointing_to=pointing)"));
+            self.pointing = true;
+        } else if self.vacuum {
+            self.pointing = false;
+            self.line(&format!("move_gripper_to({handle:?})"));
+        } else {
+            self.line(&format!("move_gripper_to({handle:?}, depth=0.0)"));
+        }
+    }
+
+    fn drawer_directions(&mut self) {
+        // Drawers slide out toward the side their handles are on (as the expert decides).
+        self.line("handle_y = get_obj_pos(\"bottom_drawer_handle\")[1]");
+        self.line("cabinet_y = get_obj_pos(\"drawer_body\")[1]");
+        self.line("open_dir = \"left\" if handle_y < cabinet_y else \"right\"");
+        self.line("close_dir = \"right\" if open_dir == \"left\" else \"left\"");
+        self.line("travel = get_obj_size(\"bottom_drawer\")[1] * 0.85");
+    }
+}
+
+/// Whether the handle action at `i` is followed, before any other handle is taken, by
+/// pulling the bottom drawer open.
+fn opens_bottom_drawer(actions: &[ResolvedAction], i: usize) -> bool {
+    let handle = schema(&actions[i].schema).part;
+    handle == Some("bottom_drawer_handle")
+        && actions[i + 1..]
+            .iter()
+            .take_while(|a| a.motion != GraspHandle || schema(&a.schema).part == handle)
+            .any(|a| a.motion == OpenDrawer && schema(&a.schema).part == Some("bottom_drawer"))
+}
+
+fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
+    let vacuum = embodiment == Embodiment::Vacuum;
+    let mut e = Emitter {
+        out: String::new(),
+        vacuum,
+        drops: BTreeMap::new(),
+        pointing: false,
+    };
+    let _ = writeln!(
+        e.out,
+        "# Compiled by nesy's template compiler from {} verified action(s) for the {} robot.",
+        actions.len(),
+        embodiment
+    );
+    e.line("import math");
+    for (i, a) in actions.iter().enumerate() {
+        let _ = writeln!(e.out, "\n# {}. {}", i + 1, a.name);
+        let arg = |k: usize| a.args.get(k).map(String::as_str).unwrap_or_default();
+        let part = schema(&a.schema).part.unwrap_or_default();
+        match a.motion {
+            MoveToObject => {
+                let x = arg(0);
+                e.pointing = false;
+                if vacuum {
+                    e.line(&format!("move_gripper_to({x:?})"));
+                } else {
+                    // Deep enough to push the object when a sweep follows, else mid-height.
+                    let pushes = actions
+                        .get(i + 1)
+                        .is_some_and(|n| n.motion == Push && n.args.first().map(String::as_str) == Some(x));
+                    let div = if pushes { "1.3" } else { "2" };
+                    e.line(&format!(
+                        "move_gripper_to({x:?}, depth=get_obj_size({x:?})[2] / {div})"
+                    ));
+                }
+            }
+            Take => {
+                let t = e.take();
+                e.line(t);
+            }
+            Release => {
+                let r = e.release();
+                e.line(r);
+            }
+            CarryOnto => {
+                let (x, surface) = (arg(0), arg(1));
+                let hang = e.hang(&format!("get_obj_size({x:?})[2]"));
+                if surface == "floor" {
+                    e.line(&format!("spot = get_empty_floor_xy({x:?})"));
+                    e.line(&format!(
+                        "move_to_position([spot[0], spot[1], 0.5 + {hang} + 0.01])"
+                    ));
+                } else {
+                    e.line(&format!("surface = get_obj_bbox({surface:?})"));
+                    e.line(&format!(
+                        "move_to_position([get_obj_pos({x:?})[0], (surface[0][1] + surface[1][1]) / 2, surface[1][2] + {hang} + 0.01])"
+                    ));
+                }
+            }
+            CarryInto => {
+                let (x, b) = (arg(0), arg(1));
+                let k = e.next_drop(b);
+                let [dx, dy] = if b == "toy_box" {
+                    TOY_BOX_CELLS[k % TOY_BOX_CELLS.len()]
+                } else {
+                    [0.0, 0.0]
+                };
+                let hang = e.hang(&format!("get_obj_size({x:?})[2]"));
+                e.line(&format!("box = get_obj_bbox({b:?})"));
+                e.line(&format!(
+                    "move_to_position([(box[0][0] + box[1][0]) / 2 + {dx}, (box[0][1] + box[1][1]) / 2 + {dy}, box[1][2] + {hang} + 0.01])"
+                ));
+            }
+            CarryOverHinge => {
+                let x = arg(0);
+                let k = e.next_drop("hinge_body");
+                let dy = HINGE_SPOTS[k % HINGE_SPOTS.len()];
+                let hang = e.hang(&format!("get_obj_size({x:?})[2]"));
+                e.line("body = get_obj_bbox(\"hinge_body\")");
+                e.line(&format!(
+                    "move_to_position([(body[0][0] + body[1][0]) / 2, (body[0][1] + body[1][1]) / 2 + {dy}, body[1][2] + {hang} + 0.03])"
+                ));
+            }
+            CarryOverDrawer => {
+                let x = arg(0);
+                let k = e.next_drop("bottom_drawer");
+                let [dx, dy] = DRAWER_SPOTS[k % DRAWER_SPOTS.len()];
+                e.line("outward = -1.0 if get_obj_pos(\"bottom_drawer_handle\")[1] < get_obj_pos(\"drawer_body\")[1] else 1.0");
+                e.line("drawer = get_obj_pos(\"bottom_drawer\")");
+                e.line(&format!(
+                    "move_to_position([drawer[0] + {dx}, drawer[1] + {dy} * outward, drawer[2] + get_obj_size(\"bottom_drawer\")[2] + get_obj_size({x:?})[2] + 0.05])"
+                ));
+            }
+            Push => {
+                let (x, b) = (arg(0), arg(1));
+                e.line(&format!("piece_y = get_obj_pos({x:?})[1]"));
+                e.line(&format!("box_y = get_obj_pos({b:?})[1]"));
+                e.line(
+                    "move_parallel(\"left\" if piece_y > box_y else \"right\", abs(piece_y - box_y) + 0.02)",
+                );
+            }
+            Retreat => {
+                if e.pointing {
+                    e.line("move_parallel(\"up\", 0.05, pointing_to=pointing)");
+                } else {
+                    e.line("move_parallel(\"up\", 0.05)");
+                }
+            }
+            MoveToHandle => {
+                let sideways = vacuum && opens_bottom_drawer(actions, i);
+                e.move_to_handle(part, sideways)
+            }
+            GraspHandle => {
+                let moved = i > 0
+                    && actions[i - 1].motion == MoveToHandle
+                    && schema(&actions[i - 1].schema).part == Some(part);
+                if !moved {
+                    let sideways = vacuum && opens_bottom_drawer(actions, i);
+                    e.move_to_handle(part, sideways);
+                }
+                if vacuum {
+                    e.line(&format!("attach_vacuum_handle({part:?})"));
+                } else {
+                    e.line(&format!("grasp_handle({part:?})"));
+                }
+            }
+            OpenLid | CloseLid => {
+                // A demonstration records one action per waypoint of a swing, and a
+                // waypoint that has not moved the lid yet may read either way: a run of lid
+                // actions is one arc, in the direction of the run's last action.
+                let is_swing = |m: Motion| m == OpenLid || m == CloseLid;
+                if actions.get(i + 1).is_some_and(|n| is_swing(n.motion)) {
+                    e.line("# (one swing with the next action)");
+                    continue;
+                }
+                let arc: &[f64] = if a.motion == OpenLid {
+                    &LID_OPENING_ARC
+                } else {
+                    &LID_CLOSING_ARC
+                };
+                e.line("body = get_obj_bbox(\"hinge_body\")");
+                e.line("lid = get_obj_bbox(\"hinge_lid\")");
+                e.line("lid_y = (lid[0][1] + lid[1][1]) / 2");
+                e.line("reach = max(lid[1][0] - lid[0][0], lid[1][2] - lid[0][2])");
+                e.line(&format!("for degrees in {arc:?}:"));
+                e.line("    a = math.radians(degrees)");
+                e.line("    x = min(body[1][0] + reach * math.cos(a), 0.725)");
+                e.line("    move_to_position([x, lid_y, body[1][2] + reach * math.sin(a)], lift_clearance=0.0, angle=math.pi / 2)");
+            }
+            ReleaseHandle => {
+                if vacuum {
+                    e.line("detach_vacuum_handle()");
+                } else {
+                    e.line("release_handle()");
+                }
+            }
+            OpenDrawer | CloseDrawer => {
+                e.drawer_directions();
+                let dir = if a.motion == OpenDrawer {
+                    "open_dir"
+                } else {
+                    "close_dir"
+                };
+                let _ = part;
+                if e.pointing {
+                    e.line(&format!("move_parallel({dir}, travel, pointing_to=pointing)"));
+                } else {
+                    e.line(&format!("move_parallel({dir}, travel)"));
+                }
+            }
+        }
+    }
+    e.out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn objects() -> Vec<String> {
+        [
+            "floor",
+            "toy_box",
+            "red_cube",
+            "red_cube_two",
+            "board",
+            "left_chess_box",
+            "hinge_handle",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    }
+
+    #[test]
+    fn names_resolve_to_schemas_and_arguments() {
+        let o = objects();
+        let a = resolve_action("MoveToSurroundRedCube", &o).unwrap();
+        assert_eq!(
+            (a.schema.as_str(), a.args.clone()),
+            ("move-to-surround", vec!["red_cube".to_string()])
+        );
+        let a = resolve_action("MoveToSurroundRedCubeTwo", &o).unwrap();
+        assert_eq!(a.args, vec!["red_cube_two".to_string()]);
+        let a = resolve_action("carry into red cube toy box", &o).unwrap();
+        assert_eq!((a.schema.as_str(), a.args.len()), ("carry-into", 2));
+        let a = resolve_action("GraspHingeHandle", &o).unwrap();
+        assert_eq!((a.schema.as_str(), a.motion), ("grasp-hinge-handle", GraspHandle));
+        let a = resolve_action("SuctionCarryOntoRedCubeFloor", &o).unwrap();
+        assert_eq!(a.motion, CarryOnto);
+        assert!(resolve_action("GraspBlueCube", &o).is_none());
+        assert!(resolve_action("OpenGripperToDropRedCube", &o).is_none());
+    }
+
+    #[test]
+    fn the_same_procedure_compiles_for_either_end_effector() {
+        let o = objects();
+        let ops: Vec<Operator> = [
+            "MoveToSurroundRedCube",
+            "GraspRedCube",
+            "CarryIntoRedCubeToyBox",
+            "ReleaseIntoRedCubeToyBox",
+        ]
+        .iter()
+        .map(|n| Operator::new(*n, Vec::new(), Vec::new()))
+        .collect();
+        let finger = compile_policy(&ops, &o, Embodiment::Finger).unwrap();
+        assert!(finger.code.contains("close_gripper()") && finger.code.contains("open_gripper()"));
+        assert!(
+            finger.code.contains("depth=get_obj_size(\"red_cube\")[2] / 2"),
+            "{}",
+            finger.code
+        );
+        let vacuum = compile_policy(&ops, &o, Embodiment::Vacuum).unwrap();
+        assert!(vacuum.code.contains("activate_vacuum()") && !vacuum.code.contains("close_gripper"));
+        let err =
+            compile_policy(&[Operator::new("Dance", vec![], vec![])], &o, Embodiment::Finger).unwrap_err();
+        assert!(err.to_string().contains("action 1 (Dance)"), "{err}");
+    }
+}

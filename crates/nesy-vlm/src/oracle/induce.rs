@@ -1,0 +1,350 @@
+//! Operator induction from ground truth: the recorded API call of a demonstrated
+//! transition selects the true domain's schemas for that call; the binding whose grounded
+//! effects reproduce s_{t+1} (and whose preconditions hold in s_t) is the answer.
+
+use nesy_core::exec::ExecError;
+use nesy_core::formula::{AtomPattern, Effect, Formula};
+use nesy_core::operator::Operator;
+use nesy_core::state::State;
+use nesy_core::symbol::Symbol;
+use nesy_core::text::normalize_action_name;
+use nesy_core::types::Universe;
+use nesy_core::{Atom, apply};
+use serde::{Deserialize, Serialize};
+
+use super::domain::{WorldDomain, semantic};
+use crate::context::{Embodiment, InductionContext};
+
+/// The robot API function a schema of the true domain stands for, on an end effector.
+pub fn api_function(schema: &str, embodiment: Embodiment) -> Option<&'static str> {
+    let vacuum = embodiment == Embodiment::Vacuum;
+    let s = schema.strip_prefix("suction-").unwrap_or(schema);
+    let release = if vacuum {
+        "deactivate_vacuum"
+    } else {
+        "open_gripper"
+    };
+    Some(match s {
+        s if s.starts_with("move-to-") => "move_gripper_to",
+        "grasp" => "close_gripper",
+        "attach" => "activate_vacuum",
+        s if s.starts_with("grasp-") => "grasp_handle",
+        s if s.starts_with("attach-") => "attach_vacuum_handle",
+        s if s.starts_with("carry-") || s == "open-hinge-lid" || s == "close-hinge-lid" => "move_to_position",
+        "put-down" | "release-into" => release,
+        s if s.starts_with("drop-into-") => release,
+        "sweep-into" | "slide-into" | "retreat" => "move_parallel",
+        s if s.ends_with("-drawer") && (s.starts_with("open-") || s.starts_with("close-")) => "move_parallel",
+        s if s.starts_with("release-") => "release_handle",
+        s if s.starts_with("detach-") => "detach_vacuum_handle",
+        _ => return None,
+    })
+}
+
+/// The recorded call, read from its JSON (a nesy-sim `ApiCall` or `TraceEntry`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RecordedCall {
+    /// The API function, e.g. `move_gripper_to`.
+    pub function: String,
+    /// Its `obj_name` or `handle_name` argument, if any.
+    pub object: Option<String>,
+}
+
+impl RecordedCall {
+    /// Reads `{"call": "...", "obj_name"|"handle_name": "..."}`; `None` if there is no
+    /// `call` field.
+    pub fn from_json(value: &serde_json::Value) -> Option<RecordedCall> {
+        let function = value.get("call")?.as_str()?.to_owned();
+        let object = ["obj_name", "handle_name"]
+            .iter()
+            .find_map(|k| value.get(*k).and_then(|v| v.as_str()))
+            .map(str::to_owned);
+        Some(RecordedCall { function, object })
+    }
+}
+
+/// The oracle's answer for one transition.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct InducedAction {
+    /// The schema chosen.
+    pub schema: String,
+    /// Its arguments.
+    pub args: Vec<Symbol>,
+    /// The action semantic written in the reply (`move to surround red cube`).
+    pub semantic: String,
+    /// The operator as the reply states it.
+    pub operator: Operator,
+    /// Whether the grounded schema alone reproduces s_{t+1}; when false the reply's
+    /// effects are the observed changes instead.
+    pub exact: bool,
+    /// Atoms of s_{t+1} the grounded schema does not produce.
+    pub missing: Vec<Atom>,
+    /// Atoms the grounded schema produces that s_{t+1} does not hold.
+    pub unexpected: Vec<Atom>,
+    /// Schema preconditions that do not hold in s_t (left out of the reply).
+    pub dropped_preconditions: Vec<String>,
+}
+
+/// Why the oracle could not answer a request.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum InduceError {
+    /// No schema of the domain stands for the recorded call.
+    #[error("no schema of the nesy world domain stands for {call} on the {embodiment} robot")]
+    NoSchema {
+        /// The call.
+        call: String,
+        /// The end effector.
+        embodiment: Embodiment,
+    },
+}
+
+struct Candidate {
+    schema: String,
+    args: Vec<Symbol>,
+    op: Operator,
+    mismatch: usize,
+    unmet: Vec<Formula>,
+    missing: Vec<Atom>,
+    unexpected: Vec<Atom>,
+}
+
+/// The handle a handle schema works with, from its name (`grasp-hinge-handle` →
+/// `hinge_handle`); the schemas cannot say it in the vocabulary, which has no predicate
+/// for "the tool is at the handle".
+pub fn schema_handle(schema: &str) -> Option<&'static str> {
+    ["hinge_handle", "bottom_drawer_handle", "top_drawer_handle"]
+        .into_iter()
+        .find(|h| schema.contains(&h.replace('_', "-")))
+}
+
+/// The loose object a call works on: the one `move_gripper_to` names, else the one held
+/// after the call (taking), else the one held or surrounded before it (carrying,
+/// releasing, pushing).
+fn focus_object(call: Option<&RecordedCall>, prev: &State, next: &State) -> Option<Symbol> {
+    if let Some(c) = call
+        && c.function == "move_gripper_to"
+    {
+        return c.object.as_deref().map(Symbol::new);
+    }
+    let find = |s: &State, preds: &[&str]| {
+        s.iter()
+            .find(|a| preds.contains(&a.pred().as_str()) && a.args().len() == 1)
+            .map(|a| a.args()[0])
+    };
+    let holding = ["GripperHolding", "VacuumAttached"];
+    let around = ["GripperSurrounding", "VacuumAligned"];
+    match call.map(|c| c.function.as_str()) {
+        Some("close_gripper" | "activate_vacuum") => find(next, &holding),
+        _ => find(prev, &holding).or_else(|| find(prev, &around)),
+    }
+}
+
+fn bindings(schema: &Operator, universe: &Universe, focus: Option<Symbol>) -> Vec<Vec<Symbol>> {
+    let mut out = vec![Vec::new()];
+    for (i, p) in schema.params.iter().enumerate() {
+        let objects = universe.objects_of(p.ty).unwrap_or_default();
+        let mut next = Vec::new();
+        for prefix in &out {
+            for o in &objects {
+                // The object the call works on is the schema's first (item) parameter.
+                if i == 0 && focus.is_some_and(|f| f != *o) {
+                    continue;
+                }
+                let mut b = prefix.clone();
+                b.push(*o);
+                next.push(b);
+            }
+        }
+        out = next;
+    }
+    out
+}
+
+fn evaluate(
+    schema: &Operator,
+    args: Vec<Symbol>,
+    universe: &Universe,
+    prev: &State,
+    next: &State,
+) -> Option<Candidate> {
+    let op = schema.instantiate(&args, universe).ok()?;
+    let unmet = match apply(prev, &op) {
+        Ok(_) => Vec::new(),
+        Err(ExecError::Violation(v)) => v.unmet.into_iter().map(|u| u.literal).collect(),
+        Err(ExecError::Ground(_)) => return None,
+    };
+    let unchecked = Operator::new(op.name.clone(), Vec::new(), op.eff.clone());
+    let produced = apply(prev, &unchecked).ok()?;
+    let d = produced.diff(next);
+    Some(Candidate {
+        schema: schema.name.clone(),
+        args,
+        mismatch: d.added.len() + d.removed.len(),
+        unmet,
+        missing: d.added,
+        unexpected: d.removed,
+        op,
+    })
+}
+
+/// Answers an induction request from the recorded call and the true domain.
+pub fn induce(world: &WorldDomain, ctx: &InductionContext) -> Result<InducedAction, InduceError> {
+    let req = &ctx.request;
+    let mut names: Vec<Symbol> = req.task.objects.clone();
+    names.extend(req.previous.objects());
+    names.extend(req.next.objects());
+    let universe = world.universe(names.iter().map(|s| s.as_str()));
+    let call = ctx.demo_call.as_ref().and_then(RecordedCall::from_json);
+    let call_object = call.as_ref().and_then(|c| c.object.clone());
+    let schemas: Vec<Operator> = world
+        .schemas_for(ctx.embodiment, &universe)
+        .into_iter()
+        .filter(|s| {
+            call.as_ref()
+                .is_none_or(|c| api_function(&s.name, ctx.embodiment) == Some(c.function.as_str()))
+        })
+        .filter(|s| match schema_handle(&s.name) {
+            // Handle schemas need their handle in the scene, and the call's handle when it
+            // names one (move_gripper_to, grasp_handle, attach_vacuum_handle).
+            Some(h) => {
+                universe.contains(Symbol::new(h))
+                    && (!s.name.contains("move-to-")
+                        && !s.name.starts_with("grasp-")
+                        && !s.name.starts_with("attach-")
+                        || call_object.as_deref().is_none_or(|o| o == h))
+            }
+            None => true,
+        })
+        .collect();
+    // A lid swing is recorded one waypoint at a time, and a waypoint half-way leaves the lid
+    // neither open nor closed: where the lid's state changes, the change decides between the
+    // opening and closing schemas; where it does not, the scores do.
+    let lid = Symbol::new("hinge_lid");
+    let has = |s: &State, p: &str| s.contains(&nesy_core::Atom::from_symbols(Symbol::new(p), [lid]));
+    let (p_open, p_closed) = (has(&req.previous, "Open"), has(&req.previous, "Closed"));
+    let (n_open, n_closed) = (has(&req.next, "Open"), has(&req.next, "Closed"));
+    let direction = if (n_open && !p_open) || (p_closed && !n_closed) {
+        Some("open-hinge-lid")
+    } else if (n_closed && !p_closed) || (p_open && !n_open) {
+        Some("close-hinge-lid")
+    } else {
+        None
+    };
+    let schemas: Vec<Operator> = schemas
+        .into_iter()
+        .filter(|s| {
+            let name = s.name.strip_prefix("suction-").unwrap_or(&s.name);
+            match (name, direction) {
+                ("open-hinge-lid" | "close-hinge-lid", Some(d)) => name == d,
+                _ => true,
+            }
+        })
+        .collect();
+    let focus = focus_object(call.as_ref(), &req.previous, &req.next);
+    let mut best: Option<Candidate> = None;
+    for schema in &schemas {
+        let item_first = schema.params.first().is_some_and(|p| p.ty.as_str() == "item");
+        for args in bindings(schema, &universe, focus.filter(|_| item_first)) {
+            let Some(c) = evaluate(schema, args, &universe, &req.previous, &req.next) else {
+                continue;
+            };
+            // Observer effects and unmet preconditions weigh the same; ties go to the
+            // binding whose preconditions hold.
+            let key = |c: &Candidate| (c.mismatch + c.unmet.len(), c.unmet.len());
+            let better = best.as_ref().is_none_or(|b| key(&c) < key(b));
+            if better {
+                best = Some(c);
+            }
+        }
+    }
+    let Some(best) = best else {
+        return Err(InduceError::NoSchema {
+            call: call.map_or_else(|| "an unrecorded call".to_owned(), |c| c.function),
+            embodiment: ctx.embodiment,
+        });
+    };
+    let exact = best.mismatch == 0;
+    let pre: Vec<Formula> = best
+        .op
+        .pre
+        .iter()
+        .filter(|f| !best.unmet.contains(f))
+        .cloned()
+        .collect();
+    let eff = if exact {
+        best.op.eff.clone()
+    } else {
+        observed_changes(&req.previous, &req.next)
+    };
+    let text = semantic(&best.schema, &best.args);
+    let name = normalize_action_name(&text).unwrap_or_else(|| best.schema.clone());
+    Ok(InducedAction {
+        schema: best.schema,
+        args: best.args,
+        semantic: text,
+        operator: Operator::new(name, pre, eff),
+        exact,
+        missing: best.missing,
+        unexpected: best.unexpected,
+        dropped_preconditions: best.unmet.iter().map(|f| f.to_string()).collect(),
+    })
+}
+
+/// The observed changes as effects; an unchanged state is restated by one of its atoms (an
+/// effect list may not be empty, and re-adding a true atom changes nothing).
+pub fn observed_changes(prev: &State, next: &State) -> Vec<Effect> {
+    let d = prev.diff(next);
+    let mut eff: Vec<Effect> = d
+        .added
+        .iter()
+        .map(|a| Effect::Add(AtomPattern::ground(*a)))
+        .chain(d.removed.iter().map(|a| Effect::Del(AtomPattern::ground(*a))))
+        .collect();
+    if eff.is_empty()
+        && let Some(a) = next.sorted_by_text().first()
+    {
+        eff.push(Effect::Add(AtomPattern::ground(**a)));
+    }
+    eff
+}
+
+/// The reply in the Action Prediction format.
+pub fn format_reply(action: &InducedAction, call: Option<&RecordedCall>) -> String {
+    let call_text = call.map_or_else(
+        || "no recorded call".to_owned(),
+        |c| match &c.object {
+            Some(o) => format!("{}({o})", c.function),
+            None => format!("{}()", c.function),
+        },
+    );
+    let fit = if action.exact {
+        "its effects reproduce the current state exactly".to_owned()
+    } else {
+        format!(
+            "the observer also reported changes the schema does not model ({} missing, {} unexpected), so the effects list the observed changes",
+            action.missing.len(),
+            action.unexpected.len()
+        )
+    };
+    let mut out = String::new();
+    out.push_str("* Prediction Rationale:\n");
+    out.push_str(&format!(
+        "- Reference answer from the simulator: the recorded call {call_text} is the domain schema {} bound to ({}); {fit}.\n",
+        action.schema,
+        action.args.iter().map(|a| a.as_str()).collect::<Vec<_>>().join(" ")
+    ));
+    out.push_str("* Predicted Action:\nAction Semantic:\n");
+    out.push_str(&format!("- {}\n", action.semantic));
+    out.push_str("Precondition:\n");
+    if action.operator.pre.is_empty() {
+        out.push_str("None\n");
+    }
+    for p in &action.operator.pre {
+        out.push_str(&format!("- {p}\n"));
+    }
+    out.push_str("Effect:\n");
+    for e in &action.operator.eff {
+        out.push_str(&format!("- {e}\n"));
+    }
+    out
+}

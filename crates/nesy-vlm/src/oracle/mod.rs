@@ -1,0 +1,292 @@
+//! The offline reference responder (`--vlm oracle`): a [`Transport`] that answers every
+//! NeSyCR call from simulator ground truth and nesy's true domain
+//! (`assets/pddl/nesy-world.pddl`), in the text format the prompt asks for. It sits where
+//! HTTP would, under the retry layer and any cassette, so the replies go through the same
+//! parsers, verification and cassette recording as a real model's.
+//!
+//! - **Operator induction** ([`induce`]): the transition's recorded API call selects the
+//!   domain's schemas for that call; the binding whose grounded effects reproduce s_{t+1}
+//!   is printed as the Action Prediction reply.
+//! - **Patches** ([`patch`]): nesy-core's planner over the true domain, from the violation
+//!   state to the unmet preconditions (or a removal of redundant actions, or a conversion to
+//!   the target end effector), printed as a SEARCH/REPLACE reply.
+//! - **State translation**: the ground-truth state the request carries, minus the atoms
+//!   already known.
+//! - **Code generation**: the procedure compiled by a [`PolicyCompiler`] (nesy-sim's
+//!   template compiler, plugged in by the caller), in a fenced code block.
+//!
+//! [`OracleNoise`] degrades the answers on purpose for the robustness study.
+
+pub mod domain;
+pub mod induce;
+pub mod noise;
+pub mod patch;
+
+use std::fmt;
+use std::sync::{Arc, Mutex};
+
+use nesy_core::atom::Atom;
+use nesy_core::planner::PlannerConfig;
+use nesy_core::symbol::Symbol;
+use serde::{Deserialize, Serialize};
+
+pub use domain::{DomainError, NESY_WORLD_PDDL, WorldDomain, object_type, semantic};
+pub use induce::{InduceError, InducedAction, RecordedCall, api_function, induce};
+pub use noise::{NoiseError, NoiseRng, OracleNoise};
+pub use patch::{OraclePatchError, ProposedPatch, Strategy, propose};
+
+use crate::context::{CodeGenerationContext, StateTranslationContext, VlmTask};
+use crate::error::TransportError;
+use crate::transport::{BoxFuture, Origin, Transport, WireRequest, WireResponse};
+
+/// Turns a verified procedure into a policy program (nesy-sim's template compiler; nesy-vlm
+/// does not depend on the simulator, so the caller supplies it).
+pub trait PolicyCompiler: Send + Sync + fmt::Debug {
+    /// The program for the request's procedure, objects and end effector, or why there is
+    /// none.
+    fn compile(&self, request: &CodeGenerationContext) -> Result<String, String>;
+}
+
+/// Counts of what the oracle answered, for reports and tests.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct OracleStats {
+    /// Induction replies.
+    pub inductions: usize,
+    /// Induction replies whose schema reproduced the transition exactly.
+    pub exact_inductions: usize,
+    /// Patch replies, by strategy.
+    pub patches: usize,
+    /// Patch replies corrupted by `bad_patch`.
+    pub corrupted_patches: usize,
+    /// Literals or atoms changed by `drop`/`flip`.
+    pub perturbed_literals: usize,
+    /// State translations.
+    pub translations: usize,
+    /// Programs compiled.
+    pub programs: usize,
+}
+
+/// The reference responder as a transport.
+pub struct OracleTransport {
+    world: &'static WorldDomain,
+    noise: OracleNoise,
+    seed: u64,
+    planner: PlannerConfig,
+    compiler: Option<Arc<dyn PolicyCompiler>>,
+    stats: Mutex<OracleStats>,
+}
+
+impl fmt::Debug for OracleTransport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("OracleTransport")
+            .field("noise", &self.noise)
+            .field("seed", &self.seed)
+            .field("compiler", &self.compiler)
+            .finish_non_exhaustive()
+    }
+}
+
+impl OracleTransport {
+    /// An oracle over the built-in true domain, without noise and without a compiler.
+    pub fn new() -> Result<OracleTransport, DomainError> {
+        Ok(OracleTransport {
+            world: WorldDomain::builtin()?,
+            noise: OracleNoise::NONE,
+            seed: 0,
+            planner: PlannerConfig::default(),
+            compiler: None,
+            stats: Mutex::new(OracleStats::default()),
+        })
+    }
+
+    /// Degrades answers with `noise`, drawing from `seed`.
+    pub fn with_noise(mut self, noise: OracleNoise, seed: u64) -> Self {
+        self.noise = noise;
+        self.seed = seed;
+        self
+    }
+
+    /// Answers code-generation calls with this compiler.
+    pub fn with_compiler(mut self, compiler: Arc<dyn PolicyCompiler>) -> Self {
+        self.compiler = Some(compiler);
+        self
+    }
+
+    /// Planner settings for patches.
+    pub fn with_planner(mut self, planner: PlannerConfig) -> Self {
+        self.planner = planner;
+        self
+    }
+
+    /// What has been answered so far.
+    pub fn stats(&self) -> OracleStats {
+        self.stats.lock().unwrap_or_else(|e| e.into_inner()).clone()
+    }
+
+    fn bump(&self, f: impl FnOnce(&mut OracleStats)) {
+        f(&mut self.stats.lock().unwrap_or_else(|e| e.into_inner()));
+    }
+
+    /// The reply text for a request (what the transport wraps in a completion body).
+    pub fn answer(&self, request: &WireRequest) -> Result<String, TransportError> {
+        let context = request.task.as_ref().ok_or_else(|| {
+            fail("the oracle needs the task context every nesy prompt attaches; this request has none".into())
+        })?;
+        let task = VlmTask::from_task_context(context).map_err(|e| fail(e.to_string()))?;
+        let mut rng = NoiseRng::for_request(self.seed, &request.body);
+        match task {
+            VlmTask::Induction(ctx) => {
+                let mut action = induce(self.world, &ctx).map_err(|e| fail(e.to_string()))?;
+                let changed = noise::perturb_operator(&mut action.operator, &self.noise, &mut rng);
+                let call = ctx.demo_call.as_ref().and_then(RecordedCall::from_json);
+                self.bump(|s| {
+                    s.inductions += 1;
+                    s.exact_inductions += usize::from(action.exact);
+                    s.perturbed_literals += changed;
+                });
+                Ok(induce::format_reply(&action, call.as_ref()))
+            }
+            VlmTask::Patch(ctx) => {
+                let mut proposed = match propose(self.world, &ctx, &self.planner) {
+                    Ok(p) => p,
+                    Err(e) => {
+                        // An honest non-answer: the loop records it as unparsable feedback.
+                        self.bump(|s| s.patches += 1);
+                        return Ok(format!(
+                            "* Refinement rationale:\n- The reference responder found no patch: {e}\n"
+                        ));
+                    }
+                };
+                let corrupted = rng.chance(self.noise.bad_patch);
+                if corrupted {
+                    corrupt_patch(&mut proposed, &mut rng);
+                }
+                self.bump(|s| {
+                    s.patches += 1;
+                    s.corrupted_patches += usize::from(corrupted);
+                });
+                Ok(patch::format_reply(&proposed))
+            }
+            VlmTask::StateTranslation(ctx) => {
+                let (text, changed) = translate(&ctx, &self.noise, &mut rng)?;
+                self.bump(|s| {
+                    s.translations += 1;
+                    s.perturbed_literals += changed;
+                });
+                Ok(text)
+            }
+            VlmTask::CodeGeneration(ctx) => {
+                let compiler = self.compiler.as_ref().ok_or_else(|| {
+                    fail("the oracle has no policy compiler for code generation; plug in nesy-sim's template compiler".into())
+                })?;
+                let code = compiler.compile(&ctx).map_err(fail)?;
+                self.bump(|s| s.programs += 1);
+                Ok(format!(
+                    "The program below is nesy's template compilation of the {} verified actions for the {}.\n\n```python\n{}```\n",
+                    ctx.procedure.len(),
+                    ctx.embodiment.description(),
+                    if code.ends_with('\n') { code } else { code + "\n" }
+                ))
+            }
+        }
+    }
+}
+
+fn fail(message: String) -> TransportError {
+    TransportError::Failed {
+        message: format!("oracle: {message}"),
+        retryable: false,
+    }
+}
+
+/// Corrupts a patch: half the time its SEARCH names an action the plan does not have (the
+/// loop reports a non-matching SEARCH), otherwise the first inserted action is lost (the
+/// loop reports that the violation is not resolved) when there is one to lose.
+fn corrupt_patch(p: &mut ProposedPatch, rng: &mut NoiseRng) {
+    let inserted = p
+        .replace
+        .len()
+        .saturating_sub(usize::from(p.strategy == Strategy::Insert));
+    if rng.chance(0.5) || inserted == 0 {
+        if let Some(first) = p.search.first_mut() {
+            first.name.push_str("Again");
+        }
+    } else {
+        p.replace.remove(0);
+    }
+}
+
+fn translate(
+    ctx: &StateTranslationContext,
+    noise: &OracleNoise,
+    rng: &mut NoiseRng,
+) -> Result<(String, usize), TransportError> {
+    let truth = ctx.ground_truth.as_ref().ok_or_else(|| {
+        fail(format!(
+            "state translation of {} carries no ground-truth state",
+            ctx.view_set
+        ))
+    })?;
+    let objects: Vec<Symbol> = ctx.objects.iter().map(|o| Symbol::new(o)).collect();
+    let mut changed = 0;
+    let mut lines = Vec::new();
+    for atom in truth.sorted_by_text() {
+        if ctx.known.contains(atom) {
+            continue;
+        }
+        if rng.chance(noise.drop) {
+            changed += 1;
+            continue;
+        }
+        let mut atom = *atom;
+        if rng.chance(noise.flip) && !atom.args().is_empty() && objects.len() > 1 {
+            let mut args = atom.args().to_vec();
+            let last = args.len() - 1;
+            let others: Vec<Symbol> = objects.iter().copied().filter(|o| *o != args[last]).collect();
+            args[last] = others[rng.below(others.len())];
+            atom = Atom::from_symbols(atom.pred(), args);
+            changed += 1;
+        }
+        lines.push(format!("- {atom}"));
+    }
+    if lines.is_empty() {
+        lines.push("None".into());
+    }
+    Ok((lines.join("\n") + "\n", changed))
+}
+
+/// An OpenAI chat-completion body around a reply text.
+pub fn completion_body(text: &str) -> serde_json::Value {
+    serde_json::json!({
+        "id": "oracle",
+        "object": "chat.completion",
+        "model": "nesy-oracle",
+        "choices": [{
+            "index": 0,
+            "message": {"role": "assistant", "content": text},
+            "finish_reason": "stop"
+        }],
+        "usage": {"prompt_tokens": 0, "completion_tokens": 0, "total_tokens": 0}
+    })
+}
+
+impl Transport for OracleTransport {
+    fn send<'a>(&'a self, request: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
+        Box::pin(async move {
+            let text = self.answer(request)?;
+            let mut response = WireResponse::new(200, completion_body(&text).to_string(), Origin::Offline);
+            response
+                .headers
+                .push(("content-type".into(), "application/json".into()));
+            Ok(response)
+        })
+    }
+
+    fn label(&self) -> String {
+        if self.noise.is_none() {
+            "oracle".into()
+        } else {
+            format!("oracle noise {}", self.noise)
+        }
+    }
+}

@@ -1,0 +1,454 @@
+//! Patch proposals from ground truth: the true domain and nesy-core's planner.
+//!
+//! Three strategies, each checked with nesy-core's own verification (Eq. 8) before it is
+//! offered, the best kept:
+//! - **insert**: plan from the violation state to the unmet preconditions and put the plan
+//!   before the erroneous action (missing actions: a closed lid, a stacked cube);
+//! - **remove**: delete a window of actions around the erroneous one that changes nothing
+//!   physical in the target (redundant actions: opening a lid that is already open);
+//! - **convert**: when the unmet preconditions are the other end effector's predicates,
+//!   replace the erroneous and all remaining actions by plans, over the target end
+//!   effector's schemas, to the physical effects of each replaced action in turn.
+//!
+//! Goal violations (every step applies, the goal does not hold) get a plan to the unmet
+//! goal literals appended after the last action.
+
+use nesy_core::adapt::{ViolationInfo, ViolationKind, resolves};
+use nesy_core::exec::{ExecError, Report, UnmetPrecondition};
+use nesy_core::formula::{AtomPattern, Effect, Formula};
+use nesy_core::operator::Operator;
+use nesy_core::patch::AppliedPatch;
+use nesy_core::planner::{self, PlannerConfig};
+use nesy_core::state::State;
+use nesy_core::symbol::Symbol;
+use nesy_core::text::normalize_action_name;
+use nesy_core::types::Universe;
+use nesy_core::{Atom, apply, verify_procedure};
+use serde::{Deserialize, Serialize};
+
+use super::domain::{WorldDomain, semantic};
+use crate::context::{Embodiment, PatchContext};
+
+/// How a patch was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Strategy {
+    /// A plan inserted before the erroneous action.
+    Insert,
+    /// A redundant window removed.
+    Remove,
+    /// The rest of the procedure converted to the target end effector.
+    Convert,
+    /// A plan appended for unmet goal literals.
+    Append,
+}
+
+/// A patch the oracle proposes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ProposedPatch {
+    /// How it was found.
+    pub strategy: Strategy,
+    /// The consecutive actions of the procedure it replaces.
+    pub search: Vec<Operator>,
+    /// What replaces them.
+    pub replace: Vec<Operator>,
+    /// 0-based index of the first replaced action.
+    pub at: usize,
+    /// One sentence on why.
+    pub rationale: String,
+}
+
+/// Why the oracle has no patch.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum OraclePatchError {
+    /// The procedure has no violation from the initial state.
+    #[error("the procedure already applies from the initial state; there is nothing to patch")]
+    NothingToPatch,
+    /// No strategy produced a patch that resolves the violation.
+    #[error("no patch resolves the violation: {0}")]
+    Unresolvable(String),
+}
+
+/// Predicates the goal and the conversion care about.
+const PHYSICS: [&str; 5] = ["OverOf", "OnTopOf", "InsideOf", "Open", "Closed"];
+
+fn embodiment_atom(e: Embodiment) -> Atom {
+    Atom::new(
+        match e {
+            Embodiment::Finger => "FingerGripper",
+            Embodiment::Vacuum => "VacuumSuction",
+        },
+        &[],
+    )
+}
+
+fn is_other_embodiment_pred(pred: &str, target: Embodiment) -> bool {
+    match target {
+        Embodiment::Vacuum => pred.starts_with("Gripper") || pred == "FingerGripper",
+        Embodiment::Finger => pred.starts_with("Vacuum"),
+    }
+}
+
+fn formula_preds(f: &Formula, out: &mut Vec<Symbol>) {
+    match f {
+        Formula::Atom(p) => out.push(p.pred),
+        Formula::Eq(..) => {}
+        Formula::Not(x) | Formula::Forall(_, x) | Formula::Exists(_, x) => formula_preds(x, out),
+        Formula::And(xs) | Formula::Or(xs) => xs.iter().for_each(|x| formula_preds(x, out)),
+        Formula::Imply(a, b) => {
+            formula_preds(a, out);
+            formula_preds(b, out)
+        }
+    }
+}
+
+/// Whether a formula holds in a state (over the state's and the formula's objects).
+pub fn holds(state: &State, f: &Formula) -> bool {
+    apply(state, &Operator::new("Check", vec![f.clone()], Vec::new())).is_ok()
+}
+
+struct Planning<'a> {
+    universe: Universe,
+    schemas: Vec<Operator>,
+    target: Embodiment,
+    config: &'a PlannerConfig,
+}
+
+impl Planning<'_> {
+    /// Plans from `state` to `goal`; returns the printable actions and the state after them.
+    fn plan(&self, state: &State, goal: &Formula) -> Result<(Vec<Operator>, State), String> {
+        let emb = embodiment_atom(self.target);
+        let mut init = state.clone();
+        init.insert(emb);
+        let plan = planner::plan(&self.schemas, &self.universe, &init, goal, self.config)
+            .map_err(|e| format!("planning to {goal}: {e}"))?;
+        let mut ops = Vec::new();
+        let mut s = state.clone();
+        for step in &plan.steps {
+            let op = printable(step, state.contains(&emb));
+            s = apply(&s, &op).map_err(|e| format!("planned action {} does not apply: {e:?}", op.name))?;
+            ops.push(op);
+        }
+        Ok((ops, s))
+    }
+}
+
+/// An instantiated schema as the reply writes it: named by its semantic, without the
+/// end-effector atom when the scene's states do not state it.
+pub fn printable(step: &Operator, state_names_embodiment: bool) -> Operator {
+    let name = normalize_action_name(&semantic(&step.name, &step.args)).unwrap_or_else(|| step.name.clone());
+    let pre = step
+        .pre
+        .iter()
+        .filter(|f| {
+            state_names_embodiment
+                || !matches!(f, Formula::Atom(p) if p.args.is_empty()
+                    && (p.pred.as_str() == "FingerGripper" || p.pred.as_str() == "VacuumSuction"))
+        })
+        .cloned()
+        .collect();
+    Operator::new(name, pre, step.eff.clone())
+}
+
+/// The states before each step of `ops` from `init`, up to the first failure.
+fn rollout(init: &State, ops: &[Operator]) -> Vec<State> {
+    let mut states = vec![init.clone()];
+    for op in ops {
+        match apply(states.last().expect("non-empty"), op) {
+            Ok(s) => states.push(s),
+            Err(_) => break,
+        }
+    }
+    states
+}
+
+fn apply_unchecked(state: &State, op: &Operator) -> State {
+    let bare = Operator::new(op.name.clone(), Vec::new(), op.eff.clone());
+    match apply(state, &bare) {
+        Ok(s) => s,
+        Err(ExecError::Violation(_)) | Err(ExecError::Ground(_)) => state.clone(),
+    }
+}
+
+fn physics_atoms(s: &State) -> Vec<Atom> {
+    s.iter()
+        .filter(|a| PHYSICS.contains(&a.pred().as_str()))
+        .copied()
+        .collect()
+}
+
+/// The physical literals an action's top-level effects state.
+fn physics_goal(op: &Operator) -> Vec<Formula> {
+    op.eff
+        .iter()
+        .filter_map(|e| match e {
+            Effect::Add(p) if PHYSICS.contains(&p.pred.as_str()) => Some(Formula::Atom(p.clone())),
+            Effect::Del(p) if PHYSICS.contains(&p.pred.as_str()) => {
+                Some(Formula::negate(Formula::Atom(p.clone())))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+struct Scored {
+    patch: ProposedPatch,
+    key: (bool, isize, isize),
+}
+
+fn score(
+    req_procedure: &[Operator],
+    init: &State,
+    violation: &ViolationInfo,
+    patch: ProposedPatch,
+) -> Option<Scored> {
+    let removed = patch.search.len();
+    let mut procedure = req_procedure[..patch.at].to_vec();
+    procedure.extend(patch.replace.iter().cloned());
+    procedure.extend(req_procedure[patch.at + removed..].iter().cloned());
+    let report: Report = verify_procedure(init, &procedure, None);
+    let applied = AppliedPatch {
+        procedure: procedure.clone(),
+        at: patch.at,
+        removed,
+        inserted: patch.replace.len(),
+        other_matches: Vec::new(),
+    };
+    resolves(violation, &applied, &report).ok()?;
+    let left = report.first_failure.map_or(0, |f| procedure.len() - f) as isize;
+    Some(Scored {
+        key: (report.first_failure.is_none(), -left, -(procedure.len() as isize)),
+        patch,
+    })
+}
+
+/// Proposes a patch for a refinement request.
+pub fn propose(
+    world: &WorldDomain,
+    ctx: &PatchContext,
+    config: &PlannerConfig,
+) -> Result<ProposedPatch, OraclePatchError> {
+    let req = &ctx.request;
+    let mut names: Vec<Symbol> = req.task.objects.clone();
+    names.extend(req.initial_state.objects());
+    names.extend(req.error_state.objects());
+    for op in &req.procedure {
+        names.extend(op.constants());
+    }
+    let universe = world.universe(names.iter().map(|s| s.as_str()));
+    let schemas = world.schemas_for(ctx.target_embodiment, &universe);
+    let planning = Planning {
+        universe,
+        schemas,
+        target: ctx.target_embodiment,
+        config,
+    };
+    let procedure = &req.procedure;
+
+    // Identification ablated: find the violation ourselves.
+    let (kind, failing, unmet, error_state) = match req.kind {
+        ViolationKind::Unidentified => {
+            let report = verify_procedure(&req.initial_state, procedure, None);
+            match (report.first_failure, report.first_violation()) {
+                (Some(i), Some(v)) => (
+                    ViolationKind::Precondition,
+                    Some(i),
+                    v.unmet.clone(),
+                    report.failing_state.clone().unwrap_or_default(),
+                ),
+                _ => return Err(OraclePatchError::NothingToPatch),
+            }
+        }
+        kind => (kind, req.failing_step, req.unmet.clone(), req.error_state.clone()),
+    };
+    let violation = ViolationInfo {
+        kind,
+        failing_step: failing,
+        action: failing.and_then(|i| procedure.get(i)).map(|o| o.name.clone()),
+        unmet: unmet.clone(),
+        state: error_state.clone(),
+    };
+    let goal_of =
+        |unmet: &[UnmetPrecondition]| Formula::And(unmet.iter().map(|u| u.literal.clone()).collect());
+
+    let mut candidates: Vec<ProposedPatch> = Vec::new();
+    let mut reasons: Vec<String> = Vec::new();
+    match (kind, failing) {
+        (ViolationKind::Goal, _) | (_, None) => {
+            let Some(last) = procedure.last() else {
+                return Err(OraclePatchError::Unresolvable("the procedure is empty".into()));
+            };
+            match planning.plan(&error_state, &goal_of(&unmet)) {
+                Ok((plan, _)) => {
+                    let mut replace = vec![last.clone()];
+                    replace.extend(plan);
+                    candidates.push(ProposedPatch {
+                        strategy: Strategy::Append,
+                        search: vec![last.clone()],
+                        replace,
+                        at: procedure.len() - 1,
+                        rationale: "every action applies but the goal does not hold yet; a plan over the true domain reaches the unmet goal literals after the last action.".into(),
+                    });
+                }
+                Err(e) => reasons.push(e),
+            }
+        }
+        (_, Some(i)) => {
+            let erroneous = &procedure[i];
+            let mut preds = Vec::new();
+            unmet.iter().for_each(|u| formula_preds(&u.literal, &mut preds));
+            let cross = preds
+                .iter()
+                .any(|p| is_other_embodiment_pred(p.as_str(), ctx.target_embodiment));
+            if cross {
+                match convert(&planning, &error_state, &procedure[i..]) {
+                    Ok(replace) => candidates.push(ProposedPatch {
+                        strategy: Strategy::Convert,
+                        search: procedure[i..].to_vec(),
+                        replace,
+                        at: i,
+                        rationale: format!(
+                            "{} needs the other end effector; the rest of the plan is rewritten for the {} so that each action's physical effects are reached in turn.",
+                            erroneous.name,
+                            ctx.target_embodiment.description()
+                        ),
+                    }),
+                    Err(e) => reasons.push(e),
+                }
+            }
+            // Plan to all of the erroneous action's preconditions (so that making the unmet
+            // ones true does not undo the others, e.g. the hand must be empty again after
+            // moving a blocker away), and to the unmet ones alone as a fallback.
+            let whole = Formula::And(erroneous.pre.clone());
+            for goal in [whole, goal_of(&unmet)] {
+                match planning.plan(&error_state, &goal) {
+                    Ok((plan, _)) if !plan.is_empty() => {
+                        let mut replace = plan;
+                        replace.push(erroneous.clone());
+                        candidates.push(ProposedPatch {
+                            strategy: Strategy::Insert,
+                            search: vec![erroneous.clone()],
+                            replace,
+                            at: i,
+                            rationale: format!(
+                                "{} fails because {} do not hold; the inserted actions make them true first.",
+                                erroneous.name,
+                                unmet
+                                    .iter()
+                                    .map(|u| u.literal.to_string())
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            ),
+                        });
+                    }
+                    Ok(_) => {}
+                    Err(e) => reasons.push(e),
+                }
+            }
+            // Redundant windows around the erroneous action.
+            let states = rollout(&req.initial_state, procedure);
+            for k in i.saturating_sub(4)..=i {
+                let Some(before) = states.get(k) else { continue };
+                let mut s = before.clone();
+                for j in k..procedure.len().min(i + 5) {
+                    s = apply_unchecked(&s, &procedure[j]);
+                    if j < i {
+                        continue;
+                    }
+                    if physics_atoms(&s) == physics_atoms(before) {
+                        candidates.push(ProposedPatch {
+                            strategy: Strategy::Remove,
+                            search: procedure[k..=j].to_vec(),
+                            replace: Vec::new(),
+                            at: k,
+                            rationale: format!(
+                                "in this scene {} and the actions serving it change nothing physical: what they achieve already holds, so they are removed.",
+                                erroneous.name
+                            ),
+                        });
+                    }
+                }
+            }
+        }
+    }
+    let best = candidates
+        .into_iter()
+        .filter_map(|p| score(procedure, &req.initial_state, &violation, p))
+        .max_by(|a, b| a.key.cmp(&b.key).then(b.patch.at.cmp(&a.patch.at)));
+    match best {
+        Some(s) => Ok(s.patch),
+        None if reasons.is_empty() => Err(OraclePatchError::Unresolvable(
+            "no candidate patch passes verification".into(),
+        )),
+        None => Err(OraclePatchError::Unresolvable(reasons.join("; "))),
+    }
+}
+
+/// Rewrites `actions` for the target end effector: plans to each action's physical
+/// effects in turn, then lets go of whatever is still held.
+fn convert(planning: &Planning<'_>, state: &State, actions: &[Operator]) -> Result<Vec<Operator>, String> {
+    let mut s = state.clone();
+    let mut out = Vec::new();
+    for (k, a) in actions.iter().enumerate() {
+        // Literals a later action undoes are passing states (the lid opened and closed
+        // again, a neighbour nudged and settling back): the plans reach what lasts, and the
+        // planner adds whatever the lasting effects need on the way.
+        let later: Vec<Formula> = actions[k + 1..].iter().flat_map(physics_goal).collect();
+        let goal: Vec<Formula> = physics_goal(a)
+            .into_iter()
+            .filter(|f| !later.iter().any(|l| *l == negated(f)))
+            .collect();
+        if goal.is_empty() {
+            continue;
+        }
+        let goal = Formula::And(goal);
+        if holds(&s, &goal) {
+            continue;
+        }
+        let (plan, next) = planning.plan(&s, &goal)?;
+        out.extend(plan);
+        s = next;
+    }
+    let idle = Formula::Atom(AtomPattern::ground(Atom::new(
+        match planning.target {
+            Embodiment::Finger => "GripperOpen",
+            Embodiment::Vacuum => "VacuumInactive",
+        },
+        &[],
+    )));
+    if !holds(&s, &idle) {
+        let (plan, _) = planning.plan(&s, &idle)?;
+        out.extend(plan);
+    }
+    if out.is_empty() {
+        return Err("the converted actions would be empty".into());
+    }
+    Ok(out)
+}
+
+fn negated(f: &Formula) -> Formula {
+    match f {
+        Formula::Not(inner) => (**inner).clone(),
+        other => Formula::negate(other.clone()),
+    }
+}
+
+/// The reply in the Refinement Proposal format.
+pub fn format_reply(patch: &ProposedPatch) -> String {
+    let blocks = |ops: &[Operator]| ops.iter().map(|o| o.to_string()).collect::<Vec<_>>().join("\n\n");
+    let mut out = String::new();
+    out.push_str("* Refinement rationale:\n");
+    out.push_str(&format!(
+        "- Reference answer from the true domain ({:?}): {}\n\n",
+        patch.strategy, patch.rationale
+    ));
+    out.push_str("* Refinement patch:\n<<<<<<< SEARCH\n");
+    out.push_str(&blocks(&patch.search));
+    out.push_str("\n=======\n");
+    if !patch.replace.is_empty() {
+        out.push_str(&blocks(&patch.replace));
+        out.push('\n');
+    }
+    out.push_str(">>>>>>> REPLACE\n");
+    out
+}

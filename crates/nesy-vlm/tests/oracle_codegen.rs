@@ -1,0 +1,125 @@
+//! Template-compiled policies in the simulator: the expert's demonstration is turned into
+//! the oracle's symbolic actions (one per recorded call), compiled by nesy-sim's template
+//! compiler for the same end effector, and run by nesy-policy in a fresh copy of the scene;
+//! every subtask must end in full success. The light cases run by default; every subtask
+//! on both end effectors runs with `--ignored`.
+
+use nesy_core::adapt::{InductionRequest, TaskContext};
+use nesy_core::operator::Operator;
+use nesy_core::predicates::{Tier, Vocabulary};
+use nesy_core::state::State;
+use nesy_core::symbol::Symbol;
+use nesy_policy::{Limits, SubtaskStatus, run_in_process};
+use nesy_sim::goal::GoalMonitor;
+use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
+use nesy_sim::{Embodiment, Sim, SimHook, TraceEntry, observe};
+use nesy_vlm::context::{Embodiment as VlmEmbodiment, InductionContext};
+use nesy_vlm::oracle::{WorldDomain, induce};
+
+#[derive(Default)]
+struct Keyframes {
+    calls: Vec<(serde_json::Value, State)>,
+}
+
+impl SimHook for Keyframes {
+    fn on_call(&mut self, sim: &Sim, entry: &TraceEntry) {
+        if entry.call.is_action() && entry.result.is_ok() {
+            self.calls
+                .push((serde_json::to_value(&entry.call).unwrap(), observe(sim)));
+        }
+    }
+}
+
+fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodiment) {
+    let scene = TaskConfig {
+        subtasks: vec![SubtaskConfig {
+            kind,
+            variant: 2,
+            obst_level: obst,
+            multi_level: 1,
+        }],
+        episode: 2,
+        embodiment,
+        embodiment_in_state: false,
+    }
+    .generate()
+    .unwrap()
+    .scene;
+    let mut sim = Sim::new(&scene).unwrap();
+    let objects: Vec<Symbol> = nesy_sim::observer::snapshot(&sim)
+        .objects
+        .iter()
+        .map(|o| Symbol::new(&o.name))
+        .collect();
+    let mut prev = observe(&sim);
+    sim.add_hook(Box::new(Keyframes::default()));
+    nesy_sim::expert::run(&mut sim, &scene.goals).unwrap();
+    let world = WorldDomain::builtin().unwrap();
+    let task = TaskContext {
+        instruction: scene.instruction.clone(),
+        objects: objects.clone(),
+        tier: Tier::Full,
+        vocabulary: Vocabulary::default(),
+    };
+    let mut procedure: Vec<Operator> = Vec::new();
+    for (t, (call, next)) in sim.hook::<Keyframes>().unwrap().calls.iter().enumerate() {
+        let ctx = InductionContext {
+            request: InductionRequest {
+                step: t,
+                attempt: 0,
+                previous: prev.clone(),
+                next: next.clone(),
+                diff: prev.diff(next),
+                task: task.clone(),
+                feedback: Vec::new(),
+            },
+            demo_call: Some(call.clone()),
+            embodiment: match embodiment {
+                Embodiment::Finger => VlmEmbodiment::Finger,
+                Embodiment::Vacuum => VlmEmbodiment::Vacuum,
+            },
+        };
+        procedure.push(induce(world, &ctx).unwrap().operator);
+        prev = next.clone();
+    }
+    let names: Vec<String> = objects.iter().map(|o| o.to_string()).collect();
+    let policy = nesy_sim::codegen::compile_policy(&procedure, &names, embodiment).unwrap();
+    let mut episode = Sim::new(&scene).unwrap();
+    GoalMonitor::attach(&mut episode).unwrap();
+    let result = run_in_process(&policy.code, Box::new(episode), &Limits::default(), None).unwrap();
+    assert!(result.is_ok(), "{:?}\n{}", result.outcome, policy.code);
+    let statuses: Vec<SubtaskStatus> = result
+        .subtasks
+        .unwrap_or_default()
+        .into_iter()
+        .map(|s| s.status)
+        .collect();
+    assert_eq!(
+        statuses,
+        vec![SubtaskStatus::FullSuccess],
+        "{kind} obst {obst} on {embodiment}:\n{}",
+        policy.code
+    );
+}
+
+#[test]
+fn pick_place_with_a_stack_on_the_finger_robot() {
+    compiled_expert_plan_succeeds(SubtaskKind::PickPlace, 1, Embodiment::Finger);
+}
+
+#[test]
+fn closed_hinge_on_the_vacuum_robot() {
+    compiled_expert_plan_succeeds(SubtaskKind::PutInHinge, 1, Embodiment::Vacuum);
+}
+
+#[test]
+#[ignore = "every subtask and obstruction level on both robots (about a minute)"]
+fn every_subtask_on_both_robots() {
+    for embodiment in [Embodiment::Finger, Embodiment::Vacuum] {
+        for kind in SubtaskKind::ALL {
+            for obst in 0..3 {
+                compiled_expert_plan_succeeds(kind, obst, embodiment);
+            }
+        }
+    }
+}
