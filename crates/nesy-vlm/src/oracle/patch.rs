@@ -4,8 +4,9 @@
 //! offered, the best kept:
 //! - **insert**: plan from the violation state to the unmet preconditions and put the plan
 //!   before the erroneous action (missing actions: a closed lid, a stacked cube);
-//! - **remove**: delete a window of actions around the erroneous one that changes nothing
-//!   physical in the target (redundant actions: opening a lid that is already open);
+//! - **remove**: when the erroneous action would change nothing in the violation state
+//!   (what it does already holds), delete a window of actions around it that changes
+//!   nothing physical in the target (redundant actions: opening a lid that is already open);
 //! - **convert**: when the unmet preconditions are the other end effector's predicates,
 //!   replace the erroneous and all remaining actions by plans, over the target end
 //!   effector's schemas, to the physical effects of each replaced action in turn.
@@ -345,9 +346,11 @@ pub fn propose(
                     Err(e) => reasons.push(e),
                 }
             }
-            // Redundant windows around the erroneous action.
+            // Redundant windows around the erroneous action, when it is redundant itself:
+            // what it would do already holds (applying its effects changes nothing).
             let states = rollout(&req.initial_state, procedure);
-            for k in i.saturating_sub(4)..=i {
+            let redundant = apply_unchecked(&error_state, erroneous) == error_state;
+            for k in (i.saturating_sub(4)..=i).filter(|_| redundant) {
                 let Some(before) = states.get(k) else { continue };
                 let mut s = before.clone();
                 for j in k..procedure.len().min(i + 5) {
