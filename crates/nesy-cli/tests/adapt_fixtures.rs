@@ -37,9 +37,28 @@ const CASES: &[Case] = &[
         action: "MoveToSurroundPurpleCube",
         unmet: &["(FingerGripper)", "(GripperOpen)"],
     },
+    // The target's hinge lid is closed (with a fruit on it): carrying over the box needs it open.
+    Case {
+        name: "put_in_hinge_obst_0to2_finger",
+        step: 2,
+        action: "CarryOverHingeBodyLemon",
+        unmet: &["(Open hinge_lid)"],
+    },
+    // Three subtasks; the first violation is the closed bottom drawer (then a stacked cube and a
+    // piece in the wrong box follow).
+    Case {
+        name: "composite_medium",
+        step: 2,
+        action: "CarryOverBottomDrawerRedCylinder",
+        unmet: &["(Open bottom_drawer)"],
+    },
 ];
 
 fn replay(case: &Case) {
+    replay_with(case, &[]);
+}
+
+fn replay_with(case: &Case, extra: &[&str]) {
     let out = common::scratch();
     let demo = format!("fixtures/demos/{}", case.name);
     let args: Vec<String> = [
@@ -56,6 +75,7 @@ fn replay(case: &Case) {
         &out.path().display().to_string(),
     ]
     .iter()
+    .chain(extra)
     .map(|s| s.to_string())
     .collect();
     let output = common::nesy(&args);
@@ -103,4 +123,21 @@ fn pick_place_with_a_stacked_cube() {
 #[test]
 fn finger_gripper_demo_to_a_vacuum_robot() {
     replay(&CASES[1]);
+}
+
+#[test]
+fn hinge_box_with_a_closed_lid() {
+    replay(&CASES[2]);
+}
+
+#[test]
+fn medium_composite() {
+    replay(&CASES[3]);
+}
+
+#[test]
+fn the_template_compiler_also_reaches_full_success() {
+    // The same adaptation, compiled by nesy-sim's template compiler instead of the model's
+    // code generation (the recorded code-generation call goes unused).
+    replay_with(&CASES[0], &["--codegen", "template"]);
 }

@@ -8,8 +8,9 @@
 
 use nesy_core::Operator;
 use nesy_sim::api::Embodiment;
+use nesy_sim::codegen::compile_policy;
 use nesy_sim::scene::SceneSpec;
-use nesy_vlm::{CodeGenerationRequest, CodegenError, VlmReasoner};
+use nesy_vlm::{CodeGenerationContext, CodeGenerationRequest, CodegenError, PolicyCompiler, VlmReasoner};
 use serde::Serialize;
 
 use super::to_vlm_embodiment;
@@ -130,8 +131,32 @@ pub async fn synthesize(
 }
 
 fn template(request: &SynthesisRequest<'_>) -> Result<SynthesizedPolicy, SynthError> {
-    let _ = request;
-    Err(SynthError::Call {
-        message: "--codegen template: the template compiler is not available in this build yet".into(),
+    let compiled = compile_policy(&request.procedure, &request.objects, request.target).map_err(|e| {
+        SynthError::NoProgram {
+            message: e.to_string(),
+        }
+    })?;
+    Ok(SynthesizedPolicy {
+        code: compiled.code,
+        mode: CodegenMode::Template,
+        reply: None,
+        extended: false,
+        stripped: Vec::new(),
     })
+}
+
+/// The template compiler as the oracle's code generator.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TemplateCompiler;
+
+impl PolicyCompiler for TemplateCompiler {
+    fn compile(&self, request: &CodeGenerationContext) -> Result<String, String> {
+        let embodiment = match request.embodiment {
+            nesy_vlm::Embodiment::Finger => Embodiment::Finger,
+            nesy_vlm::Embodiment::Vacuum => Embodiment::Vacuum,
+        };
+        compile_policy(&request.procedure, &request.objects, embodiment)
+            .map(|c| c.code)
+            .map_err(|e| e.to_string())
+    }
 }

@@ -16,8 +16,8 @@ use std::sync::Arc;
 use anyhow::Context as _;
 use nesy_vlm::cassette::CassetteFile;
 use nesy_vlm::{
-    BackendKind, CassetteMode, CassetteOptions, CassetteTransport, ConfigOverrides, ProcessEnv, Transport,
-    VlmClient, VlmConfig,
+    BackendKind, CassetteMode, CassetteOptions, CassetteTransport, ConfigOverrides, OracleNoise,
+    OracleTransport, ProcessEnv, Transport, VlmClient, VlmConfig,
 };
 
 /// The model name the offline responder's requests carry (recorded in its cassettes).
@@ -207,8 +207,19 @@ pub fn build_client(setup: &VlmSetup) -> anyhow::Result<VlmClient> {
     Ok(VlmClient::with_transport(&config, transport))
 }
 
-/// The offline reference responder (nesy-vlm's oracle; not in this build yet).
+/// The offline reference responder: nesy-vlm's oracle over the true domain, with the noise
+/// knobs, answering code generation with the template compiler.
 fn oracle_transport(noise: &str) -> anyhow::Result<Arc<dyn Transport>> {
-    let _ = noise;
-    anyhow::bail!("--vlm oracle: the offline reference responder is not available in this build yet")
+    let noise: OracleNoise = if noise.trim().is_empty() {
+        OracleNoise::NONE
+    } else {
+        noise
+            .parse()
+            .with_context(|| format!("--oracle-noise {noise:?}"))?
+    };
+    let oracle = OracleTransport::new()
+        .context("loading the oracle's domain")?
+        .with_noise(noise, 0)
+        .with_compiler(Arc::new(super::synth::TemplateCompiler));
+    Ok(Arc::new(oracle))
 }

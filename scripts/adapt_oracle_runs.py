@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+"""Runs `nesy adapt --vlm oracle --execute` on one scenario per factor x complexity (15) and
+prints SR/GC/PD and the time breakdown as a markdown table (crates/nesy-cli/README.md).
+
+usage: scripts/adapt_oracle_runs.py [--nesy PATH] [--work DIR] [--episode N] [--codegen vlm|template]
+
+Each scenario's source demo is recorded with `nesy record` (the scripted expert), then adapted
+to the scenario's target scene. Standard library only.
+"""
+
+import argparse
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+FACTORS = ["affo", "obst", "grip", "vacu", "comb"]
+COMPLEXITIES = ["low", "medium", "high"]
+
+
+def mean_se(values):
+    n = len(values)
+    if n == 0:
+        return float("nan"), float("nan")
+    m = sum(values) / n
+    if n < 2:
+        return m, float("nan")
+    var = sum((v - m) ** 2 for v in values) / (n - 1)
+    return m, math.sqrt(var) / math.sqrt(n)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--nesy", default="target/release/nesy")
+    ap.add_argument("--work", default="runs/oracle15")
+    ap.add_argument("--episode", type=int, default=0)
+    ap.add_argument("--codegen", default="vlm")
+    ap.add_argument("--tries", type=int, default=5, help="episodes to try per cell")
+    args = ap.parse_args()
+    work = Path(args.work)
+    rows = []
+    for factor in FACTORS:
+        for complexity in COMPLEXITIES:
+            # The first episode from --episode on whose source demo the scripted expert
+            # completes (a failed demonstration is no demonstration); skipped ones are listed.
+            sid, demo, skipped = None, None, []
+            for episode in range(args.episode, args.episode + args.tries):
+                candidate = f"{factor}_{complexity}_{episode:02d}_s0"
+                cdemo = work / candidate / "demo"
+                # `nesy record` writes the files even when the expert fails; only a run that
+                # exited 0 leaves the marker.
+                if not (cdemo / "recorded.ok").exists():
+                    rec = subprocess.run(
+                        [args.nesy, "record", "--scenario", candidate, "--out", str(cdemo)],
+                        capture_output=True, text=True,
+                    )
+                    if rec.returncode != 0:
+                        lines = (rec.stderr.strip() or rec.stdout.strip()).splitlines() or ["?"]
+                        skipped.append(f"{candidate}: {lines[-1]}")
+                        continue
+                    (cdemo / "recorded.ok").write_text(rec.stdout)
+                sid, demo = candidate, cdemo
+                break
+            for s in skipped:
+                print(f"skipped {s}", file=sys.stderr)
+            if sid is None:
+                rows.append({"id": f"{factor}_{complexity}", "error": "no recordable episode"})
+                continue
+            out = work / sid / "adapt"
+            run = subprocess.run(
+                [args.nesy, "adapt", "--demo", str(demo), "--target", str(demo / "target.json"),
+                 "--vlm", "oracle", "--codegen", args.codegen, "--execute", "--json", "--out", str(out)],
+                capture_output=True, text=True,
+            )
+            try:
+                summary = json.loads(run.stdout)
+            except json.JSONDecodeError:
+                rows.append({"id": sid, "error": (run.stderr.strip().splitlines() or ["?"])[-1]})
+                continue
+            row = {"id": sid, "status": summary["status"], "timing": summary["timing"]}
+            execution = out / "execution.json"
+            metrics = None
+            if execution.exists():
+                metrics = json.loads(execution.read_text()).get("metrics")
+            row["sr"] = metrics["sr"] if metrics else 0.0
+            row["gc"] = metrics["gc"] if metrics else 0.0
+            row["pd"] = metrics["pd"] if metrics and metrics["pd"] is not None else 1.0
+            row["subtasks"] = ", ".join(
+                f"{s['subtask']} {s['status']}" for s in (metrics or {}).get("subtasks", [])
+            )
+            adaptation = json.loads((out / "adaptation.json").read_text())
+            row["proposals"] = len(adaptation["proposals"])
+            row["violations"] = len(adaptation["violations"])
+            rows.append(row)
+            print(f"{sid}: {row['status']} SR {row['sr']:.0f} GC {row['gc']:.2f}", file=sys.stderr)
+
+    print("| scenario | status | subtasks | violations | proposals | SR | GC | PD | VLM s | symbolic ms | sim s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        if "error" in r:
+            print(f"| {r['id']} | error: {r['error']} | | | | 0 | 0 | 1 | | | |")
+            continue
+        t = r["timing"]
+        print(
+            f"| {r['id']} | {r['status']} | {r['subtasks']} | {r['violations']} | {r['proposals']} | "
+            f"{r['sr']:.0f} | {r['gc']:.2f} | {r['pd']:.2f} | {t['vlm_s']:.3f} | {t['symbolic_s'] * 1e3:.2f} | {t['sim_s']:.2f} |"
+        )
+    srs = [r.get("sr", 0.0) for r in rows]
+    gcs = [r.get("gc", 0.0) for r in rows]
+    pds = [r.get("pd", 1.0) for r in rows]
+    sym = [r["timing"]["symbolic_s"] * 1e3 for r in rows if "timing" in r]
+    (sr, sr_se), (gc, gc_se), (pd, pd_se) = mean_se(srs), mean_se(gcs), mean_se(pds)
+    print()
+    print(f"SR {sr * 100:.1f} ± {sr_se * 100:.1f}, GC {gc * 100:.1f} ± {gc_se * 100:.1f}, "
+          f"PD {pd * 100:.1f} ± {pd_se * 100:.1f} over {len(rows)} scenarios; "
+          f"symbolic time per run: mean {sum(sym) / max(len(sym), 1):.2f} ms, max {max(sym or [0]):.2f} ms")
+
+
+if __name__ == "__main__":
+    main()
