@@ -113,13 +113,22 @@ fn closed_hinge_on_the_vacuum_robot() {
 }
 
 #[test]
-#[ignore = "every subtask and obstruction level on both robots (about a minute)"]
+#[ignore = "every subtask and obstruction level on both robots (about 20 s; 23 of 24 pass, see the README)"]
 fn every_subtask_on_both_robots() {
+    let mut failures = Vec::new();
     for embodiment in [Embodiment::Finger, Embodiment::Vacuum] {
         for kind in SubtaskKind::ALL {
             for obst in 0..3 {
-                compiled_expert_plan_succeeds(kind, obst, embodiment);
+                let run = std::panic::catch_unwind(|| compiled_expert_plan_succeeds(kind, obst, embodiment));
+                if run.is_err() {
+                    failures.push(format!("{kind} obst {obst} on {embodiment}"));
+                }
             }
         }
     }
+    assert!(
+        failures.is_empty(),
+        "{} of 24 failed: {failures:?}",
+        failures.len()
+    );
 }

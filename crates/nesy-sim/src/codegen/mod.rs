@@ -419,6 +419,21 @@ impl Emitter {
         }
     }
 
+    fn carry_onto(&mut self, x: &str, surface: &str) {
+        let hang = self.hang(&format!("get_obj_size({x:?})[2]"));
+        if surface == "floor" {
+            self.line(&format!("spot = get_empty_floor_xy({x:?})"));
+            self.line(&format!(
+                "move_to_position([spot[0], spot[1], 0.5 + {hang} + 0.01])"
+            ));
+        } else {
+            self.line(&format!("surface = get_obj_bbox({surface:?})"));
+            self.line(&format!(
+                "move_to_position([get_obj_pos({x:?})[0], (surface[0][1] + surface[1][1]) / 2, surface[1][2] + {hang} + 0.01])"
+            ));
+        }
+    }
+
     fn drawer_directions(&mut self) {
         // Drawers slide out toward the side their handles are on (as the expert decides).
         self.line("handle_y = get_obj_pos(\"bottom_drawer_handle\")[1]");
@@ -481,23 +496,28 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
                 e.line(t);
             }
             Release => {
+                // A put-down says where the object comes to rest; without a carry to that
+                // surface just before it, the carry is part of it.
+                let put_down = a.schema.ends_with("put-down");
+                let carried = i > 0
+                    && actions[i - 1].motion == CarryOnto
+                    && actions[i - 1].args.first() == a.args.first();
+                if put_down && !carried {
+                    e.carry_onto(arg(0), arg(1));
+                }
                 let r = e.release();
                 e.line(r);
             }
             CarryOnto => {
-                let (x, surface) = (arg(0), arg(1));
-                let hang = e.hang(&format!("get_obj_size({x:?})[2]"));
-                if surface == "floor" {
-                    e.line(&format!("spot = get_empty_floor_xy({x:?})"));
-                    e.line(&format!(
-                        "move_to_position([spot[0], spot[1], 0.5 + {hang} + 0.01])"
-                    ));
-                } else {
-                    e.line(&format!("surface = get_obj_bbox({surface:?})"));
-                    e.line(&format!(
-                        "move_to_position([get_obj_pos({x:?})[0], (surface[0][1] + surface[1][1]) / 2, surface[1][2] + {hang} + 0.01])"
-                    ));
-                }
+                // The following put-down names the surface the object comes to rest on (the
+                // carry itself may leave it just above either surface).
+                let surface = match actions.get(i + 1) {
+                    Some(n) if n.schema.ends_with("put-down") && n.args.first() == a.args.first() => {
+                        n.args.get(1).map(String::as_str).unwrap_or(arg(1))
+                    }
+                    _ => arg(1),
+                };
+                e.carry_onto(arg(0), surface);
             }
             CarryInto => {
                 let (x, b) = (arg(0), arg(1));
