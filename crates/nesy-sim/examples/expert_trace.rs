@@ -4,7 +4,10 @@
 //!
 //! ```text
 //! cargo run -p nesy-sim --example expert_trace -- KIND OBST MULTI VARIANT finger|vacuum [SCENE_OUT.json]
+//! cargo run -p nesy-sim --example expert_trace -- --task TASK_CONFIG.json [SCENE_OUT.json]
 //! ```
+//!
+//! The second form takes any `TaskConfig` (e.g. a composite), as JSON.
 
 use nesy_sim::goal::GoalMonitor;
 use nesy_sim::sim::SimHook;
@@ -43,10 +46,11 @@ impl SimHook for PrintActions {
     }
 }
 
-const USAGE: &str = "usage: expert_trace KIND OBST MULTI VARIANT finger|vacuum [SCENE_OUT.json]";
+const USAGE: &str = "usage: expert_trace KIND OBST MULTI VARIANT finger|vacuum [SCENE_OUT.json] \
+                     | expert_trace --task TASK_CONFIG.json [SCENE_OUT.json]";
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+/// The task of the first form's arguments.
+fn single_config(args: &[String]) -> Result<TaskConfig, Box<dyn std::error::Error>> {
     if args.len() < 5 {
         return Err(USAGE.into());
     }
@@ -60,7 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         other => return Err(format!("unknown embodiment {other:?}; {USAGE}").into()),
     };
     let variant: u64 = args[3].parse()?;
-    let config = TaskConfig {
+    Ok(TaskConfig {
         subtasks: vec![SubtaskConfig {
             kind,
             variant,
@@ -70,9 +74,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         episode: variant,
         embodiment,
         embodiment_in_state: false,
+    })
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let (config, scene_out) = if args.first().map(String::as_str) == Some("--task") {
+        let path = args.get(1).ok_or(USAGE)?;
+        let text = std::fs::read_to_string(path)?;
+        let config: TaskConfig = serde_json::from_str(&text).map_err(|e| format!("{path}: {e}"))?;
+        (config, args.get(2))
+    } else {
+        (single_config(&args)?, args.get(5))
     };
     let task = config.generate()?;
-    if let Some(path) = args.get(5) {
+    if let Some(path) = scene_out {
         std::fs::write(path, task.scene.to_json_pretty())?;
     }
     let mut sim = Sim::new(&task.scene)?;

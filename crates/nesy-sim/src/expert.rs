@@ -60,6 +60,8 @@ const LID_CLOSING_ARC: [f64; 2] = [135.0, 180.0];
 const DROP_CLEARANCE: f64 = 0.01;
 /// Height of the table top.
 const TABLE: f64 = 0.5;
+/// Nearest x (m) to the robot's base at which the experts set objects down out of the way.
+const COMFORTABLE_MIN_X: f64 = 0.3;
 
 /// The robot with the subtask being worked on, for error reports.
 struct Hand<'a, R: RobotApi + ?Sized> {
@@ -229,14 +231,55 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
         self.release()
     }
 
-    /// Moves an object to a free table spot (`get_empty_floor_xy`).
+    /// Moves an object to a free table spot: `get_empty_floor_xy`'s, unless that is close to
+    /// the robot's base, where a top-down reach runs joint 4 into its limit and the planner's
+    /// joint-space fallback swings the arm through the scene; then the free spot of
+    /// [`Hand::free_spot`].
     fn move_aside(&mut self, name: &str) -> Result<(), ExpertError> {
         let h = self.pick(name)?;
         let [x, y] = self
             .robot
             .get_empty_floor_xy(name)
             .map_err(|e| self.fail(format!("get_empty_floor_xy({name})"), e))?;
+        let [x, y] = if x >= COMFORTABLE_MIN_X {
+            [x, y]
+        } else {
+            self.free_spot(name)?.unwrap_or([x, y])
+        };
         self.put(x, y, TABLE, h, DROP_CLEARANCE)
+    }
+
+    /// A table spot at x ≥ [`COMFORTABLE_MIN_X`] in the middle strip of the table whose
+    /// footprint for `name` keeps 2 cm from every other object (seen via `get_obj_names` and
+    /// `get_obj_bbox`), nearest the strip's centre; `None` if there is none.
+    fn free_spot(&mut self, name: &str) -> Result<Option<[f64; 2]>, ExpertError> {
+        let own = size(&self.bbox(name)?);
+        let half = [own[0].max(own[1]) / 2.0 + 0.02; 2];
+        let mut others = Vec::new();
+        for other in self.robot.get_obj_names() {
+            if other == name || other == "floor" || other.contains("gripper") {
+                continue;
+            }
+            others.push(self.bbox(&other)?);
+        }
+        let mut best: Option<([f64; 2], f64)> = None;
+        for i in 0..=10 {
+            for j in 0..=15 {
+                let spot = [COMFORTABLE_MIN_X + 0.02 * i as f64, -0.15 + 0.02 * j as f64];
+                let footprint: Bbox = [
+                    [spot[0] - half[0], spot[1] - half[1], TABLE],
+                    [spot[0] + half[0], spot[1] + half[1], TABLE + 0.3],
+                ];
+                if others.iter().any(|b| overlaps_xy(b, &footprint, 0.0)) {
+                    continue;
+                }
+                let cost = (spot[0] - 0.4).abs() + spot[1].abs();
+                if best.is_none_or(|(_, c)| cost < c) {
+                    best = Some((spot, cost));
+                }
+            }
+        }
+        Ok(best.map(|(spot, _)| spot))
     }
 }
 
@@ -454,18 +497,19 @@ fn put_in_prismatic<R: RobotApi + ?Sized>(
         }
     };
     let travel = size(&hand.bbox(drawer)?)[1] * 0.85;
-    // The suction tool reaches the bottom handle pointing at the cabinet: from above, its
-    // wrist (6 cm above the tip and wider than the 2.5 cm between the handle and the cabinet
-    // face) sweeps cylinders off the cabinet's front edge. The fingers come from above, as in
-    // the authors' demo.
-    let pointing = match (hand.vacuum, outward < 0.0) {
-        (false, _) => Direction::Down,
-        (true, true) => Direction::Right,
-        (true, false) => Direction::Left,
+    // Both tools reach the handles pointing at the cabinet. From above (the authors' demo),
+    // the suction tool's wrist, 6 cm above its tip and wider than the 2.5 cm between a handle
+    // and the cabinet face, pushed cylinders at the cabinet's front edge down through its top,
+    // and the finger hand, wide along the bar, swept them off the top while closing the top
+    // drawer.
+    let pointing = if outward < 0.0 {
+        Direction::Right
+    } else {
+        Direction::Left
     };
     if is_open(&hand.bbox("top_drawer")?) {
-        hand.grab_handle("top_drawer_handle")?;
-        hand.slide(close_dir, travel)?;
+        hand.grab_handle_pointing("top_drawer_handle", pointing)?;
+        hand.slide_pointing(close_dir, travel, pointing)?;
         hand.let_go_handle()?;
     }
     if !is_open(&hand.bbox(drawer)?) {
@@ -485,7 +529,7 @@ fn put_in_prismatic<R: RobotApi + ?Sized>(
         hand.move_to([x, y, c[2] + s[2] + h + 0.05], crate::api::DEFAULT_LIFT_CLEARANCE)?;
         hand.release()?;
     }
-    hand.grab_handle("bottom_drawer_handle")?;
-    hand.slide(close_dir, travel)?;
+    hand.grab_handle_pointing("bottom_drawer_handle", pointing)?;
+    hand.slide_pointing(close_dir, travel, pointing)?;
     hand.let_go_handle()
 }
