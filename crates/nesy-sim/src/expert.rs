@@ -497,21 +497,24 @@ fn put_in_prismatic<R: RobotApi + ?Sized>(
         }
     };
     let travel = size(&hand.bbox(drawer)?)[1] * 0.85;
-    // Both tools reach the handles pointing at the cabinet. From above (the authors' demo),
-    // the suction tool's wrist, 6 cm above its tip and wider than the 2.5 cm between a handle
-    // and the cabinet face, pushed cylinders at the cabinet's front edge down through its top,
-    // and the finger hand, wide along the bar, swept them off the top while closing the top
-    // drawer.
-    let pointing = if outward < 0.0 {
+    // Toward the cabinet: the pointing that keeps the hand in front of the handle.
+    let sideways = if outward < 0.0 {
         Direction::Right
     } else {
         Direction::Left
     };
+    // The open top drawer is closed with the tool pointing at the cabinet: from above, the
+    // finger hand, wide along the bar, swept cylinders off the cabinet top on the way in.
     if is_open(&hand.bbox("top_drawer")?) {
-        hand.grab_handle_pointing("top_drawer_handle", pointing)?;
-        hand.slide_pointing(close_dir, travel, pointing)?;
+        hand.grab_handle_pointing("top_drawer_handle", sideways)?;
+        hand.slide_pointing(close_dir, travel, sideways)?;
         hand.let_go_handle()?;
     }
+    // The bottom handle: the fingers from above, as in the authors' demo; the suction tool
+    // pointing at the cabinet, because from above its wrist (6 cm above the tip and wider
+    // than the 2.5 cm between the handle and the cabinet face) pushed cylinders standing at
+    // the cabinet's front edge down through its top.
+    let pointing = if hand.vacuum { sideways } else { Direction::Down };
     if !is_open(&hand.bbox(drawer)?) {
         hand.grab_handle_pointing("bottom_drawer_handle", pointing)?;
         hand.slide_pointing(open_dir, travel, pointing)?;
