@@ -284,6 +284,16 @@ pub fn run(
     let adapt_wall = adapt_started.elapsed();
     timing.vlm_s += timed.vlm_time().as_secs_f64();
     timing.symbolic_s = adapt_wall.saturating_sub(timed.vlm_time()).as_secs_f64();
+    // Split at the first patch request: before it, world-model construction (and the first
+    // identification, which is negligible next to it); after it, the adaptation loop.
+    timing.symbolic_world_model_s = match timed.first_patch() {
+        Some((at, vlm_before)) => at
+            .saturating_duration_since(adapt_started)
+            .saturating_sub(vlm_before)
+            .as_secs_f64(),
+        None => timing.symbolic_s,
+    };
+    timing.symbolic_adaptation_s = (timing.symbolic_s - timing.symbolic_world_model_s).max(0.0);
     timing.adapt_wall_s = adapt_wall.as_secs_f64();
     let reasoner = timed.into_inner();
 

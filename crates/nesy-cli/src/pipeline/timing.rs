@@ -20,6 +20,12 @@ pub struct TimeBreakdown {
     pub vlm_s: f64,
     /// The adaptation loop outside model calls (and the template compiler).
     pub symbolic_s: f64,
+    /// The part of `symbolic_s` spent building the world model (parsing and verifying the
+    /// induced operators against the demonstration, Eq. 3).
+    pub symbolic_world_model_s: f64,
+    /// The part of `symbolic_s` spent on counterfactual adaptation (identification,
+    /// patching and re-verification, Eq. 6–8).
+    pub symbolic_adaptation_s: f64,
     /// The target scene (build, observe, render) and the policy's execution.
     pub sim_s: f64,
     /// Wall time of `nesy_core::adapt::run` (VLM + symbolic parts of it).
@@ -37,6 +43,7 @@ pub struct TimedReasoner<R> {
     transitions: usize,
     budget: usize,
     calls: usize,
+    first_patch: Option<(Instant, Duration)>,
 }
 
 impl<R: Reasoner> TimedReasoner<R> {
@@ -49,12 +56,19 @@ impl<R: Reasoner> TimedReasoner<R> {
             transitions,
             budget,
             calls: 0,
+            first_patch: None,
         }
     }
 
     /// Time spent inside the wrapped reasoner so far.
     pub fn vlm_time(&self) -> Duration {
         self.vlm
+    }
+
+    /// When the first patch was requested and the model time spent before it (the end of
+    /// world-model construction and the first identification), if any was requested.
+    pub fn first_patch(&self) -> Option<(Instant, Duration)> {
+        self.first_patch
     }
 
     /// Calls made so far.
@@ -88,6 +102,9 @@ impl<R: Reasoner + Send> Reasoner for TimedReasoner<R> {
             (Some(op), Some(step)) => format!("step {} {}", step + 1, op.display_name()),
             _ => "goal".to_owned(),
         };
+        if self.first_patch.is_none() {
+            self.first_patch = Some((Instant::now(), self.vlm));
+        }
         self.progress.detail(&format!(
             "patch proposal {}/{} for {what}",
             request.iteration + 1,
