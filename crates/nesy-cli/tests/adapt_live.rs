@@ -1,8 +1,8 @@
 //! `nesy adapt --vlm URL` against a local mock OpenAI-compatible server (wiremock) with a
 //! scripted responder: the live HTTP path end to end, through the real binary.
 //!
-//! The demo is recorded here by nesy-sim's expert (small images to stay fast); the target
-//! is the same scene, so the adaptation needs no patch. The responder answers operator
+//! The demo is the committed drawer demo; the target is the scene it was recorded in, so the
+//! adaptation needs no patch. The responder answers operator
 //! induction from the state difference the prompt shows (preconditions: the atoms the step
 //! removed; effects: the difference), which the verifier accepts, and code generation with
 //! prose around a fenced program.
@@ -73,9 +73,10 @@ impl Respond for Scripted {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn adapt_talks_to_a_live_server_and_writes_every_output() {
     let dir = common::scratch();
+    // The committed drawer demo (not one recorded here: the expert's motions may change), and
+    // its own scene as the target.
     let scene_path = common::workspace().join("fixtures/scenes/drawer_finger.json");
-    let demo_path = dir.path().join("demo.mcap");
-    common::record_demo(&scene_path, &demo_path, 48);
+    let demo_path = common::workspace().join("fixtures/demos/adapt-realstyle/demo.mcap");
 
     let server = MockServer::start().await;
     let seen = Arc::new(Mutex::new(Seen::default()));
