@@ -141,3 +141,44 @@ fn the_template_compiler_also_reaches_full_success() {
     // code generation (the recorded code-generation call goes unused).
     replay_with(&CASES[0], &["--codegen", "template"]);
 }
+
+#[test]
+fn states_translated_by_the_model_from_the_marked_views() {
+    // `--states vlm`: every keyframe and the target go through the State Translation prompt
+    // (recorded with the oracle, which answers from ground truth, so F1 is 1).
+    let out = common::scratch();
+    let name = CASES[0].name;
+    let demo = format!("fixtures/demos/{name}");
+    let args: Vec<String> = [
+        "adapt",
+        "--demo",
+        &demo,
+        "--target",
+        &format!("{demo}/target.json"),
+        "--vlm",
+        &format!("replay:fixtures/cassettes/adapt-{name}-states-vlm.json"),
+        "--states",
+        "vlm",
+        "--execute",
+        "--json",
+        "--out",
+        &out.path().display().to_string(),
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let output = common::nesy(&args);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(
+        output.status.code(),
+        Some(0),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let summary: Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(summary["states"]["source"], "vlm");
+    assert_eq!(summary["states"]["translated"], 14);
+    assert_eq!(summary["states"]["agreement"]["f1"], 1.0);
+    assert_eq!(summary["usage"]["by_purpose"]["translate"]["calls"], 14);
+    assert_eq!(summary["status"], "succeeded");
+}
