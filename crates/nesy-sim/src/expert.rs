@@ -28,7 +28,7 @@ pub struct ExpertError {
 /// Cells of the toy box the cubes are dropped into (offsets from its centre, m): three
 /// along the long side, two across; placed cubes are square to the box (the wrist turns to
 /// yaw 0 on the way), so they fit side by side.
-const TOY_BOX_CELLS: [[f64; 2]; 6] = [
+pub(crate) const TOY_BOX_CELLS: [[f64; 2]; 6] = [
     [-0.042, -0.022],
     [0.0, -0.022],
     [0.042, -0.022],
@@ -38,13 +38,13 @@ const TOY_BOX_CELLS: [[f64; 2]; 6] = [
 ];
 /// Fruit drop spots along the hinge box's long side (y offsets, m): fruits are round with a
 /// flat base and do not roll aside when dropped onto each other.
-const HINGE_SPOTS: [f64; 3] = [-0.06, 0.0, 0.06];
+pub(crate) const HINGE_SPOTS: [f64; 3] = [-0.06, 0.0, 0.06];
 /// Cylinder drop spots in the bottom drawer (x offset, outward y offset from the drawer's
 /// centre, m). They are 5 cm or more apart, because a cylinder dropped onto another one tips
 /// over and, lying on its side, rolls on without stopping (Rapier has no rolling
 /// resistance); and 1.5 cm or more inside the walls, because a cylinder falling 19 cm that
 /// clips a wall's top edge is flung out of the drawer.
-const DRAWER_SPOTS: [[f64; 2]; 3] = [[-0.035, -0.005], [0.035, -0.005], [0.0, 0.035]];
+pub(crate) const DRAWER_SPOTS: [[f64; 2]; 3] = [[-0.035, -0.005], [0.035, -0.005], [0.0, 0.035]];
 /// Waypoints of the tool around the hinge axis when opening the lid (degrees from +x in
 /// the x–z plane; the closed lid points at 180°, the open one at 90°). A grasped lid follows
 /// the tool's angle about the axis, and the handle slips when the tool gets more than
@@ -52,10 +52,10 @@ const DRAWER_SPOTS: [[f64; 2]; 3] = [[-0.035, -0.005], [0.035, -0.005], [0.0, 0.
 /// the tool holding the handle a little above its centre it left the lid short of vertical or
 /// lost the handle. Short arcs keep the tool near the handle; the last one is 30° past
 /// vertical so the lid stops at its limit (q = 0.8).
-const LID_OPENING_ARC: [f64; 3] = [135.0, 90.0, 60.0];
+pub(crate) const LID_OPENING_ARC: [f64; 3] = [135.0, 90.0, 60.0];
 /// Waypoints when closing the lid (the last one is the authors' target, the body's −x top
 /// edge).
-const LID_CLOSING_ARC: [f64; 2] = [135.0, 180.0];
+pub(crate) const LID_CLOSING_ARC: [f64; 2] = [135.0, 180.0];
 /// Height above the release point at which a carried object is let go over a container.
 const DROP_CLEARANCE: f64 = 0.01;
 /// Height of the table top.

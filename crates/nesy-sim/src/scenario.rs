@@ -154,18 +154,6 @@ impl std::fmt::Display for Complexity {
     }
 }
 
-/// Schema mirror of [`Embodiment`].
-#[derive(JsonSchema)]
-#[serde(rename_all = "snake_case")]
-#[schemars(rename = "Embodiment")]
-#[allow(dead_code)]
-enum EmbodimentName {
-    /// Two-finger gripper.
-    Finger,
-    /// Suction tool.
-    Vacuum,
-}
-
 /// One source/target configuration (the authors' episode).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -177,10 +165,10 @@ pub struct EpisodeConfig {
     /// The deployment's subtasks: the same kinds and variants, other obstruction levels.
     pub target_subtasks: Vec<SubtaskConfig>,
     /// The demonstrating robot.
-    #[schemars(with = "EmbodimentName")]
+    #[schemars(with = "crate::scene::EmbodimentSchema")]
     pub source_embodiment: Embodiment,
     /// The deploying robot.
-    #[schemars(with = "EmbodimentName")]
+    #[schemars(with = "crate::scene::EmbodimentSchema")]
     pub target_embodiment: Embodiment,
     /// States name the end effector (`(FingerGripper)` / `(VacuumSuction)`): the authors'
     /// `ee_set`, on for `grip`, `vacu` and `comb`.

@@ -45,12 +45,14 @@ pub struct SceneSpec {
     pub goals: Vec<SubtaskGoal>,
 }
 
-/// Mirror of [`Embodiment`] for the schema: the robot's end effector.
+// Mirror of `Embodiment` for the JSON schemas of scenes, scenarios and demo manifests (the API
+// module, where `Embodiment` lives, does not depend on schemars); its doc is the schema's text.
+/// The robot's end effector.
 #[derive(JsonSchema)]
 #[serde(rename_all = "snake_case")]
 #[schemars(rename = "Embodiment")]
 #[allow(dead_code)]
-enum EmbodimentSchema {
+pub(crate) enum EmbodimentSchema {
     /// Franka hand with two prismatic fingers.
     Finger,
     /// Suction tool on link 7.

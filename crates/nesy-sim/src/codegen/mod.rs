@@ -210,24 +210,9 @@ pub fn schema_names() -> impl Iterator<Item = &'static str> {
     SCHEMAS.iter().map(|s| s.name)
 }
 
-/// Cells of the toy box (offsets from its centre, m), as the pick-and-place expert uses.
-const TOY_BOX_CELLS: [[f64; 2]; 6] = [
-    [-0.042, -0.022],
-    [0.0, -0.022],
-    [0.042, -0.022],
-    [-0.042, 0.022],
-    [0.0, 0.022],
-    [0.042, 0.022],
-];
-/// Fruit spots along the hinge box (y offsets, m).
-const HINGE_SPOTS: [f64; 3] = [-0.06, 0.0, 0.06];
-/// Cylinder spots in the bottom drawer (x offset, outward y offset, m).
-const DRAWER_SPOTS: [[f64; 2]; 3] = [[-0.035, -0.005], [0.035, -0.005], [0.0, 0.035]];
-/// Tool waypoints about the hinge axis (degrees from +x in the x–z plane) when opening and
-/// closing the lid, as the hinge expert swings it: a grasped lid follows the tool's angle,
-/// and short arcs keep the tool within the handle's 0.1 m grasp range.
-const LID_OPENING_ARC: [f64; 3] = [135.0, 90.0, 60.0];
-const LID_CLOSING_ARC: [f64; 2] = [135.0, 180.0];
+// Where objects go and how the lid swings: the scripted experts' constants, shared so the
+// compiled policies place objects exactly where the experts do.
+use crate::expert::{DRAWER_SPOTS, HINGE_SPOTS, LID_CLOSING_ARC, LID_OPENING_ARC, TOY_BOX_CELLS};
 
 /// One action recognised in a procedure.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]

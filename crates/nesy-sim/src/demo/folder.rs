@@ -57,7 +57,7 @@ pub struct Manifest {
     /// Object names in the scene.
     pub objects: Vec<String>,
     /// The demonstrating robot's end effector: `finger` or `vacuum`.
-    #[schemars(with = "EmbodimentName")]
+    #[schemars(with = "crate::scene::EmbodimentSchema")]
     pub embodiment: Embodiment,
     /// Benchmark scenario id, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -91,18 +91,6 @@ pub struct ManifestKeyframe {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(with = "Option<serde_json::Map<String, serde_json::Value>>")]
     pub action: Option<TraceEntry>,
-}
-
-/// Schema mirror of [`Embodiment`].
-#[derive(JsonSchema)]
-#[serde(rename_all = "snake_case")]
-#[schemars(rename = "Embodiment")]
-#[allow(dead_code)]
-enum EmbodimentName {
-    /// Two-finger gripper.
-    Finger,
-    /// Suction tool.
-    Vacuum,
 }
 
 /// JSON Schema of `manifest.json`.
