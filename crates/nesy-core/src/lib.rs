@@ -10,6 +10,7 @@
 
 pub mod adapt;
 pub mod atom;
+pub mod embodiment;
 pub mod exec;
 pub mod formula;
 mod indexed;
@@ -25,6 +26,7 @@ pub mod text;
 pub mod types;
 
 pub use atom::Atom;
+pub use embodiment::Embodiment;
 pub use exec::{
     ExecError, Report, UnmetPrecondition, Violation, apply, apply_in, verify_procedure, verify_procedure_in,
 };

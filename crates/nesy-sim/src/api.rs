@@ -8,31 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The robot's end effector.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Embodiment {
-    /// Franka hand with two prismatic fingers (9 DoF in all).
-    Finger,
-    /// Suction tool on link 7 (7 DoF in all).
-    Vacuum,
-}
-
-impl Embodiment {
-    /// Lower-case name as used in scene files and prompts: `finger` or `vacuum`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Embodiment::Finger => "finger",
-            Embodiment::Vacuum => "vacuum",
-        }
-    }
-}
-
-impl std::fmt::Display for Embodiment {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
+pub use nesy_core::Embodiment;
 
 /// A world-frame direction in the API's naming, which is inverted compared with ROS:
 /// left = −y, right = +y, front = +x, back = −x, up = +z, down = −z.

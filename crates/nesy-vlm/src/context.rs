@@ -7,10 +7,7 @@
 //! server and never part of a cassette key. [`VlmTask::from_task_context`] reads it back.
 //!
 //! nesy-vlm does not depend on nesy-sim: simulator values (the recorded API call of a demo
-//! transition) travel as JSON, and [`Embodiment`] mirrors nesy-sim's enum with the same
-//! serde names (`finger`, `vacuum`).
-
-use std::fmt;
+//! transition) travel as JSON; [`Embodiment`] is nesy-core's, shared with the simulator.
 
 use nesy_core::adapt::{InductionRequest, PatchRequest};
 use nesy_core::operator::Operator;
@@ -20,50 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::request::TaskContext;
 
-/// The robot's end effector (the same names as nesy-sim's `Embodiment`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Embodiment {
-    /// Two-finger gripper.
-    Finger,
-    /// Vacuum suction tool.
-    Vacuum,
-}
-
-impl Embodiment {
-    /// `finger` or `vacuum`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Embodiment::Finger => "finger",
-            Embodiment::Vacuum => "vacuum",
-        }
-    }
-
-    /// How prompts name it.
-    pub fn description(self) -> &'static str {
-        match self {
-            Embodiment::Finger => "two-finger gripper",
-            Embodiment::Vacuum => "vacuum suction tool",
-        }
-    }
-}
-
-impl fmt::Display for Embodiment {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-impl std::str::FromStr for Embodiment {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.to_ascii_lowercase().as_str() {
-            "finger" | "gripper" => Ok(Embodiment::Finger),
-            "vacuum" | "suction" => Ok(Embodiment::Vacuum),
-            other => Err(format!("unknown embodiment {other:?}; expected finger or vacuum")),
-        }
-    }
-}
+pub use nesy_core::Embodiment;
 
 /// Operator induction for one demonstrated transition.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]

@@ -24,18 +24,11 @@ fn scene_path(scene: &str) -> PathBuf {
     prompts_dir().join("examples/scenes").join(scene)
 }
 
-fn sim_embodiment(e: Embodiment) -> nesy_sim::Embodiment {
-    match e {
-        Embodiment::Finger => nesy_sim::Embodiment::Finger,
-        Embodiment::Vacuum => nesy_sim::Embodiment::Vacuum,
-    }
-}
-
 fn build(scene: &str, embodiment: Embodiment, in_state: bool) -> Sim {
     let path = scene_path(scene);
     let text = std::fs::read_to_string(&path).unwrap();
     let mut spec = SceneSpec::from_json_str(&text, &path.display().to_string()).unwrap();
-    spec.embodiment = sim_embodiment(embodiment);
+    spec.embodiment = embodiment;
     spec.embodiment_in_state = in_state;
     Sim::new(&spec).unwrap_or_else(|e| panic!("{scene}: {e}"))
 }
@@ -201,7 +194,7 @@ fn run_code_example(embodiment: Embodiment) {
 
         let spec = EpisodeSpec::Scene {
             path: scene_path(&example.scene),
-            embodiment: Some(sim_embodiment(embodiment)),
+            embodiment: Some(embodiment),
             render_every: 0,
         };
         let episode = SimEpisodes.build(&spec).unwrap();

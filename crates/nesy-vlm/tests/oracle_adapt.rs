@@ -16,7 +16,7 @@ use nesy_sim::scene::SceneSpec;
 use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
 use nesy_sim::{Embodiment, Sim, SimHook, TraceEntry, observe};
 use nesy_vlm::codegen::CodeGenerationRequest;
-use nesy_vlm::context::{CodeGenerationContext, Embodiment as VlmEmbodiment};
+use nesy_vlm::context::CodeGenerationContext;
 use nesy_vlm::oracle::{OracleNoise, OracleTransport, PolicyCompiler};
 use nesy_vlm::{BackendKind, KeyframeList, VlmClient, VlmConfig, VlmReasoner};
 
@@ -40,20 +40,9 @@ struct TemplateCompiler;
 
 impl PolicyCompiler for TemplateCompiler {
     fn compile(&self, request: &CodeGenerationContext) -> Result<String, String> {
-        let embodiment = match request.embodiment {
-            VlmEmbodiment::Finger => Embodiment::Finger,
-            VlmEmbodiment::Vacuum => Embodiment::Vacuum,
-        };
-        nesy_sim::codegen::compile_policy(&request.procedure, &request.objects, embodiment)
+        nesy_sim::codegen::compile_policy(&request.procedure, &request.objects, request.embodiment)
             .map(|p| p.code)
             .map_err(|e| e.to_string())
-    }
-}
-
-fn vlm(e: Embodiment) -> VlmEmbodiment {
-    match e {
-        Embodiment::Finger => VlmEmbodiment::Finger,
-        Embodiment::Vacuum => VlmEmbodiment::Vacuum,
     }
 }
 
@@ -150,7 +139,7 @@ async fn adapt_and_execute(case: &Case, noise: OracleNoise, budget: usize) -> Ru
     let mut reasoner = VlmReasoner::new(client)
         .unwrap()
         .with_keyframes(Arc::new(keyframes))
-        .with_embodiments(vlm(case.source), vlm(case.target));
+        .with_embodiments(case.source, case.target);
     let config = AdaptConfig {
         budget,
         ..AdaptConfig::default()
@@ -164,7 +153,7 @@ async fn adapt_and_execute(case: &Case, noise: OracleNoise, budget: usize) -> Ru
                 instruction: target_scene.instruction.clone(),
                 objects: target_objects.iter().map(|o| o.to_string()).collect(),
                 procedure: procedure.clone(),
-                embodiment: vlm(case.target),
+                embodiment: case.target,
                 extended: cross,
             })
             .await

@@ -13,7 +13,7 @@ use nesy_policy::{Limits, SubtaskStatus, run_in_process};
 use nesy_sim::goal::GoalMonitor;
 use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
 use nesy_sim::{Embodiment, Sim, SimHook, TraceEntry, observe};
-use nesy_vlm::context::{Embodiment as VlmEmbodiment, InductionContext};
+use nesy_vlm::context::InductionContext;
 use nesy_vlm::oracle::{WorldDomain, induce};
 
 #[derive(Default)]
@@ -74,10 +74,7 @@ fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodi
                 feedback: Vec::new(),
             },
             demo_call: Some(call.clone()),
-            embodiment: match embodiment {
-                Embodiment::Finger => VlmEmbodiment::Finger,
-                Embodiment::Vacuum => VlmEmbodiment::Vacuum,
-            },
+            embodiment,
         };
         procedure.push(induce(world, &ctx).unwrap().operator);
         prev = next.clone();

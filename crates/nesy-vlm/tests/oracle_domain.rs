@@ -11,7 +11,7 @@ use nesy_core::state::State;
 use nesy_core::symbol::Symbol;
 use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
 use nesy_sim::{Embodiment, Sim, SimHook, TraceEntry, observe};
-use nesy_vlm::context::{Embodiment as VlmEmbodiment, InductionContext};
+use nesy_vlm::context::InductionContext;
 use nesy_vlm::oracle::{WorldDomain, induce};
 
 #[derive(Default)]
@@ -95,10 +95,7 @@ fn every_expert_transition_matches_a_schema_and_verifies() {
                             feedback: Vec::new(),
                         },
                         demo_call: Some(call.clone()),
-                        embodiment: match embodiment {
-                            Embodiment::Finger => VlmEmbodiment::Finger,
-                            Embodiment::Vacuum => VlmEmbodiment::Vacuum,
-                        },
+                        embodiment,
                     };
                     let action = induce(world, &ctx)
                         .unwrap_or_else(|e| panic!("{embodiment} {kind} obst {obst} step {t} {call}: {e}"));

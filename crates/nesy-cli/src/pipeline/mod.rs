@@ -226,10 +226,7 @@ pub fn run(
     let reasoner = VlmReasoner::new(client)
         .context("loading nesy's prompts")?
         .with_keyframes(keyframes)
-        .with_embodiments(
-            to_vlm_embodiment(setting.source_embodiment),
-            to_vlm_embodiment(setting.target_embodiment),
-        );
+        .with_embodiments(setting.source_embodiment, setting.target_embodiment);
 
     // 2. Symbolic states.
     progress.stage("symbolic states");
@@ -381,14 +378,6 @@ pub fn run(
     progress.stage("writing the outputs");
     output::write_all(&run, &target, &options.out_dir)?;
     Ok(run)
-}
-
-/// nesy-sim's embodiment as nesy-vlm names it.
-pub fn to_vlm_embodiment(e: Embodiment) -> nesy_vlm::Embodiment {
-    match e {
-        Embodiment::Finger => nesy_vlm::Embodiment::Finger,
-        Embodiment::Vacuum => nesy_vlm::Embodiment::Vacuum,
-    }
 }
 
 /// Tier, embodiment atoms, factor, complexity and budget for a demo and a target.

@@ -13,8 +13,6 @@ use nesy_sim::scene::SceneSpec;
 use nesy_vlm::{CodeGenerationContext, CodeGenerationRequest, CodegenError, PolicyCompiler, VlmReasoner};
 use serde::Serialize;
 
-use super::to_vlm_embodiment;
-
 /// How code is synthesized (`--codegen`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -97,7 +95,7 @@ pub async fn synthesize(
                     instruction: request.instruction.clone(),
                     objects: request.objects.clone(),
                     procedure: request.procedure.clone(),
-                    embodiment: to_vlm_embodiment(request.target),
+                    embodiment: request.target,
                     extended: request.source != request.target,
                 })
                 .await;
@@ -151,11 +149,7 @@ pub struct TemplateCompiler;
 
 impl PolicyCompiler for TemplateCompiler {
     fn compile(&self, request: &CodeGenerationContext) -> Result<String, String> {
-        let embodiment = match request.embodiment {
-            nesy_vlm::Embodiment::Finger => Embodiment::Finger,
-            nesy_vlm::Embodiment::Vacuum => Embodiment::Vacuum,
-        };
-        compile_policy(&request.procedure, &request.objects, embodiment)
+        compile_policy(&request.procedure, &request.objects, request.embodiment)
             .map(|c| c.code)
             .map_err(|e| e.to_string())
     }
