@@ -286,8 +286,41 @@ pub(crate) fn count_image_refs(value: &Value) -> usize {
 /// The command line of this process, quoted for a POSIX shell, prefixed with the mode that
 /// records what is missing.
 pub(crate) fn rerecord_command() -> String {
-    let args: Vec<String> = std::env::args().map(|arg| shell_quote(&arg)).collect();
-    format!("NESY_CASSETTE_MODE=new_episodes {}", args.join(" "))
+    rerecord_command_for(std::env::args())
+}
+
+/// [`rerecord_command`] for a given command line.
+///
+/// A `--vlm replay:PATH` source only ever replays, so repeating it would miss again: it is
+/// dropped, which leaves the model configured in the environment, and the cassette moves to
+/// `NESY_CASSETTE` so that the missing calls are recorded into the same file.
+fn rerecord_command_for(args: impl IntoIterator<Item = String>) -> String {
+    let mut kept = Vec::new();
+    let mut cassette = None;
+    let mut args = args.into_iter().peekable();
+    while let Some(arg) = args.next() {
+        let replay_path = if arg == "--vlm" {
+            match args.peek().and_then(|next| next.strip_prefix("replay:")) {
+                Some(path) => {
+                    let path = path.to_string();
+                    args.next();
+                    Some(path)
+                }
+                None => None,
+            }
+        } else {
+            arg.strip_prefix("--vlm=replay:").map(str::to_string)
+        };
+        match replay_path {
+            Some(path) => cassette = Some(path),
+            None => kept.push(shell_quote(&arg)),
+        }
+    }
+    let prefix = match cassette {
+        Some(path) => format!("NESY_CASSETTE={} ", shell_quote(&path)),
+        None => String::new(),
+    };
+    format!("{prefix}NESY_CASSETTE_MODE=new_episodes {}", kept.join(" "))
 }
 
 fn shell_quote(arg: &str) -> String {
@@ -334,6 +367,23 @@ mod tests {
                 &json!({"m": [{"t": "a"}, {"t": "b"}], "x": {"y": 1, "z": 2}})
             ),
             2
+        );
+    }
+
+    #[test]
+    fn a_replay_source_becomes_the_cassette_to_record_into() {
+        let args = |line: &str| line.split(' ').map(str::to_string).collect::<Vec<_>>();
+        assert_eq!(
+            rerecord_command_for(args("nesy adapt --demo d --vlm replay:fixtures/c.json --execute")),
+            "NESY_CASSETTE=fixtures/c.json NESY_CASSETTE_MODE=new_episodes nesy adapt --demo d --execute"
+        );
+        assert_eq!(
+            rerecord_command_for(args("nesy adapt --vlm=replay:c.json")),
+            "NESY_CASSETTE=c.json NESY_CASSETTE_MODE=new_episodes nesy adapt"
+        );
+        assert_eq!(
+            rerecord_command_for(args("nesy adapt --vlm oracle")),
+            "NESY_CASSETTE_MODE=new_episodes nesy adapt --vlm oracle"
         );
     }
 
