@@ -25,6 +25,9 @@ pub type Args = SmallVec<[Symbol; 3]>;
 struct AtomData {
     pred: Symbol,
     args: Args,
+    /// The printed form, `(Pred a b)`, built once at interning: printing, and sorting by
+    /// text (every human-facing output), then never allocate or resolve symbols.
+    text: Box<str>,
 }
 
 type AtomKey = (Symbol, Args);
@@ -38,8 +41,8 @@ const SEGMENTS: usize = 27;
 type Segment = Box<[OnceLock<&'static AtomData>]>;
 static SLOTS: [OnceLock<Segment>; SEGMENTS] = [const { OnceLock::new() }; SEGMENTS];
 
-/// Segment and offset of an id.
-fn locate(id: u32) -> (usize, usize) {
+/// Segment and offset of an id in a table of segments of doubling size (`64 << k`).
+pub(crate) fn locate(id: u32) -> (usize, usize) {
     let n = u64::from(id) / 64 + 1;
     let k = 63 - n.leading_zeros() as usize;
     let start = 64 * ((1u64 << k) - 1);
@@ -58,9 +61,18 @@ fn intern(pred: Symbol, args: Args) -> u32 {
     let id = u32::try_from(table.len()).expect("more than 2^32 distinct atoms");
     // Leaked on purpose: the table lives for the whole process and hands out `'static`
     // references.
+    let mut text = String::with_capacity(32);
+    text.push('(');
+    text.push_str(key.0.as_str());
+    for a in &key.1 {
+        text.push(' ');
+        text.push_str(a.as_str());
+    }
+    text.push(')');
     let data: &'static AtomData = Box::leak(Box::new(AtomData {
         pred: key.0,
         args: key.1.clone(),
+        text: text.into_boxed_str(),
     }));
     let (k, offset) = locate(id);
     let segment = SLOTS[k].get_or_init(|| (0..(64usize << k)).map(|_| OnceLock::new()).collect());
@@ -119,6 +131,11 @@ impl Atom {
         self.data().args.contains(&object)
     }
 
+    /// The printed form, `(Pred a b)` (what `Display` writes), without allocating.
+    pub fn text(&self) -> &'static str {
+        &self.data().text
+    }
+
     /// The dense interned id (stable for the life of the process).
     pub fn id(&self) -> u32 {
         self.0
@@ -127,11 +144,7 @@ impl Atom {
 
 impl fmt::Display for Atom {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "({}", self.pred())?;
-        for a in self.args() {
-            write!(f, " {a}")?;
-        }
-        f.write_str(")")
+        f.write_str(self.text())
     }
 }
 

@@ -2,6 +2,9 @@
 //! verification, with violations that name every unmet precondition as written.
 
 use std::fmt;
+use std::sync::Arc;
+
+use rustc_hash::FxHashMap;
 
 use serde::{Deserialize, Serialize};
 
@@ -281,11 +284,54 @@ type GoalConjunct = (Formula, Ground, Cond);
 
 /// One compiled step: its display name, its operator (for violation reports) and its
 /// indexed form.
-#[derive(Debug, Clone)]
-struct CompiledStep {
+/// One operator grounded over a universe; shared between the compiled procedures that
+/// contain it (see [`GroundingCache`]).
+#[derive(Debug)]
+struct Grounded {
     source: Operator,
     name: String,
-    compiled: Result<(CompiledOperator, IndexedEffects, Vec<Cond>), GroundError>,
+    compiled: Result<CompiledOperator, GroundError>,
+}
+
+#[derive(Debug, Clone)]
+struct CompiledStep {
+    grounded: Arc<Grounded>,
+    /// The effects and preconditions over this procedure's fact indices, or why the
+    /// operator could not be grounded.
+    indexed: Result<(IndexedEffects, Vec<Cond>), GroundError>,
+}
+
+/// Grounded operators kept across verifications over one universe.
+///
+/// Grounding (expanding quantifiers over every object, interning atoms) is most of the cost
+/// of verifying a procedure, and the adaptation loop re-verifies procedures that differ from
+/// the previous version by one patch: with a cache, an unchanged action is grounded once.
+/// The cache is keyed by the whole operator (name, preconditions, effects, parameters), so a
+/// changed literal is a different entry; it empties itself when the universe changes (e.g. a
+/// patch mentions a new object), since quantifiers then range over other objects.
+#[derive(Debug, Default)]
+pub(crate) struct GroundingCache {
+    universe: Option<Universe>,
+    entries: FxHashMap<Operator, Arc<Grounded>>,
+}
+
+impl GroundingCache {
+    fn grounded(&mut self, universe: &Universe, op: &Operator) -> Arc<Grounded> {
+        if self.universe.as_ref() != Some(universe) {
+            self.universe = Some(universe.clone());
+            self.entries.clear();
+        }
+        if let Some(g) = self.entries.get(op) {
+            return g.clone();
+        }
+        let g = Arc::new(Grounded {
+            source: op.clone(),
+            name: op.display_name(),
+            compiled: op.compile(universe),
+        });
+        self.entries.insert(op.clone(), g.clone());
+        g
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -310,11 +356,22 @@ impl CompiledProcedure {
     /// Compiles `ops` and `goal` against `universe`. Steps that cannot be grounded are
     /// kept and reported as [`StepStatus::Invalid`] when reached.
     pub fn new(universe: &Universe, ops: &[Operator], goal: Option<&Formula>) -> Self {
+        Self::new_cached(universe, ops, goal, &mut GroundingCache::default())
+    }
+
+    /// [`CompiledProcedure::new`], taking already grounded operators from `cache`.
+    pub(crate) fn new_cached(
+        universe: &Universe,
+        ops: &[Operator],
+        goal: Option<&Formula>,
+        cache: &mut GroundingCache,
+    ) -> Self {
         let mut facts = Facts::new();
         let steps = ops
             .iter()
             .map(|op| {
-                let compiled = op.compile(universe).map(|c| {
+                let grounded = cache.grounded(universe, op);
+                let indexed = grounded.compiled.as_ref().map_err(Clone::clone).map(|c| {
                     let pre = c.pre.iter().map(|(_, g)| facts.cond(g)).collect();
                     let eff = IndexedEffects {
                         adds: c.effects.adds.iter().map(|a| facts.id(*a)).collect(),
@@ -326,13 +383,9 @@ impl CompiledProcedure {
                             .map(|e| (facts.cond(&e.condition), facts.id(e.atom), e.add))
                             .collect(),
                     };
-                    (c, eff, pre)
+                    (eff, pre)
                 });
-                CompiledStep {
-                    source: op.clone(),
-                    name: op.display_name(),
-                    compiled,
-                }
+                CompiledStep { grounded, indexed }
             })
             .collect();
         let goal = goal.map(|g| {
@@ -384,7 +437,7 @@ impl CompiledProcedure {
         let mut failing_state = None;
         let (mut adds, mut dels) = (Vec::new(), Vec::new());
         for (index, step) in self.steps.iter().enumerate() {
-            let action = step.name.clone();
+            let action = step.grounded.name.clone();
             if first_failure.is_some() {
                 steps.push(StepOutcome {
                     index,
@@ -393,9 +446,9 @@ impl CompiledProcedure {
                 });
                 continue;
             }
-            let status = match &step.compiled {
+            let status = match &step.indexed {
                 Err(error) => StepStatus::Invalid { error: error.clone() },
-                Ok((compiled, eff, pre)) => {
+                Ok((eff, pre)) => {
                     if pre.iter().all(|c| c.holds(&bits)) {
                         adds.clear();
                         dels.clear();
@@ -431,8 +484,11 @@ impl CompiledProcedure {
                         StepStatus::Applied { added, removed }
                     } else {
                         let state = self.state_of(&bits, &untouched);
-                        StepStatus::Failed {
-                            violation: compiled.violation(&state, &step.source),
+                        match &step.grounded.compiled {
+                            Ok(compiled) => StepStatus::Failed {
+                                violation: compiled.violation(&state, &step.grounded.source),
+                            },
+                            Err(error) => StepStatus::Invalid { error: error.clone() },
                         }
                     }
                 }

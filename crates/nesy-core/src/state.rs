@@ -73,7 +73,7 @@ impl State {
     /// Atoms sorted by their printed text, the order used in every human-facing output.
     pub fn sorted_by_text(&self) -> Vec<&Atom> {
         let mut v: Vec<&Atom> = self.atoms.iter().collect();
-        v.sort_by_cached_key(|a| a.to_string());
+        v.sort_unstable_by_key(|a| a.text());
         v
     }
 

@@ -4,15 +4,23 @@
 //! and hash as a `u32`, and resolve back to a `&'static str` without locking.
 
 use std::fmt;
-use std::sync::LazyLock;
+use std::sync::{LazyLock, OnceLock};
 
-use lasso::{Spur, ThreadedRodeo};
+use lasso::{Key, Spur, ThreadedRodeo};
 
 /// Fx hashing: names are short and trusted enough that SipHash's DoS resistance buys
 /// nothing here, while interning sits on every parser's hot path.
 type Interner = ThreadedRodeo<Spur, rustc_hash::FxBuildHasher>;
 
 static INTERNER: LazyLock<Interner> = LazyLock::new(|| ThreadedRodeo::with_hasher(rustc_hash::FxBuildHasher));
+
+/// Key index → resolved text, filled on first resolution. `ThreadedRodeo::resolve` looks the
+/// key up in a sharded, locked map; printing and sorting resolve names in hot loops, so the
+/// answer is kept in an append-only slot table (segments of doubling size, as for atoms)
+/// that is read without locking.
+const TEXT_SEGMENTS: usize = 27;
+type TextSegment = Box<[OnceLock<&'static str>]>;
+static TEXTS: [OnceLock<TextSegment>; TEXT_SEGMENTS] = [const { OnceLock::new() }; TEXT_SEGMENTS];
 
 /// An interned name.
 ///
@@ -37,7 +45,9 @@ impl Symbol {
         // The interner is a never-dropped static, so its strings live for the whole
         // process; `resolve` ties them to the borrow of the static, which is 'static.
         let rodeo: &'static Interner = &INTERNER;
-        rodeo.resolve(&self.0)
+        let (k, offset) = crate::atom::locate(self.0.into_usize() as u32);
+        let segment = TEXTS[k].get_or_init(|| (0..(64usize << k)).map(|_| OnceLock::new()).collect());
+        segment[offset].get_or_init(|| rodeo.resolve(&self.0))
     }
 }
 

@@ -4,7 +4,9 @@ use super::reasoner::{Feedback, PatchRequest, Problem, Reasoner, ViolationKind};
 use super::{
     AdaptConfig, AdaptError, Outcome, Target, Trace, TraceEvent, Verdict, ViolationInfo, WorldModel,
 };
-use crate::exec::{Report, UnmetPrecondition, format_unmet, implicit_universe, verify_procedure_in};
+use crate::exec::{
+    CompiledProcedure, GroundingCache, Report, UnmetPrecondition, format_unmet, implicit_universe,
+};
 use crate::formula::Formula;
 use crate::operator::Operator;
 use crate::patch::{AppliedPatch, apply_patch};
@@ -18,12 +20,13 @@ fn verify(
     target_objects: &[crate::symbol::Symbol],
     procedure: &[Operator],
     goal: &Formula,
+    cache: &mut GroundingCache,
 ) -> Report {
     let mut universe = implicit_universe(init, procedure, Some(goal));
     for o in target_objects {
         universe.add_thing(*o);
     }
-    verify_procedure_in(&universe, init, procedure, Some(goal))
+    CompiledProcedure::new_cached(&universe, procedure, Some(goal), cache).verify(init)
 }
 
 /// Eq. 6: the first inconsistency of a verified procedure — the first failing step's unmet
@@ -193,7 +196,10 @@ pub async fn explore<R: Reasoner>(
     let goal = &world_model.goal;
     let objects = &target.task.objects;
     let mut procedure = world_model.procedure.clone();
-    let mut report = verify(&target.init, objects, &procedure, goal);
+    // Every verification of this loop runs over the same initial state and goal, and
+    // successive procedures share most actions: each distinct action is grounded once.
+    let mut cache = GroundingCache::default();
+    let mut report = verify(&target.init, objects, &procedure, goal, &mut cache);
     let mut best = (progress(&report), procedure.clone());
     let mut feedback: Vec<Feedback> = Vec::new();
     let mut last_violation: Option<ViolationInfo> = None;
@@ -310,7 +316,7 @@ pub async fn explore<R: Reasoner>(
             }
             let applied = apply_patch(&procedure, &r.patches[0], near)
                 .map_err(|error| Problem::PatchDidNotApply { error })?;
-            let new_report = verify(&target.init, objects, &applied.procedure, goal);
+            let new_report = verify(&target.init, objects, &applied.procedure, goal, &mut cache);
             if ablation.verification {
                 if ablation.identification {
                     resolves(&visible, &applied, &new_report)?;
