@@ -90,9 +90,9 @@ pub fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     let run = pipeline::run(demo, target, setup, &options, progress.clone())?;
     progress.stage("");
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&run)?);
+        outln!("{}", serde_json::to_string_pretty(&run)?)?;
     } else {
-        print!("{}", summary(&run));
+        out!("{}", summary(&run))?;
     }
     if let Some(error @ pipeline::SynthError::Call { .. }) = &run.codegen_error {
         eprintln!("error: {error} (outputs written to {})", run.out_dir.display());

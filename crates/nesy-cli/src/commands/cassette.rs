@@ -74,24 +74,24 @@ pub fn run(args: CassetteArgs) -> anyhow::Result<ExitCode> {
             let outcome = tools::prune(&cassette, &report, orphan_blobs, dry_run)
                 .with_context(|| format!("pruning {}", cassette.display()))?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&outcome)?);
+                outln!("{}", serde_json::to_string_pretty(&outcome)?)?;
             } else {
                 let verb = if dry_run { "would drop" } else { "dropped" };
-                println!(
+                outln!(
                     "{}: kept {}, {verb} {} interaction(s)",
                     cassette.display(),
                     outcome.kept,
                     outcome.dropped.len()
-                );
+                )?;
                 for index in &outcome.dropped {
-                    println!("  {verb} #{index}");
+                    outln!("  {verb} #{index}")?;
                 }
                 for blob in &outcome.removed_blobs {
-                    println!(
+                    outln!(
                         "  {} blob {}",
                         if dry_run { "would remove" } else { "removed" },
                         blob.display()
-                    );
+                    )?;
                 }
             }
             Ok(ExitCode::SUCCESS)
@@ -109,18 +109,18 @@ pub fn run(args: CassetteArgs) -> anyhow::Result<ExitCode> {
                     .iter()
                     .map(|(path, problems)| serde_json::json!({"cassette": path, "problems": problems}))
                     .collect();
-                println!("{}", serde_json::to_string_pretty(&value)?);
+                outln!("{}", serde_json::to_string_pretty(&value)?)?;
             } else {
                 for (path, problems) in &all {
                     if problems.is_empty() {
-                        println!("{}: ok", path.display());
+                        outln!("{}: ok", path.display())?;
                     }
                     for problem in problems {
                         let at = problem
                             .interaction
                             .map(|i| format!(" interaction #{i}:"))
                             .unwrap_or_default();
-                        println!("{}:{at} {}", path.display(), problem.message);
+                        outln!("{}:{at} {}", path.display(), problem.message)?;
                     }
                 }
             }
@@ -136,11 +136,11 @@ pub fn run(args: CassetteArgs) -> anyhow::Result<ExitCode> {
 fn inspect(cassette: &std::path::Path, json: bool) -> anyhow::Result<ExitCode> {
     let listing = tools::inspect(cassette).with_context(|| format!("inspecting {}", cassette.display()))?;
     if json {
-        println!("{}", serde_json::to_string_pretty(&listing)?);
+        outln!("{}", serde_json::to_string_pretty(&listing)?)?;
         return Ok(ExitCode::SUCCESS);
     }
     let meta = &listing.meta;
-    println!(
+    outln!(
         "{}: schema {}, recorded by {} ({}), backend {}, created {}, updated {}",
         cassette.display(),
         listing.schema_version,
@@ -149,8 +149,8 @@ fn inspect(cassette: &std::path::Path, json: bool) -> anyhow::Result<ExitCode> {
         meta.backend.as_deref().unwrap_or("?"),
         meta.created_at,
         meta.updated_at
-    );
-    println!(
+    )?;
+    outln!(
         "{:>4}  {:<12}  {:<14}  {:<20}  {:>4}  {:>4}  {:>6}  {:<8}  {:>8}  {:>8}  {:>8}  {:>9}",
         "#",
         "key",
@@ -164,9 +164,9 @@ fn inspect(cassette: &std::path::Path, json: bool) -> anyhow::Result<ExitCode> {
         "output",
         "reason",
         "ms"
-    );
+    )?;
     for call in &listing.interactions {
-        println!(
+        outln!(
             "{:>4}  {:<12}  {:<14}  {:<20}  {:>4}  {:>4}  {:>6}  {:<8}  {:>8}  {:>8}  {:>8}  {:>9.1}",
             call.index,
             call.key,
@@ -180,14 +180,14 @@ fn inspect(cassette: &std::path::Path, json: bool) -> anyhow::Result<ExitCode> {
             call.completion_tokens,
             call.reasoning_tokens,
             call.latency_ms
-        );
+        )?;
     }
     let models: Vec<String> = listing
         .models
         .iter()
         .map(|(model, calls)| format!("{model} ×{calls}"))
         .collect();
-    println!(
+    outln!(
         "{} call(s); tokens: {} prompt, {} output ({} reasoning); {} distinct image(s); models: {}",
         listing.interactions.len(),
         listing.prompt_tokens,
@@ -195,7 +195,7 @@ fn inspect(cassette: &std::path::Path, json: bool) -> anyhow::Result<ExitCode> {
         listing.reasoning_tokens,
         listing.distinct_images,
         models.join(", ")
-    );
+    )?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -47,7 +47,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let written = write_views(&views, &args.out)
         .with_context(|| format!("writing images to {}", args.out.display()))?;
     for path in &written {
-        println!("{}", path.display());
+        outln!("{}", path.display())?;
     }
     eprintln!(
         "rendered 3 views at {}x{} in {:.1} ms on {threads} thread(s)",

@@ -66,9 +66,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     let result = run_policy(&worker, &source, &spec, &limits)
         .with_context(|| format!("running {} on {}", args.policy.display(), args.scene.display()))?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&result)?);
+        outln!("{}", serde_json::to_string_pretty(&result)?)?;
     } else {
-        print_summary(&result);
+        print_summary(&result)?;
     }
     Ok(if result.is_ok() {
         ExitCode::SUCCESS
@@ -77,53 +77,54 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     })
 }
 
-fn print_summary(result: &ExecutionResult) {
+fn print_summary(result: &ExecutionResult) -> std::io::Result<()> {
     if !result.stdout.text.is_empty() {
-        print!("{}", result.stdout.text);
+        out!("{}", result.stdout.text)?;
     }
     if !result.stderr.text.is_empty() {
         eprint!("{}", result.stderr.text);
     }
     let actions = result.trace.iter().filter(|e| e.call.is_action()).count();
     let refused = result.trace.iter().filter(|e| e.result.is_err()).count();
-    println!(
+    outln!(
         "outcome: {} ({} API calls, {actions} actions, {refused} refused, {:.2} s)",
         result.outcome.kind(),
         result.trace.len(),
         result.wall_time_s
-    );
+    )?;
     match &result.outcome {
         Outcome::Ok => {}
         Outcome::Rejected { violations } => {
             for v in violations {
-                println!("  {v}");
+                outln!("  {v}")?;
             }
         }
-        Outcome::PythonError(error) => println!("{}", error.traceback),
+        Outcome::PythonError(error) => outln!("{}", error.traceback)?,
         Outcome::SandboxViolation { event, detail, .. } => {
-            println!(
+            outln!(
                 "  refused: {event}{}",
                 detail.as_ref().map(|d| format!(" ({d})")).unwrap_or_default()
-            )
+            )?
         }
         Outcome::Timeout { limit, error } => {
-            println!("  limit: {limit:?}");
+            outln!("  limit: {limit:?}")?;
             if let Some(error) = error {
-                println!("{}", error.traceback);
+                outln!("{}", error.traceback)?;
             }
         }
-        Outcome::Memory { .. } => println!("  out of memory"),
-        Outcome::Killed { reason } => println!("  {reason}"),
+        Outcome::Memory { .. } => outln!("  out of memory")?,
+        Outcome::Killed { reason } => outln!("  {reason}")?,
     }
     match &result.subtasks {
         Some(subtasks) => {
             for s in subtasks {
-                println!("subtask {}: {:?}", s.subtask, s.status);
+                outln!("subtask {}: {:?}", s.subtask, s.status)?;
             }
         }
-        None => println!("subtasks: goal checks not available"),
+        None => outln!("subtasks: goal checks not available")?,
     }
     if let Some(state) = &result.final_state {
-        println!("final state:\n{state}");
+        outln!("final state:\n{state}")?;
     }
+    Ok(())
 }

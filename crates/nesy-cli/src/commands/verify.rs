@@ -123,35 +123,35 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<ExitCode> {
     };
 
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&verdict)?);
+        outln!("{}", serde_json::to_string_pretty(&verdict)?)?;
     } else if verdict.valid {
-        println!("Plan valid: {} step(s) executed, goal satisfied.", verdict.steps);
+        outln!("Plan valid: {} step(s) executed, goal satisfied.", verdict.steps)?;
     } else if let Some(i) = report.first_failure {
-        println!(
+        outln!(
             "Plan invalid: step {} {} (plan line {}) cannot be executed.",
             i + 1,
             ops[i].display_name(),
             steps[i].line
-        );
+        )?;
         match &report.steps[i].status {
             StepStatus::Failed { violation } => {
-                println!("Unmet preconditions:");
+                outln!("Unmet preconditions:")?;
                 for u in &violation.unmet {
-                    println!("{}", explain(u));
+                    outln!("{}", explain(u))?;
                 }
             }
-            StepStatus::Invalid { error } => println!("The step cannot be grounded: {error}"),
+            StepStatus::Invalid { error } => outln!("The step cannot be grounded: {error}")?,
             _ => {}
         }
-        println!("Goal: not checked (execution stopped at step {}).", i + 1);
+        outln!("Goal: not checked (execution stopped at step {}).", i + 1)?;
     } else if let Some(g) = &report.goal {
-        println!(
+        outln!(
             "Plan invalid: all {} step(s) executed, but the goal is not satisfied.",
             verdict.steps
-        );
-        println!("Unmet goal conditions:");
+        )?;
+        outln!("Unmet goal conditions:")?;
         for u in &g.unmet {
-            println!("{}", explain(u));
+            outln!("{}", explain(u))?;
         }
     } else if let Some(e) = &report.goal_error {
         return Err(anyhow!(
