@@ -361,8 +361,9 @@ pub fn mark(sim: &Sim, camera: &Camera, image: &Image) -> Image {
         let Some((x, y)) = basis.project(sim.part_aabb(i).centre(), image.width, image.height) else {
             continue;
         };
-        let x = x.clamp(24.0, w - 21.0) as i64;
-        let y = (y + 20.0).clamp(24.0, h - 21.0) as i64;
+        // `max` keeps the range valid on frames narrower than a label margin (--size 32).
+        let x = x.clamp(24.0, (w - 21.0).max(24.0)) as i64;
+        let y = (y + 20.0).clamp(24.0, (h - 21.0).max(24.0)) as i64;
         let width = label_width(&part.name);
         let boxed = |cy: i64| [x - width / 2 - 2, cy - 6, x + width / 2 + 2, cy + 6];
         let overlaps = |b: &[i64; 4]| {
