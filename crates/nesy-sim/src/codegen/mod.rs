@@ -18,6 +18,7 @@ use nesy_core::operator::Operator;
 use serde::{Deserialize, Serialize};
 
 use crate::api::Embodiment;
+use crate::api_impl::MAX_FINGER_DEPTH;
 
 /// What an action does, independent of the end effector.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -213,6 +214,32 @@ pub fn schema_names() -> impl Iterator<Item = &'static str> {
 // Where objects go and how the lid swings: the scripted experts' constants, shared so the
 // compiled policies place objects exactly where the experts do.
 use crate::expert::{DRAWER_SPOTS, HINGE_SPOTS, LID_CLOSING_ARC, LID_OPENING_ARC, TOY_BOX_CELLS};
+
+/// A Python helper the finger programs use to pick up round fruit: the wrist turn (rad) at
+/// which the open fingers point away from the nearest neighbour that stands above the
+/// fruit's bottom. At turn 0 the fingers open along y, so the turn is the direction to the
+/// neighbour. Fruits are yaw-free, but `move_gripper_to` turns the fingers to the fruit's
+/// own yaw; with fruits in a row 8 cm apart that lands a finger on the next fruit and knocks
+/// it away before its own pick.
+const CLEAR_ANGLE_HELPER: &str = r#"
+def clear_angle(name):
+    centre = get_obj_pos(name)
+    own = get_obj_bbox(name)
+    angle, nearest = 0.0, 1e9
+    for other in get_obj_names():
+        if other == name or other == "floor" or "gripper" in other:
+            continue
+        b = get_obj_bbox(other)
+        if b[1][2] < own[0][2] + 0.01:
+            continue
+        dx = min(max(centre[0], b[0][0]), b[1][0]) - centre[0]
+        dy = min(max(centre[1], b[0][1]), b[1][1]) - centre[1]
+        d = math.hypot(dx, dy)
+        if 1e-6 < d < nearest:
+            nearest = d
+            angle = math.atan2(dy, dx)
+    return angle
+"#;
 
 /// One action recognised in a procedure.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -455,6 +482,16 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
         embodiment
     );
     e.line("import math");
+    // The hinge task's fruits (what is carried over the hinge body) are round: the fingers
+    // take them at the turn that keeps clear of their neighbours.
+    let fruits: Vec<&str> = actions
+        .iter()
+        .filter(|a| a.motion == CarryOverHinge)
+        .filter_map(|a| a.args.first().map(String::as_str))
+        .collect();
+    if !vacuum && !fruits.is_empty() {
+        e.out.push_str(CLEAR_ANGLE_HELPER);
+    }
     for (i, a) in actions.iter().enumerate() {
         let _ = writeln!(e.out, "\n# {}. {}", i + 1, a.name);
         let arg = |k: usize| a.args.get(k).map(String::as_str).unwrap_or_default();
@@ -471,9 +508,18 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
                         .get(i + 1)
                         .is_some_and(|n| n.motion == Push && n.args.first().map(String::as_str) == Some(x));
                     let div = if pushes { "1.3" } else { "2" };
-                    e.line(&format!(
-                        "move_gripper_to({x:?}, depth=get_obj_size({x:?})[2] / {div})"
-                    ));
+                    if fruits.contains(&x) && !pushes {
+                        // `move_gripper_to`'s tool point (the top less the depth, capped as
+                        // the API caps it), with the fingers turned clear of the neighbours.
+                        e.line(&format!("fb = get_obj_bbox({x:?})"));
+                        e.line(&format!(
+                            "move_to_position([(fb[0][0] + fb[1][0]) / 2, (fb[0][1] + fb[1][1]) / 2, fb[1][2] - min(get_obj_size({x:?})[2] / 2, {MAX_FINGER_DEPTH})], angle=clear_angle({x:?}))"
+                        ));
+                    } else {
+                        e.line(&format!(
+                            "move_gripper_to({x:?}, depth=get_obj_size({x:?})[2] / {div})"
+                        ));
+                    }
                 }
             }
             Take => {
@@ -540,6 +586,18 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
             }
             Push => {
                 let (x, b) = (arg(0), arg(1));
+                // A push starts low around the piece. After a put-down the fingers are still
+                // open around it, but at the carry height and with the piece loose between
+                // them: from there the slide leaves it short of its box. Approach it again,
+                // as the expert does before every push.
+                let approached = i > 0
+                    && actions[i - 1].motion == MoveToObject
+                    && actions[i - 1].args.first().map(String::as_str) == Some(x);
+                if !vacuum && !approached {
+                    e.line(&format!(
+                        "move_gripper_to({x:?}, depth=get_obj_size({x:?})[2] / 1.3)"
+                    ));
+                }
                 e.line(&format!("piece_y = get_obj_pos({x:?})[1]"));
                 e.line(&format!("box_y = get_obj_pos({b:?})[1]"));
                 e.line(
@@ -657,6 +715,58 @@ mod tests {
         assert_eq!(a.motion, CarryOnto);
         assert!(resolve_action("GraspBlueCube", &o).is_none());
         assert!(resolve_action("OpenGripperToDropRedCube", &o).is_none());
+    }
+
+    fn ops(names: &[&str]) -> Vec<Operator> {
+        names
+            .iter()
+            .map(|n| Operator::new(*n, Vec::new(), Vec::new()))
+            .collect()
+    }
+
+    #[test]
+    fn fruits_are_taken_with_the_fingers_turned_clear_of_their_neighbours() {
+        let o: Vec<String> = ["floor", "apple", "red_cube", "hinge_body", "hinge_lid"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let procedure = ops(&[
+            "MoveToSurroundRedCube",
+            "GraspRedCube",
+            "PutDownRedCubeFloor",
+            "MoveToSurroundApple",
+            "GraspApple",
+            "CarryOverHingeBodyApple",
+            "DropIntoHingeBodyApple",
+        ]);
+        let finger = compile_policy(&procedure, &o, Embodiment::Finger).unwrap().code;
+        assert!(finger.contains("def clear_angle(name):"), "{finger}");
+        assert!(finger.contains("angle=clear_angle(\"apple\")"), "{finger}");
+        assert!(finger.contains("move_gripper_to(\"red_cube\""), "{finger}");
+        assert!(!finger.contains("move_gripper_to(\"apple\""), "{finger}");
+        let vacuum = compile_policy(&procedure, &o, Embodiment::Vacuum).unwrap().code;
+        assert!(!vacuum.contains("clear_angle"), "{vacuum}");
+    }
+
+    #[test]
+    fn a_push_right_after_a_put_down_approaches_the_piece_first() {
+        let o: Vec<String> = ["floor", "board", "white_rook", "left_chess_box"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let procedure = ops(&[
+            "MoveToSurroundWhiteRook",
+            "GraspWhiteRook",
+            "CarryOntoWhiteRookBoard",
+            "PutDownWhiteRookBoard",
+            "SweepIntoWhiteRookLeftChessBox",
+            "MoveToSurroundWhiteRook",
+            "SweepIntoWhiteRookLeftChessBox",
+        ]);
+        let code = compile_policy(&procedure, &o, Embodiment::Finger).unwrap().code;
+        let approach = "move_gripper_to(\"white_rook\", depth=get_obj_size(\"white_rook\")[2] / 1.3)";
+        // Once inserted after the put-down, once from the procedure's own approach.
+        assert_eq!(code.matches(approach).count(), 2, "{code}");
     }
 
     #[test]

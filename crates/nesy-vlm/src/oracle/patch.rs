@@ -207,7 +207,11 @@ fn score(
     let mut procedure = req_procedure[..patch.at].to_vec();
     procedure.extend(patch.replace.iter().cloned());
     procedure.extend(req_procedure[patch.at + removed..].iter().cloned());
-    let report: Report = verify_procedure(init, &procedure, None);
+    // A goal violation is resolved by reaching its unmet goal literals, so the check needs
+    // them as the goal (without one the report never says the goal holds).
+    let goal = (violation.kind == ViolationKind::Goal)
+        .then(|| Formula::And(violation.unmet.iter().map(|u| u.literal.clone()).collect()));
+    let report: Report = verify_procedure(init, &procedure, goal.as_ref());
     let applied = AppliedPatch {
         procedure: procedure.clone(),
         at: patch.at,
@@ -454,4 +458,71 @@ pub fn format_reply(patch: &ProposedPatch) -> String {
     }
     out.push_str(">>>>>>> REPLACE\n");
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use nesy_core::adapt::{PatchRequest, TaskContext};
+    use nesy_core::predicates::{Tier, Vocabulary};
+    use nesy_core::text::{parse_formula, parse_state_list};
+
+    use super::*;
+
+    /// A procedure that ends with every action applied but the goal `(Closed hinge_lid)`
+    /// unmet (the lid was left open) gets a plan appended that closes it, and the check
+    /// accepts it: the goal literals hold after the patched procedure.
+    #[test]
+    fn a_goal_violation_gets_an_appended_plan_that_reaches_the_goal() {
+        let world = WorldDomain::builtin().unwrap();
+        let init = parse_state_list(
+            "- (Open hinge_lid)\n- (GripperOpen)\n- (OnTopOf hinge_body floor)\n- (OnTopOf apple floor)",
+        )
+        .unwrap();
+        let names = ["apple", "hinge_body", "hinge_lid", "hinge_handle", "floor"];
+        let universe = world.universe(names);
+        let planning = Planning {
+            universe: universe.clone(),
+            schemas: world.schemas_for(Embodiment::Finger, &universe),
+            target: Embodiment::Finger,
+            config: &PlannerConfig::default(),
+        };
+        let (procedure, end) = planning
+            .plan(&init, &parse_formula("(InsideOf apple hinge_body)").unwrap())
+            .unwrap();
+        let goal = parse_formula("(Closed hinge_lid)").unwrap();
+        assert!(!holds(&end, &goal));
+        let request = PatchRequest {
+            iteration: 0,
+            task: TaskContext {
+                instruction: "Put the apple in the hinge box and close it.".into(),
+                objects: names.iter().map(|n| Symbol::new(n)).collect::<Vec<_>>(),
+                tier: Tier::Full,
+                vocabulary: Vocabulary::default(),
+            },
+            kind: ViolationKind::Goal,
+            executed: procedure.clone(),
+            procedure: procedure.clone(),
+            erroneous: None,
+            remaining: Vec::new(),
+            failing_step: None,
+            initial_state: init.clone(),
+            error_state: end,
+            unmet: vec![UnmetPrecondition {
+                literal: goal.clone(),
+                atoms: Vec::new(),
+            }],
+            feedback: Vec::new(),
+        };
+        let ctx = PatchContext {
+            request,
+            target_embodiment: Embodiment::Finger,
+        };
+        let patch = propose(world, &ctx, &PlannerConfig::default()).unwrap();
+        assert_eq!(patch.strategy, Strategy::Append);
+        let mut patched = procedure[..patch.at].to_vec();
+        patched.extend(patch.replace.iter().cloned());
+        let report = verify_procedure(&init, &patched, Some(&goal));
+        assert!(report.first_failure.is_none());
+        assert!(report.goal.is_some_and(|g| g.satisfied), "{patched:?}");
+    }
 }
