@@ -4,6 +4,8 @@
 //! nesy-core's symbolic work only. Prints, per run, the minimum over `--reps` repetitions
 //! (default 101) of each part (the least-disturbed repetition: on a shared 2-core machine
 //! the median includes waits for a core) and the median of the whole, as a markdown table.
+//! The last column is the part of the symbolic time spent parsing the model's replies (every
+//! recorded reply parsed once, as the loop does), measured separately the same way.
 //!
 //! `cargo run --release -p nesy-core --example adapt_time [-- --reps N] [--only SCENARIO]`
 
@@ -13,6 +15,7 @@ mod replay;
 use std::time::{Duration, Instant};
 
 use nesy_core::adapt;
+use nesy_core::text::{parse_induction_reply, parse_refinement_reply};
 
 fn median(mut v: Vec<Duration>) -> f64 {
     v.sort();
@@ -47,9 +50,9 @@ fn main() {
         }
     }
     println!(
-        "| run | transitions | proposals | outcome | world model ms (min) | adaptation ms (min) | symbolic ms (min) | symbolic ms (median) |"
+        "| run | transitions | proposals | outcome | world model ms (min) | adaptation ms (min) | symbolic ms (min) | symbolic ms (median) | of which reply parsing ms (min) |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|");
     let (mut all_wm, mut all_ad) = (Vec::new(), Vec::new());
     let runs = replay::load_all();
     for run in runs
@@ -75,11 +78,23 @@ fn main() {
             ad.push(elapsed - split);
             total.push(elapsed);
         }
+        let mut parsing = Vec::new();
+        for _ in 0..reps {
+            let started = Instant::now();
+            for reply in &run.induction_replies {
+                let _ = std::hint::black_box(parse_induction_reply(reply));
+            }
+            for reply in &run.patch_replies {
+                let _ = std::hint::black_box(parse_refinement_reply(reply));
+            }
+            parsing.push(started.elapsed());
+        }
+        let parsing = min(&parsing);
         let (wm, ad, total_min, total) = (min(&wm), min(&ad), min(&total), median(total));
         all_wm.push(wm);
         all_ad.push(ad);
         println!(
-            "| {} | {} | {} | {} | {wm:.3} | {ad:.3} | {total_min:.3} | {total:.3} |",
+            "| {} | {} | {} | {} | {wm:.3} | {ad:.3} | {total_min:.3} | {total:.3} | {parsing:.3} |",
             run.scenario,
             run.induction_replies.len(),
             run.patch_replies.len(),

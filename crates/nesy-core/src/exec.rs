@@ -9,7 +9,7 @@ use rustc_hash::FxHashMap;
 use serde::{Deserialize, Serialize};
 
 use crate::atom::Atom;
-use crate::formula::{AtomTruth, Formula, Ground, GroundError};
+use crate::formula::{AtomTruth, Bindings, Effect, Formula, Ground, GroundEffects, GroundError};
 use crate::indexed::{Bits, Cond, Facts, get, set};
 use crate::operator::{CompiledOperator, Operator};
 use crate::state::State;
@@ -309,10 +309,17 @@ struct CompiledStep {
 /// The cache is keyed by the whole operator (name, preconditions, effects, parameters), so a
 /// changed literal is a different entry; it empties itself when the universe changes (e.g. a
 /// patch mentions a new object), since quantifiers then range over other objects.
+///
+/// Ground operators (no parameters) are grounded conjunct by conjunct, and each distinct
+/// precondition conjunct and top-level effect is grounded once too: actions of one procedure
+/// share most of them (`(VacuumSuction)`, `(forall (?y - thing) (not (GripperHolding ?y)))`).
+/// The result is the same as [`Operator::compile`]'s.
 #[derive(Debug, Default)]
 pub(crate) struct GroundingCache {
     universe: Option<Universe>,
     entries: FxHashMap<Operator, Arc<Grounded>>,
+    conjuncts: FxHashMap<Formula, Ground>,
+    effects: FxHashMap<Effect, GroundEffects>,
 }
 
 impl GroundingCache {
@@ -320,17 +327,66 @@ impl GroundingCache {
         if self.universe.as_ref() != Some(universe) {
             self.universe = Some(universe.clone());
             self.entries.clear();
+            self.conjuncts.clear();
+            self.effects.clear();
         }
         if let Some(g) = self.entries.get(op) {
             return g.clone();
         }
+        let compiled = if op.params.is_empty() && op.args.is_empty() {
+            self.compile_ground(universe, op)
+        } else {
+            op.compile(universe)
+        };
         let g = Arc::new(Grounded {
             source: op.clone(),
             name: op.display_name(),
-            compiled: op.compile(universe),
+            compiled,
         });
         self.entries.insert(op.clone(), g.clone());
         g
+    }
+
+    /// [`Operator::compile`] for an operator without parameters, whose conjuncts and effects
+    /// then ground independently of the operator they belong to.
+    fn compile_ground(
+        &mut self,
+        universe: &Universe,
+        op: &Operator,
+    ) -> Result<CompiledOperator, GroundError> {
+        let mut pre = Vec::with_capacity(op.pre.len());
+        for (i, f) in op.pre.iter().enumerate() {
+            let g = match self.conjuncts.get(f) {
+                Some(g) => g.clone(),
+                None => {
+                    let g = f.ground(universe, &mut Bindings::new())?;
+                    self.conjuncts.insert(f.clone(), g.clone());
+                    g
+                }
+            };
+            if g != Ground::True {
+                pre.push((i, g));
+            }
+        }
+        let mut effects = GroundEffects::default();
+        for e in &op.eff {
+            if !self.effects.contains_key(e) {
+                let mut part = GroundEffects::default();
+                e.ground(universe, &mut Bindings::new(), None, &mut part)?;
+                self.effects.insert(e.clone(), part);
+            }
+            if let Some(part) = self.effects.get(e) {
+                effects.adds.extend_from_slice(&part.adds);
+                effects.dels.extend_from_slice(&part.dels);
+                effects.conditional.extend(part.conditional.iter().cloned());
+            }
+        }
+        effects.normalize();
+        Ok(CompiledOperator {
+            name: op.display_name(),
+            pre,
+            effects,
+        })
     }
 }
 

@@ -563,6 +563,15 @@ impl Ground {
     }
 
     fn and(parts: Vec<Ground>) -> Ground {
+        // The common case (a quantifier's instances, all atoms or negated atoms) is already
+        // simplified: keep the vector instead of copying it.
+        if parts.len() > 1
+            && parts
+                .iter()
+                .all(|p| matches!(p, Ground::Atom(_) | Ground::Not(_) | Ground::Or(_)))
+        {
+            return Ground::And(parts);
+        }
         let mut out = Vec::with_capacity(parts.len());
         for p in parts {
             match p {
@@ -580,6 +589,13 @@ impl Ground {
     }
 
     fn or(parts: Vec<Ground>) -> Ground {
+        if parts.len() > 1
+            && parts
+                .iter()
+                .all(|p| matches!(p, Ground::Atom(_) | Ground::Not(_) | Ground::And(_)))
+        {
+            return Ground::Or(parts);
+        }
         let mut out = Vec::with_capacity(parts.len());
         for p in parts {
             match p {

@@ -11,9 +11,12 @@
 //! anchor to insert at).
 
 use std::fmt;
+use std::hash::{Hash, Hasher};
 
+use rustc_hash::FxHasher;
 use serde::{Deserialize, Serialize};
 
+use crate::formula::{Effect, Formula};
 use crate::operator::{Operator, format_procedure};
 use crate::text::normalize_action_name;
 
@@ -97,6 +100,58 @@ impl ActionKey {
     }
 }
 
+/// [`ActionKey`]'s comparison without printing: the normalised name, and the preconditions
+/// and effects as sets of the formulas themselves. Printing is injective on formulas (the
+/// printed form parses back to the same formula, which `tests/roundtrip.rs` checks), so two
+/// formulas are equal exactly when their canonical printed forms are, and `MatchKey`s are
+/// equal exactly when the corresponding `ActionKey`s are. Matching a SEARCH block against a
+/// procedure compares every action; only the error message needs the printed forms.
+struct MatchKey<'a> {
+    name: String,
+    pre: Vec<(u64, &'a Formula)>,
+    eff: Vec<(u64, &'a Effect)>,
+}
+
+/// The items with their hashes, duplicates removed (a set).
+fn hashed_set<T: Hash + Eq>(items: &[T]) -> Vec<(u64, &T)> {
+    let mut out: Vec<(u64, &T)> = Vec::with_capacity(items.len());
+    for item in items {
+        let mut h = FxHasher::default();
+        item.hash(&mut h);
+        let h = h.finish();
+        if !out.iter().any(|(oh, o)| *oh == h && *o == item) {
+            out.push((h, item));
+        }
+    }
+    out
+}
+
+/// Set equality of two duplicate-free lists.
+fn same_set<T: Eq>(a: &[(u64, &T)], b: &[(u64, &T)]) -> bool {
+    a.len() == b.len() && a.iter().all(|(h, x)| b.iter().any(|(g, y)| g == h && y == x))
+}
+
+impl<'a> MatchKey<'a> {
+    fn of(op: &'a Operator) -> Self {
+        let name = if op.args.is_empty() {
+            normalize_action_name(&op.name).unwrap_or_else(|| op.name.clone())
+        } else {
+            op.display_name()
+        };
+        MatchKey {
+            name,
+            pre: hashed_set(&op.pre),
+            eff: hashed_set(&op.eff),
+        }
+    }
+}
+
+impl PartialEq for MatchKey<'_> {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name && same_set(&self.pre, &other.pre) && same_set(&self.eff, &other.eff)
+    }
+}
+
 fn join(items: &[&String]) -> String {
     items.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ")
 }
@@ -173,8 +228,8 @@ pub fn apply_patch(procedure: &[Operator], patch: &Patch, near: usize) -> Result
     if k == 0 {
         return Err(PatchError::EmptySearch);
     }
-    let search: Vec<ActionKey> = patch.search.iter().map(ActionKey::of).collect();
-    let keys: Vec<ActionKey> = procedure.iter().map(ActionKey::of).collect();
+    let search: Vec<MatchKey<'_>> = patch.search.iter().map(MatchKey::of).collect();
+    let keys: Vec<MatchKey<'_>> = procedure.iter().map(MatchKey::of).collect();
     if keys.len() < k {
         return Err(PatchError::NoMatch {
             search_len: k,
@@ -211,8 +266,8 @@ pub fn apply_patch(procedure: &[Operator], patch: &Patch, near: usize) -> Result
                     .collect(),
                 matching: (0..k).filter(|&j| keys[start + j] == search[j]).count(),
                 first_mismatch,
-                difference: search[first_mismatch]
-                    .difference(&keys[start + first_mismatch])
+                difference: ActionKey::of(&patch.search[first_mismatch])
+                    .difference(&ActionKey::of(&procedure[start + first_mismatch]))
                     .unwrap_or_else(|| "they differ".to_string()),
             }
         });

@@ -18,6 +18,7 @@
 //! enter a goal).
 
 use std::fmt;
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
@@ -280,15 +281,41 @@ pub enum VocabularyError {
 }
 
 /// The built-in predicates plus user-declared extras.
+///
+/// The list is shared (`Arc`) and copied on write: every model request carries the task's
+/// vocabulary, and cloning it must not copy every definition.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(from = "VocabularyRepr", into = "VocabularyRepr")]
 pub struct Vocabulary {
+    predicates: Arc<Vec<PredicateInfo>>,
+}
+
+/// The serialised form of a [`Vocabulary`] (unchanged by the sharing).
+#[derive(Serialize, Deserialize)]
+struct VocabularyRepr {
     predicates: Vec<PredicateInfo>,
+}
+
+impl From<VocabularyRepr> for Vocabulary {
+    fn from(repr: VocabularyRepr) -> Self {
+        Vocabulary {
+            predicates: Arc::new(repr.predicates),
+        }
+    }
+}
+
+impl From<Vocabulary> for VocabularyRepr {
+    fn from(v: Vocabulary) -> Self {
+        VocabularyRepr {
+            predicates: Arc::unwrap_or_clone(v.predicates),
+        }
+    }
 }
 
 impl Default for Vocabulary {
     fn default() -> Self {
         Vocabulary {
-            predicates: builtin_predicates(),
+            predicates: Arc::new(builtin_predicates()),
         }
     }
 }
@@ -317,7 +344,8 @@ impl Vocabulary {
             definition: definition.to_string(),
             tiers: Vec::new(),
         };
-        if let Some(existing) = self.predicates.iter_mut().find(|p| p.name == info.name) {
+        let predicates = Arc::make_mut(&mut self.predicates);
+        if let Some(existing) = predicates.iter_mut().find(|p| p.name == info.name) {
             if existing.arity != info.arity {
                 return Err(VocabularyError::ArityConflict {
                     name: name.to_string(),
@@ -331,7 +359,7 @@ impl Vocabulary {
             };
             return Ok(());
         }
-        self.predicates.push(info);
+        predicates.push(info);
         Ok(())
     }
 

@@ -73,7 +73,9 @@ impl State {
     /// Atoms sorted by their printed text, the order used in every human-facing output.
     pub fn sorted_by_text(&self) -> Vec<&Atom> {
         let mut v: Vec<&Atom> = self.atoms.iter().collect();
-        v.sort_unstable_by_key(|a| a.text());
+        // Texts are distinct (atoms are), so an unstable sort is deterministic; the key is
+        // looked up once per atom.
+        v.sort_by_cached_key(|a| a.text());
         v
     }
 

@@ -19,6 +19,14 @@ static INTERNER: LazyLock<Interner> = LazyLock::new(|| ThreadedRodeo::with_hashe
 /// answer is kept in an append-only slot table (segments of doubling size, as for atoms)
 /// that is read without locking.
 const TEXT_SEGMENTS: usize = 27;
+
+/// At most this many names are remembered per thread (the interner itself is unbounded).
+const RECENT_CAPACITY: usize = 1 << 16;
+
+thread_local! {
+    static RECENT: std::cell::RefCell<rustc_hash::FxHashMap<&'static str, Symbol>> =
+        std::cell::RefCell::new(rustc_hash::FxHashMap::default());
+}
 type TextSegment = Box<[OnceLock<&'static str>]>;
 static TEXTS: [OnceLock<TextSegment>; TEXT_SEGMENTS] = [const { OnceLock::new() }; TEXT_SEGMENTS];
 
@@ -32,7 +40,18 @@ pub struct Symbol(Spur);
 impl Symbol {
     /// Interns `name` (or finds it if it was interned before).
     pub fn new(name: &str) -> Self {
-        Symbol(INTERNER.get_or_intern(name))
+        // Parsers intern every name they read; a per-thread map in front of the shared
+        // interner answers repeated names without touching its locks.
+        RECENT.with_borrow_mut(|recent| {
+            if let Some(&sym) = recent.get(name) {
+                return sym;
+            }
+            let sym = Symbol(INTERNER.get_or_intern(name));
+            if recent.len() < RECENT_CAPACITY {
+                recent.insert(sym.as_str(), sym);
+            }
+            sym
+        })
     }
 
     /// Returns the symbol for `name` only if it has been interned already.

@@ -18,6 +18,15 @@ pub const ROOT_TYPE: &str = "thing";
 /// PDDL's name for the root type; accepted as an alias of [`ROOT_TYPE`].
 pub const PDDL_ROOT_TYPE: &str = "object";
 
+/// [`ROOT_TYPE`] and [`PDDL_ROOT_TYPE`] interned once: type checks run for every object a
+/// quantifier ranges over.
+static ROOT_SYMBOLS: std::sync::LazyLock<(Symbol, Symbol)> =
+    std::sync::LazyLock::new(|| (Symbol::new(ROOT_TYPE), Symbol::new(PDDL_ROOT_TYPE)));
+
+fn root_symbol() -> Symbol {
+    ROOT_SYMBOLS.0
+}
+
 /// Errors about types and objects.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error, Serialize, Deserialize)]
 pub enum TypeError {
@@ -72,8 +81,8 @@ impl TypeHierarchy {
 
     /// Canonical symbol of a type name: `object` means the root.
     pub fn canonical(name: Symbol) -> Symbol {
-        if name.as_str() == PDDL_ROOT_TYPE {
-            Symbol::new(ROOT_TYPE)
+        if name == ROOT_SYMBOLS.1 {
+            root_symbol()
         } else {
             name
         }
@@ -178,7 +187,7 @@ impl Universe {
     /// Adds an object of type `thing` unless it is already present (with any type).
     pub fn add_thing(&mut self, object: Symbol) {
         if self.type_of(object).is_none() {
-            self.objects.push((object, Symbol::new(ROOT_TYPE)));
+            self.objects.push((object, root_symbol()));
         }
     }
 

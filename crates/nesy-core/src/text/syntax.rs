@@ -57,8 +57,13 @@ impl<'d> Converter<'d> {
         }
     }
 
-    fn keyword(&self, e: &SExpr<'_>) -> Option<String> {
-        e.token().map(|t| t.to_ascii_lowercase())
+    /// The connective or quantifier a list head names (case-insensitive), in lower case;
+    /// `None` for anything else (a predicate name, a nested list). Allocation-free: every
+    /// formula node of a reply goes through here.
+    fn keyword(&self, e: &SExpr<'_>) -> Option<&'static str> {
+        const KEYWORDS: [&str; 8] = ["and", "or", "not", "imply", "forall", "exists", "when", "="];
+        let t = e.token()?;
+        KEYWORDS.into_iter().find(|k| t.eq_ignore_ascii_case(k))
     }
 
     fn term(&self, e: &SExpr<'_>, scope: &[Symbol]) -> Result<Term, ParseError> {
@@ -222,13 +227,13 @@ impl<'d> Converter<'d> {
             ));
         };
         let kw = self.keyword(head);
-        match kw.as_deref() {
+        match kw {
             Some("and") | Some("or") => {
                 let parts = rest
                     .iter()
                     .map(|x| self.formula(x, scope))
                     .collect::<Result<Vec<_>, _>>()?;
-                Ok(if kw.as_deref() == Some("and") {
+                Ok(if kw == Some("and") {
                     Formula::And(parts)
                 } else {
                     Formula::Or(parts)
@@ -253,17 +258,13 @@ impl<'d> Converter<'d> {
                     let body = self.formula(body, scope);
                     scope.truncate(depth);
                     let body = Box::new(body?);
-                    Ok(if kw.as_deref() == Some("forall") {
+                    Ok(if kw == Some("forall") {
                         Formula::Forall(vars, body)
                     } else {
                         Formula::Exists(vars, body)
                     })
                 }
-                _ => Err(self.arity_error(
-                    e,
-                    kw.as_deref().unwrap_or_default(),
-                    "a variable list and one formula",
-                )),
+                _ => Err(self.arity_error(e, kw.unwrap_or_default(), "a variable list and one formula")),
             },
             Some("=") => match rest {
                 [a, b] => Ok(Formula::Eq(self.term(a, scope)?, self.term(b, scope)?)),
@@ -291,7 +292,7 @@ impl<'d> Converter<'d> {
             ));
         };
         let kw = self.keyword(head);
-        match kw.as_deref() {
+        match kw {
             Some("and") => {
                 let mut out = Vec::new();
                 for x in rest {
@@ -305,7 +306,7 @@ impl<'d> Converter<'d> {
                     match inner.split_first() {
                         Some((h, args))
                             if !matches!(
-                                self.keyword(h).as_deref(),
+                                self.keyword(h),
                                 Some("and" | "or" | "not" | "forall" | "exists" | "when" | "imply" | "=")
                             ) =>
                         {
