@@ -280,13 +280,19 @@ pub fn run(
         .context("adaptation")?;
     let adapt_wall = adapt_started.elapsed();
     timing.vlm_s += timed.vlm_time().as_secs_f64();
-    timing.symbolic_s = adapt_wall.saturating_sub(timed.vlm_time()).as_secs_f64();
-    // Split at the first patch request: before it, world-model construction (and the first
-    // identification, which is negligible next to it); after it, the adaptation loop.
+    timing.symbolic_s = adapt_wall
+        .saturating_sub(timed.vlm_time())
+        .saturating_sub(timed.reporting_time())
+        .as_secs_f64();
+    // Split at the first patch request: before it, world-model construction and the first
+    // identification (the demonstrated procedure verified from the target state); after it,
+    // the adaptation loop. Progress reporting is neither.
     timing.symbolic_world_model_s = match timed.first_patch() {
-        Some((at, vlm_before)) => at
+        Some(first) => first
+            .at
             .saturating_duration_since(adapt_started)
-            .saturating_sub(vlm_before)
+            .saturating_sub(first.vlm_before)
+            .saturating_sub(first.reporting_before)
             .as_secs_f64(),
         None => timing.symbolic_s,
     };
@@ -324,7 +330,7 @@ pub fn run(
         let spent = synth_started.elapsed().as_secs_f64();
         match options.codegen {
             CodegenMode::Vlm => timing.vlm_s += spent,
-            CodegenMode::Template => timing.symbolic_s += spent,
+            CodegenMode::Template => timing.codegen_template_s += spent,
         }
     }
 

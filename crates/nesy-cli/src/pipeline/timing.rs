@@ -1,7 +1,9 @@
 //! Where a run's time goes, as in the paper's Table 9: VLM time (model calls, prompt
 //! rendering included), symbolic time (parsing, verification, patching: everything the
-//! adaptation loop does outside model calls), and simulation time (building, observing and
-//! rendering the target, and executing the policy).
+//! adaptation loop does outside model calls and progress reporting), and simulation time
+//! (building, observing and rendering the target, and executing the policy). The template
+//! compiler (`--codegen template`) is code synthesis without a model and is reported on its
+//! own, not as symbolic time.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -18,7 +20,8 @@ pub struct TimeBreakdown {
     pub load_s: f64,
     /// Model calls: state translation, induction, proposals, code generation.
     pub vlm_s: f64,
-    /// The adaptation loop outside model calls (and the template compiler).
+    /// The adaptation loop (`nesy_core::adapt::run`) outside model calls and progress
+    /// reporting: reply parsing, verification, identification, patching, trace recording.
     pub symbolic_s: f64,
     /// The part of `symbolic_s` spent building the world model (parsing and verifying the
     /// induced operators against the demonstration, Eq. 3).
@@ -28,7 +31,11 @@ pub struct TimeBreakdown {
     pub symbolic_adaptation_s: f64,
     /// The target scene (build, observe, render) and the policy's execution.
     pub sim_s: f64,
-    /// Wall time of `nesy_core::adapt::run` (VLM + symbolic parts of it).
+    /// The template compiler (`--codegen template`; 0 otherwise): code synthesis from the
+    /// verified procedure without a model.
+    pub codegen_template_s: f64,
+    /// Wall time of `nesy_core::adapt::run`: its VLM and symbolic parts plus progress
+    /// reporting.
     pub adapt_wall_s: f64,
     /// The whole run.
     pub total_s: f64,
@@ -39,11 +46,23 @@ pub struct TimeBreakdown {
 pub struct TimedReasoner<R> {
     inner: R,
     vlm: Duration,
+    reporting: Duration,
     progress: Arc<dyn Progress>,
     transitions: usize,
     budget: usize,
     calls: usize,
-    first_patch: Option<(Instant, Duration)>,
+    first_patch: Option<FirstPatch>,
+}
+
+/// When the first patch was requested, and the time spent outside symbolic work before it.
+#[derive(Debug, Clone, Copy)]
+pub struct FirstPatch {
+    /// When the request arrived.
+    pub at: Instant,
+    /// Model time before it.
+    pub vlm_before: Duration,
+    /// Progress-reporting time before it.
+    pub reporting_before: Duration,
 }
 
 impl<R: Reasoner> TimedReasoner<R> {
@@ -52,6 +71,7 @@ impl<R: Reasoner> TimedReasoner<R> {
         TimedReasoner {
             inner,
             vlm: Duration::ZERO,
+            reporting: Duration::ZERO,
             progress,
             transitions,
             budget,
@@ -65,9 +85,14 @@ impl<R: Reasoner> TimedReasoner<R> {
         self.vlm
     }
 
-    /// When the first patch was requested and the model time spent before it (the end of
-    /// world-model construction and the first identification), if any was requested.
-    pub fn first_patch(&self) -> Option<(Instant, Duration)> {
+    /// Time spent reporting progress (formatting and emitting the messages) so far.
+    pub fn reporting_time(&self) -> Duration {
+        self.reporting
+    }
+
+    /// When the first patch was requested (the end of world-model construction and the
+    /// first identification), if any was requested.
+    pub fn first_patch(&self) -> Option<FirstPatch> {
         self.first_patch
     }
 
@@ -84,12 +109,14 @@ impl<R: Reasoner> TimedReasoner<R> {
 
 impl<R: Reasoner + Send> Reasoner for TimedReasoner<R> {
     async fn induce_operator(&mut self, request: &InductionRequest) -> Result<String, ReasonerError> {
+        let reporting = Instant::now();
         self.progress.detail(&format!(
             "inducing operator {}/{} (attempt {})",
             request.step + 1,
             self.transitions,
             request.attempt + 1
         ));
+        self.reporting += reporting.elapsed();
         let started = Instant::now();
         let reply = self.inner.induce_operator(request).await;
         self.vlm += started.elapsed();
@@ -98,18 +125,24 @@ impl<R: Reasoner + Send> Reasoner for TimedReasoner<R> {
     }
 
     async fn propose_patch(&mut self, request: &PatchRequest) -> Result<String, ReasonerError> {
+        let reporting = Instant::now();
+        if self.first_patch.is_none() {
+            self.first_patch = Some(FirstPatch {
+                at: reporting,
+                vlm_before: self.vlm,
+                reporting_before: self.reporting,
+            });
+        }
         let what = match (&request.erroneous, request.failing_step) {
             (Some(op), Some(step)) => format!("step {} {}", step + 1, op.display_name()),
             _ => "goal".to_owned(),
         };
-        if self.first_patch.is_none() {
-            self.first_patch = Some((Instant::now(), self.vlm));
-        }
         self.progress.detail(&format!(
             "patch proposal {}/{} for {what}",
             request.iteration + 1,
             self.budget
         ));
+        self.reporting += reporting.elapsed();
         let started = Instant::now();
         let reply = self.inner.propose_patch(request).await;
         self.vlm += started.elapsed();
