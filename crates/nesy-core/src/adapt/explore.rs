@@ -211,6 +211,10 @@ pub async fn explore<R: Reasoner>(
     let mut revised = false;
     // Identification is recorded once per procedure version, not once per proposal.
     let mut identified = false;
+    // Incremented whenever a patch is accepted; with the violation, it says whether the last
+    // request can be reused.
+    let mut procedure_version = 0usize;
+    let mut cached_request: Option<(usize, PatchRequest)> = None;
     loop {
         if (ablation.identification || ablation.verification) && !identified {
             identified = true;
@@ -249,7 +253,17 @@ pub async fn explore<R: Reasoner>(
         if last_violation.as_ref().is_some_and(|v| *v != violation) {
             feedback.clear();
         }
-        let request = if ablation.identification {
+        // A rejected proposal leaves the procedure and the violation as they were: the next
+        // request differs only in its iteration and feedback, so the previous one is reused
+        // instead of copying the procedure again.
+        let reusable = cached_request
+            .take()
+            .filter(|(v, _)| *v == procedure_version && last_violation.as_ref() == Some(&violation));
+        let request = if let Some((_, mut request)) = reusable {
+            request.iteration = iteration;
+            request.feedback = feedback.clone();
+            request
+        } else if ablation.identification {
             let split = violation.failing_step.unwrap_or(procedure.len());
             PatchRequest {
                 iteration,
@@ -294,6 +308,7 @@ pub async fn explore<R: Reasoner>(
         };
         last_violation = Some(violation.clone());
         let reply = reasoner.propose_patch(&request).await?;
+        cached_request = Some((procedure_version, request));
         let this_iteration = iteration;
         iteration += 1;
 
@@ -342,6 +357,7 @@ pub async fn explore<R: Reasoner>(
                     procedure_after: Some(applied.procedure.clone()),
                 });
                 procedure = applied.procedure;
+                procedure_version += 1;
                 report = new_report;
                 revised = true;
                 identified = false;
