@@ -80,6 +80,32 @@ fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodi
         prev = next.clone();
     }
     let names: Vec<String> = objects.iter().map(|o| o.to_string()).collect();
+    // Named freely, every action is recognised by its effects as the same motion on the
+    // same objects as by its name. Two exceptions the effects cannot tell apart: an
+    // approach to a handle changes no relation, like a retreat (the grasp that follows
+    // approaches by itself); a carry whose put-down follows may not state the surface.
+    use nesy_sim::codegen::Motion;
+    for op in &procedure {
+        let by_name = nesy_sim::codegen::resolve_action(&op.name, &names).unwrap();
+        let by_effects = nesy_sim::codegen::resolve_by_effects(op, &names).unwrap_or_else(|| panic!("{op}"));
+        match (by_name.motion, by_effects.motion) {
+            (Motion::MoveToHandle, Motion::Retreat) => {}
+            (Motion::CarryOnto, Motion::CarryOnto) => assert_eq!(by_name.args[0], by_effects.args[0]),
+            _ => assert_eq!(
+                (
+                    by_effects.motion,
+                    &by_effects.args,
+                    by_effects.schema.ends_with("put-down")
+                ),
+                (
+                    by_name.motion,
+                    &by_name.args,
+                    by_name.schema.ends_with("put-down")
+                ),
+                "{op}"
+            ),
+        }
+    }
     let policy = nesy_sim::codegen::compile_policy(&procedure, &names, embodiment).unwrap();
     let mut episode = Sim::new(&scene).unwrap();
     GoalMonitor::attach(&mut episode).unwrap();

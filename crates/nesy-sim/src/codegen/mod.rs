@@ -6,10 +6,14 @@
 //! Actions are recognised by name: the CamelCase form of a schema name followed by the
 //! CamelCase forms of its arguments, e.g. `MoveToSurroundRedCube` is `move-to-surround`
 //! bound to `red_cube` and `CarryIntoBlueCubeToyBox` is `carry-into` bound to
-//! `(blue_cube, toy_box)` (the names the reference responder writes). A finger schema on the
+//! `(blue_cube, toy_box)` (the names the reference responder writes). An action whose name
+//! names no schema (a model naming its operators freely) is recognised by its effects and
+//! preconditions instead ([`resolve_by_effects`]). A finger schema on the
 //! vacuum robot, or the reverse, compiles to the same motion with the other end effector's
 //! calls (`close_gripper` ↔ `activate_vacuum`, ...). The placement rules (box cells, drop
 //! heights, drawer directions) are those of nesy-sim's scripted experts.
+
+mod effects;
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -257,9 +261,10 @@ pub struct ResolvedAction {
 /// Why a procedure could not be compiled.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error, Serialize, Deserialize)]
 pub enum CodegenError {
-    /// An action's name names no schema of the true domain with objects of the scene.
+    /// An action's name names no schema of the true domain with objects of the scene, and
+    /// its effects match none either.
     #[error(
-        "action {index} ({name}) names no schema of the nesy world domain with objects of this scene; expected a schema name followed by its arguments, e.g. MoveToSurroundRedCube"
+        "action {index} ({name}) names no schema of the nesy world domain with objects of this scene, and its effects match none; expected a schema name followed by its arguments (e.g. MoveToSurroundRedCube) or physical effects in nesy's predicates"
     )]
     UnknownAction {
         /// 1-based position in the procedure.
@@ -338,6 +343,19 @@ pub fn resolve_action(name: &str, objects: &[String]) -> Option<ResolvedAction> 
     })
 }
 
+/// Recognises an action by its effects and preconditions (see [`effects`]) when its name
+/// names no schema: how operators named freely by a model are compiled.
+pub fn resolve_by_effects(op: &Operator, objects: &[String]) -> Option<ResolvedAction> {
+    let (name, args) = effects::schema_by_effects(op, objects)?;
+    let schema = schema(name);
+    (schema.params.len() == args.len()).then(|| ResolvedAction {
+        name: op.name.clone(),
+        schema: name.to_owned(),
+        motion: schema.motion,
+        args,
+    })
+}
+
 fn schema(name: &str) -> &'static Schema {
     SCHEMAS
         .iter()
@@ -355,10 +373,12 @@ pub fn compile_policy(
         .iter()
         .enumerate()
         .map(|(i, op)| {
-            resolve_action(&op.name, objects).ok_or_else(|| CodegenError::UnknownAction {
-                index: i + 1,
-                name: op.name.clone(),
-            })
+            resolve_action(&op.name, objects)
+                .or_else(|| resolve_by_effects(op, objects))
+                .ok_or_else(|| CodegenError::UnknownAction {
+                    index: i + 1,
+                    name: op.name.clone(),
+                })
         })
         .collect::<Result<Vec<_>, _>>()?;
     let code = emit(&actions, embodiment);
@@ -767,6 +787,90 @@ mod tests {
         let approach = "move_gripper_to(\"white_rook\", depth=get_obj_size(\"white_rook\")[2] / 1.3)";
         // Once inserted after the put-down, once from the procedure's own approach.
         assert_eq!(code.matches(approach).count(), 2, "{code}");
+    }
+
+    #[test]
+    fn freely_named_operators_are_recognised_by_their_effects() {
+        use nesy_core::Atom;
+        use nesy_core::formula::{AtomPattern, Effect, Formula};
+        let lit = |p: &str, args: &[&str]| AtomPattern::ground(Atom::new(p, args));
+        let holds = |p: &str, args: &[&str]| Formula::Atom(lit(p, args));
+        let mut o = objects();
+        o.push("hinge_lid".into());
+        let procedure = vec![
+            Operator::new(
+                "ReachForTheRedBlock",
+                vec![holds("GripperOpen", &[])],
+                vec![Effect::Add(lit("GripperSurrounding", &["red_cube"]))],
+            ),
+            Operator::new(
+                "PinchIt",
+                vec![holds("GripperSurrounding", &["red_cube"])],
+                vec![
+                    Effect::Add(lit("GripperHolding", &["red_cube"])),
+                    Effect::Add(lit("GripperClosed", &[])),
+                    Effect::Del(lit("GripperOpen", &[])),
+                ],
+            ),
+            Operator::new(
+                "BringOverTheBin",
+                vec![holds("GripperHolding", &["red_cube"])],
+                vec![
+                    Effect::Del(lit("OnTopOf", &["red_cube", "floor"])),
+                    Effect::Add(lit("InsideOf", &["red_cube", "toy_box"])),
+                ],
+            ),
+            Operator::new(
+                "LetGo",
+                vec![
+                    holds("GripperHolding", &["red_cube"]),
+                    holds("InsideOf", &["red_cube", "toy_box"]),
+                ],
+                vec![
+                    Effect::Del(lit("GripperHolding", &["red_cube"])),
+                    Effect::Add(lit("GripperOpen", &[])),
+                ],
+            ),
+            Operator::new(
+                "PullTheLidUp",
+                vec![holds("GripperHolding", &["hinge_handle"])],
+                vec![
+                    Effect::Add(lit("Open", &["hinge_lid"])),
+                    Effect::Del(lit("Closed", &["hinge_lid"])),
+                ],
+            ),
+        ];
+        let policy = compile_policy(&procedure, &o, Embodiment::Finger).unwrap();
+        let schemas: Vec<&str> = policy.actions.iter().map(|a| a.schema.as_str()).collect();
+        assert_eq!(
+            schemas,
+            [
+                "move-to-surround",
+                "grasp",
+                "carry-into",
+                "release-into",
+                "open-hinge-lid"
+            ]
+        );
+        assert_eq!(policy.actions[2].args, ["red_cube", "toy_box"]);
+        assert!(
+            policy.code.contains("box = get_obj_bbox(\"toy_box\")"),
+            "{}",
+            policy.code
+        );
+        // Names that resolve keep the name route; an action without physical effects is
+        // still unknown.
+        let err = compile_policy(
+            &[Operator::new(
+                "Wave",
+                vec![],
+                vec![Effect::Add(lit("GripperOpen", &[]))],
+            )],
+            &o,
+            Embodiment::Finger,
+        )
+        .unwrap_err();
+        assert!(err.to_string().contains("action 1 (Wave)"), "{err}");
     }
 
     #[test]

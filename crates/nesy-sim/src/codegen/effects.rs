@@ -1,0 +1,214 @@
+//! Recognising an action by what it does when its name names no schema: a model free to
+//! name its operators (`PickUpTheApple`, `PlaceCubeInBin`) still states the physical
+//! effects and preconditions in nesy's predicates, and those identify the schema of the
+//! true domain the action performs (an action that adds `(InsideOf x toy_box)` while
+//! `(GripperHolding x)` holds carries `x` into the box; one that deletes
+//! `(GripperHolding x)` and adds `(OnTopOf x floor)` puts it down).
+//!
+//! Only the top-level literals with object arguments are read (quantified clearing
+//! effects say nothing about which schema it is). The finger schema is returned; the
+//! compiler turns it into the target end effector's calls either way.
+
+use nesy_core::formula::{Effect, Formula};
+use nesy_core::operator::Operator;
+
+use super::{Kind, kind_of};
+
+/// A ground literal: predicate and arguments.
+type Lit = (String, Vec<String>);
+
+fn lits(effects: &[Effect], want_add: bool) -> Vec<Lit> {
+    effects
+        .iter()
+        .filter_map(|e| match e {
+            Effect::Add(p) if want_add => p.as_atom(),
+            Effect::Del(p) if !want_add => p.as_atom(),
+            _ => None,
+        })
+        .map(|a| {
+            (
+                a.pred().as_str().to_owned(),
+                a.args().iter().map(|s| s.as_str().to_owned()).collect(),
+            )
+        })
+        .collect()
+}
+
+fn positive_pre(pre: &[Formula]) -> Vec<Lit> {
+    let mut out = Vec::new();
+    for f in pre {
+        match f {
+            Formula::Atom(p) => {
+                if let Some(a) = p.as_atom() {
+                    out.push((
+                        a.pred().as_str().to_owned(),
+                        a.args().iter().map(|s| s.as_str().to_owned()).collect(),
+                    ));
+                }
+            }
+            Formula::And(xs) => out.extend(positive_pre(xs)),
+            _ => {}
+        }
+    }
+    out
+}
+
+/// The handles, the part each one moves (the observer may name either) and the schemas'
+/// word for it.
+const HANDLES: [(&str, &str, &str); 3] = [
+    ("hinge_handle", "hinge_lid", "hinge"),
+    ("bottom_drawer_handle", "bottom_drawer", "bottom-drawer"),
+    ("top_drawer_handle", "top_drawer", "top-drawer"),
+];
+
+fn is_holding(pred: &str) -> bool {
+    pred == "GripperHolding" || pred == "VacuumAttached"
+}
+
+fn is_surrounding(pred: &str) -> bool {
+    pred == "GripperSurrounding" || pred == "VacuumAligned"
+}
+
+/// The schema name and arguments an operator performs, judged from its effects and
+/// preconditions; `None` if they match no schema (e.g. an action without physical effects).
+pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(&'static str, Vec<String>)> {
+    let adds = lits(&op.eff, true);
+    let dels = lits(&op.eff, false);
+    let pre = positive_pre(&op.pre);
+    let known = |o: &String| objects.contains(o);
+    let add1 = |pred: &dyn Fn(&str) -> bool| {
+        adds.iter()
+            .find(|(p, a)| pred(p) && a.len() == 1 && known(&a[0]))
+            .map(|(_, a)| a[0].clone())
+    };
+    let add2 = |name: &str| {
+        adds.iter()
+            .filter(|(p, a)| p == name && a.len() == 2 && a.iter().all(known))
+            .map(|(_, a)| (a[0].clone(), a[1].clone()))
+            .collect::<Vec<_>>()
+    };
+    // Articulations: a lid or a drawer opened or closed (a swing waypoint may only state
+    // that it is no longer closed, or no longer open).
+    let del1 = |name: &str| {
+        dels.iter()
+            .find(|(p, a)| p == name && a.len() == 1 && known(&a[0]))
+            .map(|(_, a)| a[0].clone())
+    };
+    let changes = [
+        (add1(&|p| p == "Open"), true),
+        (add1(&|p| p == "Closed"), false),
+        (del1("Closed"), true),
+        (del1("Open"), false),
+    ];
+    for (x, opened) in changes {
+        if let Some(x) = x {
+            let schema = match (x.as_str(), opened) {
+                ("hinge_lid", true) => "open-hinge-lid",
+                ("hinge_lid", false) => "close-hinge-lid",
+                ("bottom_drawer", true) => "open-bottom-drawer",
+                ("bottom_drawer", false) => "close-bottom-drawer",
+                ("top_drawer", true) => "open-top-drawer",
+                ("top_drawer", false) => "close-top-drawer",
+                _ => continue,
+            };
+            return Some((schema, Vec::new()));
+        }
+    }
+    // Handles: approached, grasped, let go.
+    for (handle, part, what) in HANDLES {
+        let on = |v: &[Lit], pred: fn(&str) -> bool| {
+            v.iter()
+                .any(|(p, a)| pred(p) && a.len() == 1 && (a[0] == handle || a[0] == part))
+        };
+        let schema = if on(&adds, is_holding) {
+            Some(format!("grasp-{what}-handle"))
+        } else if on(&dels, is_holding) {
+            Some(format!("release-{what}-handle"))
+        } else if on(&adds, is_surrounding) {
+            Some(format!("move-to-{what}-handle"))
+        } else {
+            None
+        };
+        if let Some(name) = schema {
+            return super::SCHEMAS
+                .iter()
+                .find(|s| s.name == name)
+                .map(|s| (s.name, Vec::new()));
+        }
+    }
+    let item = |o: &String| kind_of(o) == Some(Kind::Item);
+    // Letting go of a held item: where it comes to rest names the schema.
+    if let Some((_, a)) = dels
+        .iter()
+        .find(|(p, a)| is_holding(p) && a.len() == 1 && item(&a[0]))
+    {
+        let x = a[0].clone();
+        let rest = add2("InsideOf")
+            .into_iter()
+            .chain(add2("OnTopOf"))
+            .chain(
+                pre.iter()
+                    .filter(|(p, a)| (p == "InsideOf" || p == "OverOf") && a.len() == 2)
+                    .map(|(_, a)| (a[0].clone(), a[1].clone())),
+            )
+            .find(|(y, _)| *y == x)
+            .map(|(_, place)| place)?;
+        return match (rest.as_str(), kind_of(&rest)) {
+            ("hinge_body", _) => Some(("drop-into-hinge-body", vec![x])),
+            ("bottom_drawer", _) => Some(("drop-into-bottom-drawer", vec![x])),
+            (_, Some(Kind::Surface)) => Some(("put-down", vec![x, rest])),
+            (_, Some(Kind::Box)) => Some(("release-into", vec![x, rest])),
+            _ => None,
+        };
+    }
+    if let Some(x) = add1(&|p| is_holding(p)).filter(item) {
+        return Some(("grasp", vec![x]));
+    }
+    if let Some(x) = add1(&|p| is_surrounding(p)).filter(item) {
+        return Some(("move-to-surround", vec![x]));
+    }
+    let held = |x: &String| {
+        pre.iter()
+            .any(|(p, a)| is_holding(p) && a == std::slice::from_ref(x))
+    };
+    if let Some((x, place)) = add2("OverOf").into_iter().find(|(x, _)| item(x)) {
+        return match place.as_str() {
+            "hinge_body" => Some(("carry-over-hinge-body", vec![x])),
+            "bottom_drawer" => Some(("carry-over-bottom-drawer", vec![x])),
+            _ => None,
+        };
+    }
+    if let Some((x, b)) = add2("InsideOf")
+        .into_iter()
+        .find(|(x, b)| item(x) && kind_of(b) == Some(Kind::Box))
+    {
+        // Chess pieces reach their boxes by a push across the board; anything held is
+        // carried in.
+        return if b.ends_with("chess_box") || !held(&x) {
+            Some(("sweep-into", vec![x, b]))
+        } else {
+            Some(("carry-into", vec![x, b]))
+        };
+    }
+    if let Some((x, s)) = add2("OnTopOf")
+        .into_iter()
+        .find(|(x, s)| item(x) && kind_of(s) == Some(Kind::Surface) && held(x))
+    {
+        return Some(("carry-onto", vec![x, s]));
+    }
+    // A held item lifted off what it stood on or in, with nowhere new stated: a carry to
+    // the table (the put-down that follows names the surface it comes to rest on).
+    if let Some((_, a)) = dels.iter().find(|(p, a)| {
+        matches!(p.as_str(), "OnTopOf" | "InsideOf" | "OverOf") && a.len() == 2 && item(&a[0]) && held(&a[0])
+    }) && objects.iter().any(|o| o == "floor")
+    {
+        return Some(("carry-onto", vec![a[0].clone(), "floor".to_owned()]));
+    }
+    // Only quantified clearing effects, no relation of its own: the hand only moves (a
+    // retreat, or an approach to a handle, which the grasp that follows makes itself). An
+    // operator with no effects at all says nothing and stays unknown.
+    if adds.is_empty() && dels.is_empty() && !op.eff.is_empty() {
+        return Some(("retreat", Vec::new()));
+    }
+    None
+}
