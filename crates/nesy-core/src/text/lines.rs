@@ -52,6 +52,11 @@ pub(crate) fn strip_decoration(text: &str) -> (&str, usize) {
     loop {
         let before = rest.len();
         rest = rest.trim_start();
+        // Fast exit for the bulk of lines (formulas, names, prose): no marker starts with a
+        // parenthesis or a letter.
+        if no_marker_here(rest) {
+            break;
+        }
         let mut input = rest;
         let marker: ModalResult<()> = (|| {
             let digits = take_while(0.., |c: char| c.is_ascii_digit()).parse_next(&mut input)?;
@@ -72,10 +77,19 @@ pub(crate) fn strip_decoration(text: &str) -> (&str, usize) {
     (rest, text.len() - rest.len())
 }
 
+/// True if no decoration marker (digit, `-`, `*`, `•`, `+`, `#`, `>`, `_`) can start at the
+/// beginning of `text`.
+fn no_marker_here(text: &str) -> bool {
+    matches!(text.as_bytes().first(), None | Some(b'(' | b')' | b'a'..=b'z' | b'A'..=b'Z'))
+}
+
 /// Like [`strip_decoration`] but removes only one leading bullet (`-`, `*`, `•`, `+` or
 /// numbering) and the whitespace around it.
 pub(crate) fn strip_bullet(text: &str) -> &str {
     let t = text.trim_start();
+    if no_marker_here(t) {
+        return t;
+    }
     let mut input = t;
     let marker: ModalResult<()> = (|| {
         let digits = take_while(0.., |c: char| c.is_ascii_digit()).parse_next(&mut input)?;
