@@ -332,11 +332,12 @@ pub fn summary(run: &AdaptRun) -> String {
     let t = &run.timing;
     let _ = writeln!(
         out,
-        "  time      VLM {:.3} s, symbolic {:.2} ms (world model {:.2}, adaptation {:.2}), sim {:.2} s, total {:.2} s",
+        "  time      VLM {:.3} s, symbolic {:.2} ms (world model {:.2}, adaptation {:.2}), template compiler {:.2} ms, sim {:.2} s, total {:.2} s",
         t.vlm_s,
         t.symbolic_s * 1e3,
         t.symbolic_world_model_s * 1e3,
         t.symbolic_adaptation_s * 1e3,
+        t.codegen_template_s * 1e3,
         t.sim_s,
         t.total_s
     );

@@ -433,12 +433,18 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
     }
     let t = &run.timing;
     let _ = writeln!(md, "## Time\n");
-    let _ = writeln!(md, "| VLM | symbolic | simulation | total |\n|---|---|---|---|");
     let _ = writeln!(
         md,
-        "| {:.3} s | {:.3} ms | {:.3} s | {:.3} s |",
+        "| VLM | symbolic (world model + adaptation) | template compiler | simulation | total |\n|---|---|---|---|---|"
+    );
+    let _ = writeln!(
+        md,
+        "| {:.3} s | {:.3} ms ({:.3} + {:.3}) | {:.3} ms | {:.3} s | {:.3} s |",
         t.vlm_s,
         t.symbolic_s * 1e3,
+        t.symbolic_world_model_s * 1e3,
+        t.symbolic_adaptation_s * 1e3,
+        t.codegen_template_s * 1e3,
         t.sim_s,
         t.total_s
     );
