@@ -100,12 +100,10 @@ fn print_summary(result: &ExecutionResult) -> std::io::Result<()> {
             }
         }
         Outcome::PythonError(error) => outln!("{}", error.traceback)?,
-        Outcome::SandboxViolation { event, detail, .. } => {
-            outln!(
-                "  refused: {event}{}",
-                detail.as_ref().map(|d| format!(" ({d})")).unwrap_or_default()
-            )?
-        }
+        Outcome::SandboxViolation { event, detail, .. } => outln!(
+            "  refused: {event}{}",
+            detail.as_ref().map(|d| format!(" ({d})")).unwrap_or_default()
+        )?,
         Outcome::Timeout { limit, error } => {
             outln!("  limit: {limit:?}")?;
             if let Some(error) = error {
