@@ -5,9 +5,13 @@
 //! ```text
 //! cargo run -p nesy-sim --example expert_trace -- KIND OBST MULTI VARIANT finger|vacuum [SCENE_OUT.json]
 //! cargo run -p nesy-sim --example expert_trace -- --task TASK_CONFIG.json [SCENE_OUT.json]
+//! cargo run -p nesy-sim --example expert_trace -- --scene SCENE.json
 //! ```
 //!
-//! The second form takes any `TaskConfig` (e.g. a composite), as JSON.
+//! The second form takes any `TaskConfig` (e.g. a composite), as JSON; the third a
+//! `scene.json` with goals, e.g. from `nesy scenarios show ID --side source`. After each call
+//! the loose objects that moved more than 2 cm during it are listed, so an object knocked by
+//! the arm shows at the call that knocked it.
 
 use nesy_sim::goal::GoalMonitor;
 use nesy_sim::sim::SimHook;
@@ -17,6 +21,8 @@ use nesy_sim::{Embodiment, Sim, TraceEntry};
 /// Prints every action call with its result and the articulations' joint positions after it.
 struct PrintActions {
     articulations: Vec<String>,
+    /// Loose objects and where they were after the previous action.
+    tracked: Vec<(String, [f64; 3])>,
 }
 
 impl SimHook for PrintActions {
@@ -43,11 +49,27 @@ impl SimHook for PrintActions {
             tool.y,
             tool.z
         );
+        let held = sim.held_object().map(str::to_owned);
+        for (name, last) in &mut self.tracked {
+            let Some(aabb) = sim.object_aabb(name) else {
+                continue;
+            };
+            let now = aabb.centre();
+            let moved = (0..3).map(|i| (now[i] - last[i]).powi(2)).sum::<f64>().sqrt();
+            if moved > 0.02 && held.as_deref() != Some(name.as_str()) {
+                println!(
+                    "           {name} moved {moved:.3} m to ({:.3}, {:.3}, {:.3})",
+                    now[0], now[1], now[2]
+                );
+            }
+            *last = now;
+        }
     }
 }
 
 const USAGE: &str = "usage: expert_trace KIND OBST MULTI VARIANT finger|vacuum [SCENE_OUT.json] \
-                     | expert_trace --task TASK_CONFIG.json [SCENE_OUT.json]";
+                     | expert_trace --task TASK_CONFIG.json [SCENE_OUT.json] \
+                     | expert_trace --scene SCENE.json";
 
 /// The task of the first form's arguments.
 fn single_config(args: &[String]) -> Result<TaskConfig, Box<dyn std::error::Error>> {
@@ -79,26 +101,48 @@ fn single_config(args: &[String]) -> Result<TaskConfig, Box<dyn std::error::Erro
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    let scene = if args.first().map(String::as_str) == Some("--scene") {
+        let path = args.get(1).ok_or(USAGE)?;
+        nesy_sim::SceneSpec::from_file(std::path::Path::new(path))?
+    } else {
+        generated_scene(&args)?
+    };
+    trace(&scene)
+}
+
+/// The scene of the first two forms (written to SCENE_OUT.json when given).
+fn generated_scene(args: &[String]) -> Result<nesy_sim::SceneSpec, Box<dyn std::error::Error>> {
     let (config, scene_out) = if args.first().map(String::as_str) == Some("--task") {
         let path = args.get(1).ok_or(USAGE)?;
         let text = std::fs::read_to_string(path)?;
         let config: TaskConfig = serde_json::from_str(&text).map_err(|e| format!("{path}: {e}"))?;
         (config, args.get(2))
     } else {
-        (single_config(&args)?, args.get(5))
+        (single_config(args)?, args.get(5))
     };
     let task = config.generate()?;
     if let Some(path) = scene_out {
         std::fs::write(path, task.scene.to_json_pretty())?;
     }
-    let mut sim = Sim::new(&task.scene)?;
+    Ok(task.scene)
+}
+
+fn trace(scene: &nesy_sim::SceneSpec) -> Result<(), Box<dyn std::error::Error>> {
+    let mut sim = Sim::new(scene)?;
     let monitor = GoalMonitor::attach(&mut sim)?;
+    let tracked = scene
+        .goals
+        .iter()
+        .flat_map(|g| g.objects())
+        .filter_map(|name| Some((name.to_owned(), sim.object_aabb(name)?.centre())))
+        .collect();
     sim.add_hook(Box::new(PrintActions {
-        articulations: task.scene.articulations.keys().cloned().collect(),
+        articulations: scene.articulations.keys().cloned().collect(),
+        tracked,
     }));
-    let result = nesy_sim::expert::run(&mut sim, &task.scene.goals);
+    let result = nesy_sim::expert::run(&mut sim, &scene.goals);
     println!("\n{}", nesy_sim::observe(&sim));
-    for name in task.scene.goals.iter().flat_map(|g| g.objects()) {
+    for name in scene.goals.iter().flat_map(|g| g.objects()) {
         println!("{name}: {:?}", sim.object_aabb(name));
     }
     let outcome = monitor.finish(&mut sim);

@@ -197,6 +197,9 @@ impl Sim {
             clearance
         };
         let mut waypoints = Vec::new();
+        // The move from the lift point (or the start) to the approach point is the free
+        // transit the planner keeps clear of loose objects.
+        let mut transit = None;
         if clearance > 0.0 {
             if self.moved_since_reset {
                 waypoints.push(ToolGoal {
@@ -204,8 +207,17 @@ impl Sim {
                     rotation: current.rotation,
                 });
             }
+            transit = Some(waypoints.len());
+            let approach = self.clear_approach(
+                &ToolGoal {
+                    position: target,
+                    rotation,
+                },
+                dir,
+                clearance,
+            );
             waypoints.push(ToolGoal {
-                position: target - dir * clearance,
+                position: target - dir * approach,
                 rotation,
             });
         }
@@ -213,7 +225,7 @@ impl Sim {
             position: target,
             rotation,
         });
-        let plan = self.plan(&waypoints, pointing)?;
+        let plan = self.plan(&waypoints, pointing, transit)?;
         self.execute(&plan, SETTLE_STEPS);
         self.moved_since_reset = true;
         Ok(())
@@ -317,6 +329,7 @@ impl Sim {
                 rotation: current.rotation,
             }],
             dir,
+            None,
         )?;
         self.execute_at_least(&plan, SETTLE_STEPS, crate::motion::PARALLEL_MIN_DURATION);
         self.moved_since_reset = true;

@@ -3,10 +3,13 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
+use rapier3d::prelude::{ColliderHandle, Pose};
+
 use crate::api::{ApiError, Direction, Embodiment};
-use crate::geometry::array_to_na;
+use crate::geometry::{array_to_na, iso_to_pose};
 use crate::kinematics::{IkOptions, Iso, OrientationGoal, pointing_rotation};
-use crate::sim::{CONTROL_DT, Sim};
+use crate::objects::PartRole;
+use crate::sim::{CONTROL_DT, Sim, TABLE_TOP};
 
 /// The quadratic ease-in/out profile of spec §4: `2t²` below ½, `1 − 2(1 − t)²` above.
 pub fn ease(t: f64) -> f64 {
@@ -31,6 +34,26 @@ pub const PARALLEL_MIN_DURATION: f64 = 0.8;
 const SAMPLE_SPACING: f64 = 0.015;
 /// Control steps the world runs after a motion so objects come to rest.
 pub const SETTLE_STEPS: u32 = 20;
+/// Gap (m) a transit keeps between the arm (and what it carries) and every loose object.
+const TRANSIT_GAP: f32 = 0.01;
+/// Largest joint step (rad) between two configurations checked along a transit.
+const CHECK_SPACING: f64 = 0.03;
+/// Heights (m) above the tallest loose object at which a detour transit crosses the table.
+const DETOUR_HEIGHTS: [f64; 3] = [0.06, 0.12, 0.2];
+/// Highest tool position (m above the table) a detour uses; above it the arm runs out of reach.
+const DETOUR_CEILING: f64 = 0.55;
+
+/// Fractions of the lift clearance tried, longest first, for an approach point next to an
+/// object.
+const APPROACH_FRACTIONS: [f64; 4] = [1.0, 0.7, 0.45, 0.25];
+
+/// A loose object the arm must not touch on a transit: its colliders' shapes and world poses.
+struct Obstacle<'a> {
+    part: usize,
+    shapes: Vec<(&'a dyn rapier3d::prelude::Shape, Pose)>,
+    min: [f32; 3],
+    max: [f32; 3],
+}
 
 /// A tool pose to reach: position and orientation goal.
 #[derive(Clone, Copy, Debug)]
@@ -81,23 +104,23 @@ impl Sim {
     /// Each segment is a straight tool-space line sampled every 1.5 cm and solved by IK
     /// warm-started along the line; where that fails the segment falls back to straight
     /// joint interpolation between its verified endpoints.
+    ///
+    /// The segment ending at waypoint `transit` (if any) is a free move between two
+    /// clearance points. Its swept arm, fingers and carried object are checked against every
+    /// loose object; when they would touch one, the transit becomes a detour: straight up to
+    /// a height above the tallest loose object, across, and down to the waypoint (the lowest
+    /// of [`DETOUR_HEIGHTS`] that is clear). If no detour is clear either, the direct
+    /// segment is kept.
     pub(crate) fn plan(
         &self,
         waypoints: &[ToolGoal],
         pointing: Direction,
+        transit: Option<usize>,
     ) -> Result<Vec<Vec<Vec<f64>>>, ApiError> {
-        let full = IkOptions::default();
-        let quick = IkOptions {
-            restarts: 1,
-            iterations: 60,
-            pos_tol: 5e-4,
-            rot_tol: 5e-3,
-            ..IkOptions::default()
-        };
         // The final goal first, so an unreachable target is reported as such rather than
         // as one of the clearance waypoints in front of it.
         if let Some(last) = waypoints.last()
-            && self.ik(last, &self.q, &full).is_none()
+            && self.ik(last, &self.q, &IkOptions::default()).is_none()
         {
             return Err(ApiError::IkFailed {
                 target: [last.position.x, last.position.y, last.position.z],
@@ -107,47 +130,296 @@ impl Sim {
         let mut segments = Vec::new();
         let mut q_from = self.q.clone();
         let mut pose_from: Iso = self.tool_pose();
-        for wp in waypoints {
-            let start = pose_from.translation.vector;
-            let length = (wp.position - start).norm();
-            let n = (length / SAMPLE_SPACING).ceil() as usize;
-            let mut path = vec![q_from.clone()];
-            let mut ok = true;
-            let mut seed = q_from.clone();
-            for i in 1..n {
-                let s = i as f64 / n as f64;
-                let goal = ToolGoal {
-                    position: start + (wp.position - start) * s,
-                    rotation: pose_from.rotation.slerp(&wp.rotation, s),
-                };
-                match self.ik(&goal, &seed, &quick) {
-                    Some(q) if max_delta(&q, &seed) < 0.3 => {
-                        seed = q.clone();
-                        path.push(q);
-                    }
-                    _ => {
-                        ok = false;
-                        break;
-                    }
-                }
-            }
-            // The waypoint itself, seeded from the end of the line so the branch carries on.
-            let q_to = self
-                .ik(wp, &seed, &full)
-                .or_else(|| self.ik(wp, &q_from, &full))
-                .ok_or(ApiError::IkFailed {
-                    target: [wp.position.x, wp.position.y, wp.position.z],
-                    pointing_to: pointing,
-                })?;
-            if !ok || max_delta(&seed, &q_to) > 0.3 {
-                path = vec![q_from.clone()];
-            }
-            path.push(q_to.clone());
-            segments.push(path);
-            q_from = q_to;
+        for (i, wp) in waypoints.iter().enumerate() {
+            let direct = self.segment(&q_from, &pose_from, wp, pointing)?;
+            let route = if transit == Some(i) {
+                self.clear_transit(direct, &q_from, &pose_from, wp, pointing)
+            } else {
+                vec![direct]
+            };
+            q_from = route
+                .last()
+                .and_then(|p| p.last())
+                .cloned()
+                .unwrap_or_else(|| q_from.clone());
+            segments.extend(route);
             pose_from = Iso::from_parts(nalgebra::Translation3::from(wp.position), wp.rotation);
         }
         Ok(segments)
+    }
+
+    /// One straight tool segment from `(q_from, pose_from)` to `wp`, or joint interpolation
+    /// to an IK solution of `wp` where the line cannot be followed.
+    fn segment(
+        &self,
+        q_from: &[f64],
+        pose_from: &Iso,
+        wp: &ToolGoal,
+        pointing: Direction,
+    ) -> Result<Vec<Vec<f64>>, ApiError> {
+        let full = IkOptions::default();
+        let quick = IkOptions {
+            restarts: 1,
+            iterations: 60,
+            pos_tol: 5e-4,
+            rot_tol: 5e-3,
+            ..IkOptions::default()
+        };
+        let start = pose_from.translation.vector;
+        let length = (wp.position - start).norm();
+        let n = (length / SAMPLE_SPACING).ceil() as usize;
+        let mut path = vec![q_from.to_vec()];
+        let mut ok = true;
+        let mut seed = q_from.to_vec();
+        for i in 1..n {
+            let s = i as f64 / n as f64;
+            let goal = ToolGoal {
+                position: start + (wp.position - start) * s,
+                rotation: pose_from.rotation.slerp(&wp.rotation, s),
+            };
+            match self.ik(&goal, &seed, &quick) {
+                Some(q) if max_delta(&q, &seed) < 0.3 => {
+                    seed = q.clone();
+                    path.push(q);
+                }
+                _ => {
+                    ok = false;
+                    break;
+                }
+            }
+        }
+        // The waypoint itself, seeded from the end of the line so the branch carries on.
+        let q_to = self
+            .ik(wp, &seed, &full)
+            .or_else(|| self.ik(wp, q_from, &full))
+            .ok_or(ApiError::IkFailed {
+                target: [wp.position.x, wp.position.y, wp.position.z],
+                pointing_to: pointing,
+            })?;
+        if !ok || max_delta(&seed, &q_to) > 0.3 {
+            path = vec![q_from.to_vec()];
+        }
+        path.push(q_to);
+        Ok(path)
+    }
+
+    /// The direct transit if it is clear of loose objects, else the lowest clear detour over
+    /// them, else the direct one.
+    fn clear_transit(
+        &self,
+        direct: Vec<Vec<f64>>,
+        q_from: &[f64],
+        pose_from: &Iso,
+        wp: &ToolGoal,
+        pointing: Direction,
+    ) -> Vec<Vec<Vec<f64>>> {
+        // An object already touching the arm where the transit starts (a piece just pushed,
+        // say) cannot be avoided by the transit; the others can.
+        let obstacles: Vec<Obstacle<'_>> = self
+            .transit_obstacles()
+            .into_iter()
+            .filter(|o| self.configuration_is_clear(q_from, std::slice::from_ref(o)))
+            .collect();
+        if obstacles.is_empty() || self.path_is_clear(&direct, &obstacles) {
+            return vec![direct];
+        }
+        if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
+            eprintln!("transit to {:?} not clear; detouring", wp.position);
+        }
+        let tallest = obstacles
+            .iter()
+            .map(|o| o.max[2] as f64)
+            .fold(TABLE_TOP, f64::max);
+        // How far the carried object (or the fingertips) reach below the tool point.
+        let tool_z = pose_from.translation.vector.z;
+        let below = self
+            .held
+            .map(|h| tool_z - self.part_aabb(h.part).min[2])
+            .unwrap_or(0.0)
+            .max(0.03);
+        let start = pose_from.translation.vector;
+        for height in DETOUR_HEIGHTS {
+            let z = (tallest + height + below)
+                .max(start.z)
+                .max(wp.position.z)
+                .min(TABLE_TOP + DETOUR_CEILING);
+            let up = ToolGoal {
+                position: nalgebra::Vector3::new(start.x, start.y, z),
+                rotation: pose_from.rotation,
+            };
+            let across = ToolGoal {
+                position: nalgebra::Vector3::new(wp.position.x, wp.position.y, z),
+                rotation: wp.rotation,
+            };
+            let mut route = Vec::new();
+            let mut q = q_from.to_vec();
+            let mut pose = *pose_from;
+            let mut clear = true;
+            for goal in [up, across, *wp] {
+                let Ok(path) = self.segment(&q, &pose, &goal, pointing) else {
+                    if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
+                        eprintln!("  height {height}: no IK for {:?}", goal.position);
+                    }
+                    clear = false;
+                    break;
+                };
+                if !self.path_is_clear(&path, &obstacles) {
+                    if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
+                        eprintln!(
+                            "  height {height}: {:?} not clear ({} samples)",
+                            goal.position,
+                            path.len()
+                        );
+                    }
+                    clear = false;
+                    break;
+                }
+                q = path.last().cloned().unwrap_or(q);
+                pose = Iso::from_parts(nalgebra::Translation3::from(goal.position), goal.rotation);
+                route.push(path);
+            }
+            if clear {
+                return route;
+            }
+        }
+        if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
+            eprintln!("  no clear detour");
+        }
+        vec![direct]
+    }
+
+    /// The approach distance for a move to `goal` along `dir` (unit, the pointing): the
+    /// longest of `clearance` and its fractions in [`APPROACH_FRACTIONS`] at which the arm
+    /// reaches the approach point `goal − dir·c` without touching a loose object (the
+    /// objects touching the arm now are not counted). An object next to the target (a fruit
+    /// on a lid beside a drawer handle) can leave no room for the full distance. `clearance`
+    /// when none is clear.
+    pub(crate) fn clear_approach(&self, goal: &ToolGoal, dir: nalgebra::Vector3<f64>, clearance: f64) -> f64 {
+        let obstacles: Vec<Obstacle<'_>> = self
+            .transit_obstacles()
+            .into_iter()
+            .filter(|o| self.configuration_is_clear(&self.q, std::slice::from_ref(o)))
+            .collect();
+        if obstacles.is_empty() {
+            return clearance;
+        }
+        let quick = IkOptions::default();
+        for fraction in APPROACH_FRACTIONS {
+            let approach = ToolGoal {
+                position: goal.position - dir * clearance * fraction,
+                rotation: goal.rotation,
+            };
+            let q = self.ik(&approach, &self.q, &quick);
+            if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
+                let hits: Vec<&str> = obstacles
+                    .iter()
+                    .filter(|o| {
+                        q.as_ref()
+                            .is_some_and(|q| !self.configuration_is_clear(q, std::slice::from_ref(o)))
+                    })
+                    .map(|o| self.parts[o.part].name.as_str())
+                    .collect();
+                eprintln!("approach {fraction}: ik {} hits {hits:?}", q.is_some());
+            }
+            if let Some(q) = q
+                && self.configuration_is_clear(&q, &obstacles)
+            {
+                return clearance * fraction;
+            }
+        }
+        clearance
+    }
+
+    /// The loose objects that are not held, with their current shapes and boxes.
+    fn transit_obstacles(&self) -> Vec<Obstacle<'_>> {
+        let held = self.held.map(|h| h.part);
+        self.parts
+            .iter()
+            .enumerate()
+            .filter(|(i, p)| p.role == PartRole::Loose && Some(*i) != held)
+            .map(|(i, p)| {
+                let aabb = self.part_aabb(i);
+                Obstacle {
+                    part: i,
+                    shapes: self.collider_shapes(&p.colliders),
+                    min: aabb.min.map(|v| v as f32),
+                    max: aabb.max.map(|v| v as f32),
+                }
+            })
+            .collect()
+    }
+
+    fn collider_shapes(&self, colliders: &[ColliderHandle]) -> Vec<(&dyn rapier3d::prelude::Shape, Pose)> {
+        colliders
+            .iter()
+            .map(|&c| {
+                let collider = &self.world.colliders[c];
+                (collider.shape(), *collider.position())
+            })
+            .collect()
+    }
+
+    /// Whether the arm, fingers and carried object stay [`TRANSIT_GAP`] away from every
+    /// obstacle along the joint path (checked every [`CHECK_SPACING`] rad).
+    fn path_is_clear(&self, path: &[Vec<f64>], obstacles: &[Obstacle<'_>]) -> bool {
+        let mut previous: Option<&Vec<f64>> = None;
+        for q in path {
+            let steps = previous.map_or(1, |p| (max_delta(p, q) / CHECK_SPACING).ceil().max(1.0) as usize);
+            for k in 1..=steps {
+                let t = k as f64 / steps as f64;
+                let at: Vec<f64> = match previous {
+                    Some(p) => p.iter().zip(q).map(|(a, b)| a + (b - a) * t).collect(),
+                    None => q.clone(),
+                };
+                if !self.configuration_is_clear(&at, obstacles) {
+                    return false;
+                }
+            }
+            previous = Some(q);
+        }
+        true
+    }
+
+    fn configuration_is_clear(&self, q: &[f64], obstacles: &[Obstacle<'_>]) -> bool {
+        let poses = self.robot.model.link_poses(q, self.gripper);
+        let mut moving: Vec<(&dyn rapier3d::prelude::Shape, Pose)> = Vec::new();
+        for &(li, body) in &self.robot.bodies {
+            let link = iso_to_pose(&(self.base * poses[li]));
+            for &c in self.world.bodies[body].colliders() {
+                let collider = &self.world.colliders[c];
+                let local = collider.position_wrt_parent().copied().unwrap_or(Pose::IDENTITY);
+                moving.push((collider.shape(), link * local));
+            }
+        }
+        if let Some(held) = self.held {
+            let carrier = iso_to_pose(&(self.base * poses[self.robot.carrier_link]));
+            let body = &self.world.bodies[self.parts[held.part].body];
+            for &c in body.colliders() {
+                let collider = &self.world.colliders[c];
+                let local = collider.position_wrt_parent().copied().unwrap_or(Pose::IDENTITY);
+                moving.push((collider.shape(), carrier * held.relative * local));
+            }
+        }
+        for (shape, pose) in &moving {
+            let aabb = shape.compute_aabb(pose);
+            for obstacle in obstacles {
+                let apart = (0..3).any(|i| {
+                    aabb.mins[i] > obstacle.max[i] + TRANSIT_GAP
+                        || obstacle.min[i] > aabb.maxs[i] + TRANSIT_GAP
+                });
+                if apart {
+                    continue;
+                }
+                for (other, other_pose) in &obstacle.shapes {
+                    let near = rapier3d::parry::query::distance(pose, *shape, other_pose, *other)
+                        .map_or(true, |d| d.distance < TRANSIT_GAP);
+                    if near {
+                        return false;
+                    }
+                }
+            }
+        }
+        true
     }
 
     /// Plays planned segments back with eased timing, then settles.

@@ -56,10 +56,13 @@ pub enum ScenariosAction {
         /// Only scenarios whose id starts with this.
         #[arg(long)]
         only: Option<String>,
+        /// Only this side of each scenario (default: both).
+        #[arg(long, value_enum)]
+        side: Option<SideArg>,
         /// Worker threads (one simulator each).
         #[arg(long, default_value_t = 1)]
         threads: usize,
-        /// Also write every result as JSON lines here.
+        /// Also write every result as JSON lines here, one line as each scene finishes.
         #[arg(long)]
         report: Option<PathBuf>,
     },
@@ -137,9 +140,10 @@ pub fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
         ScenariosAction::Sweep {
             suite,
             only,
+            side,
             threads,
             report,
-        } => sweep(suite, only, threads, report),
+        } => sweep(suite, only, side.map(Side::from), threads, report),
     }
 }
 
@@ -160,6 +164,7 @@ struct SceneResult {
 fn sweep(
     suite: Option<PathBuf>,
     only: Option<String>,
+    side: Option<Side>,
     threads: usize,
     report: Option<PathBuf>,
 ) -> anyhow::Result<ExitCode> {
@@ -176,7 +181,15 @@ fn sweep(
     let jobs: Vec<(&Scenario, Side)> = selected
         .iter()
         .flat_map(|s| [(s, Side::Source), (s, Side::Target)])
+        .filter(|(_, sd)| side.is_none_or(|want| want == *sd))
         .collect();
+    // Lines go out as scenes finish, so a long sweep that is stopped keeps what it did.
+    let report_file = match &report {
+        Some(path) => Some(Mutex::new(
+            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?,
+        )),
+        None => None,
+    };
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<(usize, SceneResult)>> = Mutex::new(Vec::new());
     let started = Instant::now();
@@ -201,6 +214,14 @@ fn sweep(
                             .unwrap_or_default()
                     );
                     eprintln!("{line}");
+                    if let Some(file) = &report_file {
+                        use std::io::Write;
+                        let json = serde_json::to_string(&result).unwrap_or_default();
+                        let mut file = file.lock().unwrap_or_else(|e| e.into_inner());
+                        if let Err(e) = writeln!(file, "{json}") {
+                            eprintln!("warning: writing the report: {e}");
+                        }
+                    }
                     results
                         .lock()
                         .unwrap_or_else(|e| e.into_inner())
@@ -212,13 +233,6 @@ fn sweep(
     let mut results = results.into_inner().unwrap_or_else(|e| e.into_inner());
     results.sort_by_key(|(i, _)| *i);
     let wall = started.elapsed().as_secs_f64();
-    if let Some(path) = &report {
-        let text: String = results
-            .iter()
-            .map(|(_, r)| serde_json::to_string(r).unwrap_or_default() + "\n")
-            .collect();
-        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
-    }
     let ok = results.iter().filter(|(_, r)| r.full_success).count();
     println!(
         "expert full_success: {ok}/{} scenes ({:.1}%) in {wall:.1} s wall on {threads} thread(s)",
