@@ -63,8 +63,8 @@ pub fn run(args: RecordArgs) -> anyhow::Result<ExitCode> {
     let wall = started.elapsed().as_secs_f64();
     let keyframes = recording.demo.keyframes.len();
     let size = std::fs::metadata(&mcap).map(|m| m.len()).unwrap_or(0);
-    println!("{}", mcap.display());
-    println!("{}", target_path.display());
+    outln!("{}", mcap.display())?;
+    outln!("{}", target_path.display())?;
     eprintln!(
         "{} {side}: {keyframes} keyframes, {:.1} simulated s; {}; {:.2} s wall ({:.2} s simulating, {:.2} s rendering; {:.0} ms simulating per keyframe); {:.2} MB",
         scenario.id,

@@ -107,7 +107,7 @@ pub fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
             }
             let written = scenario::write_suite(&files, &out)?;
             for path in &written {
-                println!("{}", path.display());
+                outln!("{}", path.display())?;
             }
             eprintln!(
                 "{} files, {} configurations, {} scenarios ({} scenes generated) in {:.1} ms",
@@ -124,17 +124,17 @@ pub fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
             let all = scenario::scenarios(&files);
             if ids {
                 for s in &all {
-                    println!("{}", s.id);
+                    outln!("{}", s.id)?;
                 }
             } else {
-                print!("{}", CountTable::of(&all).render());
+                out!("{}", CountTable::of(&all).render())?;
             }
             Ok(ExitCode::SUCCESS)
         }
         ScenariosAction::Show { id, side, suite } => {
             let files = load_suite(suite.as_deref())?;
             let scenario = scenario::find(&files, &id)?;
-            println!("{}", scenario.generate(side.into())?.scene.to_json_pretty());
+            outln!("{}", scenario.generate(side.into())?.scene.to_json_pretty())?;
             Ok(ExitCode::SUCCESS)
         }
         ScenariosAction::Sweep {
@@ -234,21 +234,21 @@ fn sweep(
     results.sort_by_key(|(i, _)| *i);
     let wall = started.elapsed().as_secs_f64();
     let ok = results.iter().filter(|(_, r)| r.full_success).count();
-    println!(
+    outln!(
         "expert full_success: {ok}/{} scenes ({:.1}%) in {wall:.1} s wall on {threads} thread(s)",
         results.len(),
         100.0 * ok as f64 / results.len() as f64
-    );
+    )?;
     for side in ["source", "target"] {
         let of_side: Vec<_> = results.iter().filter(|(_, r)| r.side == side).collect();
         let ok = of_side.iter().filter(|(_, r)| r.full_success).count();
-        println!("  {side}: {ok}/{}", of_side.len());
+        outln!("  {side}: {ok}/{}", of_side.len())?;
     }
     let failures: Vec<_> = results.iter().filter(|(_, r)| !r.full_success).collect();
     if !failures.is_empty() {
-        println!("failures:");
+        outln!("failures:")?;
         for (_, r) in &failures {
-            println!(
+            outln!(
                 "  {} {} ({}): results {:?}{}",
                 r.scenario,
                 r.side,
@@ -258,7 +258,7 @@ fn sweep(
                     .as_deref()
                     .map(|e| format!("; expert: {e}"))
                     .unwrap_or_default()
-            );
+            )?;
         }
     }
     Ok(if failures.is_empty() {
