@@ -41,6 +41,15 @@ pub fn api_function(schema: &str, embodiment: Embodiment) -> Option<&'static str
     })
 }
 
+/// Whether a schema can stand for a recorded call: its own API function or, while the tool
+/// holds nothing, a `move_to_position` for the move-to schemas, since that call can place the
+/// open tool around an object too (the scripted experts take round fruit that way, with a
+/// turned wrist). While something is held, `move_to_position` carries it or swings the lid.
+fn schema_fits_call(schema: &str, embodiment: Embodiment, function: &str, tool_free: bool) -> bool {
+    let own = api_function(schema, embodiment);
+    own == Some(function) || tool_free && function == "move_to_position" && own == Some("move_gripper_to")
+}
+
 /// The recorded call, read from its JSON (a nesy-sim `ApiCall` or `TraceEntry`).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct RecordedCall {
@@ -135,6 +144,9 @@ fn focus_object(call: Option<&RecordedCall>, prev: &State, next: &State) -> Opti
     let around = ["GripperSurrounding", "VacuumAligned"];
     match call.map(|c| c.function.as_str()) {
         Some("close_gripper" | "activate_vacuum") => find(next, &holding),
+        // A move works on what it carries, if anything; what the open tool surrounded before
+        // it is left behind, and the object it moves to is found by the bindings.
+        Some("move_to_position") => find(prev, &holding),
         _ => find(prev, &holding).or_else(|| find(prev, &around)),
     }
 }
@@ -196,12 +208,16 @@ pub fn induce(world: &WorldDomain, ctx: &InductionContext) -> Result<InducedActi
     let universe = world.universe(names.iter().map(|s| s.as_str()));
     let call = ctx.demo_call.as_ref().and_then(RecordedCall::from_json);
     let call_object = call.as_ref().and_then(|c| c.object.clone());
+    let tool_free = !req
+        .previous
+        .iter()
+        .any(|a| matches!(a.pred().as_str(), "GripperHolding" | "VacuumAttached"));
     let schemas: Vec<Operator> = world
         .schemas_for(ctx.embodiment, &universe)
         .into_iter()
         .filter(|s| {
             call.as_ref()
-                .is_none_or(|c| api_function(&s.name, ctx.embodiment) == Some(c.function.as_str()))
+                .is_none_or(|c| schema_fits_call(&s.name, ctx.embodiment, &c.function, tool_free))
         })
         .filter(|s| match schema_handle(&s.name) {
             // Handle schemas need their handle in the scene, and the call's handle when it
