@@ -1,10 +1,12 @@
 //! The scripted experts on generated tasks, judged by the goal checks: every subtask at
 //! obstruction level 2 on both embodiments, and one all-four composite, must end in
 //! `full_success`. The many-config sweep is the ignored test at the end (and the
-//! `expert_sweep` example).
+//! `expert_sweep` example). The benchmark's target scenes are covered by one scenario per
+//! factor × complexity (episode 00, seed 0); `nesy scenarios sweep` runs all 880 scenes.
 
 use nesy_sim::Embodiment;
 use nesy_sim::expert::run_scene;
+use nesy_sim::scenario::{self, Side};
 use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
 
 fn single(
@@ -90,6 +92,41 @@ fn all_four_subtasks_at_high_complexity() {
 
 /// Every subtask × obstruction × multi level on both embodiments, two variants each (144
 /// tasks, a few minutes). Prints every failure before failing.
+/// The target scene of episode 00 (seed 0) of every complexity of `factor`.
+fn benchmark_targets(factor: &str) {
+    let files = scenario::generate_suite();
+    for complexity in ["low", "medium", "high"] {
+        let id = format!("{factor}_{complexity}_00_s0");
+        let scenario = scenario::find(&files, &id).unwrap();
+        assert_full_success(&scenario.task(Side::Target));
+    }
+}
+
+#[test]
+fn benchmark_targets_obst() {
+    benchmark_targets("obst");
+}
+
+#[test]
+fn benchmark_targets_affo() {
+    benchmark_targets("affo");
+}
+
+#[test]
+fn benchmark_targets_grip() {
+    benchmark_targets("grip");
+}
+
+#[test]
+fn benchmark_targets_vacu() {
+    benchmark_targets("vacu");
+}
+
+#[test]
+fn benchmark_targets_comb() {
+    benchmark_targets("comb");
+}
+
 #[test]
 #[ignore = "heavy: run with --ignored (or use the expert_sweep example)"]
 fn expert_sweep_over_generated_tasks() {
