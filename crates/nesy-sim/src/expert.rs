@@ -231,9 +231,22 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
     /// let go and tried again from the object's new position, up to [`PICK_ATTEMPTS`] times.
     fn pick(&mut self, name: &str) -> Result<f64, ExpertError> {
         let mut h = 0.0;
+        self.grasp_retrying(name, |expert| {
+            h = size(&expert.bbox(name)?)[2];
+            expert.move_to_object(name, h / 2.0)
+        })?;
+        Ok(h)
+    }
+
+    /// Runs `approach` and closes the tool on `name`; when the grasp did not take, lets go
+    /// and tries again, up to [`PICK_ATTEMPTS`] approaches in all.
+    fn grasp_retrying(
+        &mut self,
+        name: &str,
+        mut approach: impl FnMut(&mut Self) -> Result<(), ExpertError>,
+    ) -> Result<(), ExpertError> {
         for attempt in 1..=PICK_ATTEMPTS {
-            h = size(&self.bbox(name)?)[2];
-            self.move_to_object(name, h / 2.0)?;
+            approach(self)?;
             self.grasp()?;
             let held = self
                 .robot
@@ -244,7 +257,7 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
             }
             self.release()?;
         }
-        Ok(h)
+        Ok(())
     }
 
     /// Picks a round object (a fruit) with the finger hand turned so that its long side
@@ -287,24 +300,15 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
             return self.pick(name);
         }
         let h = size(&me)[2];
-        for attempt in 1..=PICK_ATTEMPTS {
-            let b = self.bbox(name)?;
+        self.grasp_retrying(name, |expert| {
+            let b = expert.bbox(name)?;
             let c = centre(&b);
-            self.move_to_turned(
+            expert.move_to_turned(
                 [c[0], c[1], b[1][2] - h / 2.0],
                 crate::api::DEFAULT_LIFT_CLEARANCE,
                 std::f64::consts::FRAC_PI_2,
-            )?;
-            self.grasp()?;
-            let held = self
-                .robot
-                .obj_in_gripper(name)
-                .map_err(|e| self.fail(format!("obj_in_gripper({name})"), e))?;
-            if held || attempt == PICK_ATTEMPTS {
-                break;
-            }
-            self.release()?;
-        }
+            )
+        })?;
         Ok(h)
     }
 
