@@ -51,17 +51,13 @@ fn singles(variants: u64) -> Vec<TaskConfig> {
             for obst_level in 0..3 {
                 for multi_level in 0..3 {
                     for variant in 0..variants {
-                        out.push(TaskConfig {
-                            subtasks: vec![SubtaskConfig {
-                                kind,
-                                variant,
-                                obst_level,
-                                multi_level,
-                            }],
-                            episode: variant,
+                        out.push(TaskConfig::single(
+                            kind,
+                            variant,
+                            obst_level,
+                            multi_level,
                             embodiment,
-                            embodiment_in_state: false,
-                        });
+                        ));
                     }
                 }
             }

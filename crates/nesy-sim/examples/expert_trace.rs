@@ -15,7 +15,7 @@
 
 use nesy_sim::goal::GoalMonitor;
 use nesy_sim::sim::SimHook;
-use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
+use nesy_sim::task::{SubtaskKind, TaskConfig};
 use nesy_sim::{Embodiment, Sim, TraceEntry};
 
 /// Prints every action call with its result and the articulations' joint positions after it.
@@ -86,17 +86,13 @@ fn single_config(args: &[String]) -> Result<TaskConfig, Box<dyn std::error::Erro
         other => return Err(format!("unknown embodiment {other:?}; {USAGE}").into()),
     };
     let variant: u64 = args[3].parse()?;
-    Ok(TaskConfig {
-        subtasks: vec![SubtaskConfig {
-            kind,
-            variant,
-            obst_level: args[1].parse()?,
-            multi_level: args[2].parse()?,
-        }],
-        episode: variant,
+    Ok(TaskConfig::single(
+        kind,
+        variant,
+        args[1].parse()?,
+        args[2].parse()?,
         embodiment,
-        embodiment_in_state: false,
-    })
+    ))
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -12,7 +12,7 @@ use nesy_sim::demo::{
     CameraImages, CameraName, Demo, DemoError, DemoMetadata, Keyframe, KeyframeViews, RecordOptions,
 };
 use nesy_sim::render::Image;
-use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
+use nesy_sim::task::{SubtaskKind, TaskConfig};
 use sha2::Digest;
 
 fn png(seed: u8) -> Vec<u8> {
@@ -286,17 +286,7 @@ fn bad_message_payloads_name_topic_keyframe_and_field() {
 }
 
 fn small_task(kind: SubtaskKind, obst: u8, embodiment: Embodiment) -> TaskConfig {
-    TaskConfig {
-        subtasks: vec![SubtaskConfig {
-            kind,
-            variant: 3,
-            obst_level: obst,
-            multi_level: 0,
-        }],
-        episode: 3,
-        embodiment,
-        embodiment_in_state: false,
-    }
+    TaskConfig::single(kind, 3, obst, 0, embodiment)
 }
 
 fn record_bytes(config: &TaskConfig) -> (Vec<u8>, nesy_sim::demo::Recording) {
@@ -419,15 +409,8 @@ print(json.dumps({"counts": counts, "pngs": pngs, "metadata": {m.name: m.metadat
 /// The committed fixture demos: name, source task, target task (see fixtures/demos/README.md).
 fn fixture_tasks() -> Vec<(&'static str, TaskConfig, TaskConfig)> {
     let one = |kind, variant, obst, embodiment, in_state| TaskConfig {
-        subtasks: vec![SubtaskConfig {
-            kind,
-            variant,
-            obst_level: obst,
-            multi_level: 0,
-        }],
-        episode: variant,
-        embodiment,
         embodiment_in_state: in_state,
+        ..TaskConfig::single(kind, variant, obst, 0, embodiment)
     };
     let files = nesy_sim::scenario::generate_suite();
     let composite = nesy_sim::scenario::find(&files, FIXTURE_COMPOSITE).unwrap();

@@ -9,26 +9,6 @@ use nesy_sim::expert::run_scene;
 use nesy_sim::scenario::{self, Side};
 use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
 
-fn single(
-    kind: SubtaskKind,
-    embodiment: Embodiment,
-    obst_level: u8,
-    multi_level: u8,
-    variant: u64,
-) -> TaskConfig {
-    TaskConfig {
-        subtasks: vec![SubtaskConfig {
-            kind,
-            variant,
-            obst_level,
-            multi_level,
-        }],
-        episode: variant,
-        embodiment,
-        embodiment_in_state: false,
-    }
-}
-
 #[track_caller]
 fn assert_full_success(config: &TaskConfig) {
     let task = config.generate().unwrap();
@@ -46,7 +26,7 @@ fn assert_full_success(config: &TaskConfig) {
 
 fn both_embodiments(kind: SubtaskKind) {
     for embodiment in [Embodiment::Finger, Embodiment::Vacuum] {
-        assert_full_success(&single(kind, embodiment, 2, 1, 1));
+        assert_full_success(&TaskConfig::single(kind, 1, 2, 1, embodiment));
     }
 }
 
@@ -137,7 +117,7 @@ fn expert_sweep_over_generated_tasks() {
             for obst in 0..3 {
                 for multi in 0..3 {
                     for variant in 0..2 {
-                        let config = single(kind, embodiment, obst, multi, variant);
+                        let config = TaskConfig::single(kind, variant, obst, multi, embodiment);
                         total += 1;
                         let task = config.generate().unwrap();
                         let episode = run_scene(&task.scene).unwrap();

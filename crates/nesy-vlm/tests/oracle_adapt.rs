@@ -13,7 +13,7 @@ use nesy_core::symbol::Symbol;
 use nesy_policy::{Limits, SubtaskStatus, run_in_process};
 use nesy_sim::goal::GoalMonitor;
 use nesy_sim::scene::SceneSpec;
-use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
+use nesy_sim::task::{SubtaskKind, TaskConfig};
 use nesy_sim::{Embodiment, Sim, SimHook, TraceEntry, observe};
 use nesy_vlm::codegen::CodeGenerationRequest;
 use nesy_vlm::context::CodeGenerationContext;
@@ -48,15 +48,8 @@ impl PolicyCompiler for TemplateCompiler {
 
 fn scene(kind: SubtaskKind, obst: u8, embodiment: Embodiment, in_state: bool) -> SceneSpec {
     TaskConfig {
-        subtasks: vec![SubtaskConfig {
-            kind,
-            variant: 1,
-            obst_level: obst,
-            multi_level: 0,
-        }],
-        episode: 1,
-        embodiment,
         embodiment_in_state: in_state,
+        ..TaskConfig::single(kind, 1, obst, 0, embodiment)
     }
     .generate()
     .unwrap()

@@ -11,7 +11,7 @@ use nesy_core::state::State;
 use nesy_core::symbol::Symbol;
 use nesy_policy::{Limits, SubtaskStatus, run_in_process};
 use nesy_sim::goal::GoalMonitor;
-use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
+use nesy_sim::task::{SubtaskKind, TaskConfig};
 use nesy_sim::{Embodiment, Sim, SimHook, TraceEntry, observe};
 use nesy_vlm::context::InductionContext;
 use nesy_vlm::oracle::{WorldDomain, induce};
@@ -31,20 +31,10 @@ impl SimHook for Keyframes {
 }
 
 fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodiment) {
-    let scene = TaskConfig {
-        subtasks: vec![SubtaskConfig {
-            kind,
-            variant: 2,
-            obst_level: obst,
-            multi_level: 1,
-        }],
-        episode: 2,
-        embodiment,
-        embodiment_in_state: false,
-    }
-    .generate()
-    .unwrap()
-    .scene;
+    let scene = TaskConfig::single(kind, 2, obst, 1, embodiment)
+        .generate()
+        .unwrap()
+        .scene;
     let mut sim = Sim::new(&scene).unwrap();
     let objects: Vec<Symbol> = nesy_sim::observer::snapshot(&sim)
         .objects

@@ -240,6 +240,29 @@ pub fn composite_offsets(kinds: &[SubtaskKind], episode: u64) -> Vec<[f64; 2]> {
 }
 
 impl TaskConfig {
+    /// One subtask alone, at the default offset, with the episode numbered by the variant
+    /// (as the experts' tests, sweeps and fixtures lay it out) and no embodiment atoms in the
+    /// states.
+    pub fn single(
+        kind: SubtaskKind,
+        variant: u64,
+        obst_level: u8,
+        multi_level: u8,
+        embodiment: Embodiment,
+    ) -> TaskConfig {
+        TaskConfig {
+            subtasks: vec![SubtaskConfig {
+                kind,
+                variant,
+                obst_level,
+                multi_level,
+            }],
+            episode: variant,
+            embodiment,
+            embodiment_in_state: false,
+        }
+    }
+
     /// Checks counts, levels and duplicates.
     pub fn validate(&self) -> Result<(), TaskError> {
         if self.subtasks.is_empty() || self.subtasks.len() > 4 {
