@@ -8,31 +8,19 @@ use std::sync::Arc;
 
 use nesy_core::adapt::{AdaptConfig, Demonstration, Outcome, Target, TaskContext, run};
 use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::state::State;
 use nesy_core::symbol::Symbol;
 use nesy_policy::{Limits, SubtaskStatus, run_in_process};
 use nesy_sim::goal::GoalMonitor;
 use nesy_sim::scene::SceneSpec;
 use nesy_sim::task::{SubtaskKind, TaskConfig};
-use nesy_sim::{Embodiment, Sim, SimHook, TraceEntry, observe};
+use nesy_sim::{Embodiment, Sim, observe};
 use nesy_vlm::codegen::CodeGenerationRequest;
 use nesy_vlm::context::CodeGenerationContext;
 use nesy_vlm::oracle::{OracleNoise, OracleTransport, PolicyCompiler};
 use nesy_vlm::{BackendKind, KeyframeList, VlmClient, VlmConfig, VlmReasoner};
 
-#[derive(Default)]
-struct Keyframes {
-    calls: Vec<(serde_json::Value, State)>,
-}
-
-impl SimHook for Keyframes {
-    fn on_call(&mut self, sim: &Sim, entry: &TraceEntry) {
-        if entry.call.is_action() && entry.result.is_ok() {
-            self.calls
-                .push((serde_json::to_value(&entry.call).unwrap(), observe(sim)));
-        }
-    }
-}
+mod oracle_common;
+use oracle_common::Keyframes;
 
 /// nesy-sim's template compiler as the oracle's code generator.
 #[derive(Debug)]

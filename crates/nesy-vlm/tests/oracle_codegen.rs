@@ -7,28 +7,16 @@
 use nesy_core::adapt::{InductionRequest, TaskContext};
 use nesy_core::operator::Operator;
 use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::state::State;
 use nesy_core::symbol::Symbol;
 use nesy_policy::{Limits, SubtaskStatus, run_in_process};
 use nesy_sim::goal::GoalMonitor;
 use nesy_sim::task::{SubtaskKind, TaskConfig};
-use nesy_sim::{Embodiment, Sim, SimHook, TraceEntry, observe};
+use nesy_sim::{Embodiment, Sim, observe};
 use nesy_vlm::context::InductionContext;
 use nesy_vlm::oracle::{WorldDomain, induce};
 
-#[derive(Default)]
-struct Keyframes {
-    calls: Vec<(serde_json::Value, State)>,
-}
-
-impl SimHook for Keyframes {
-    fn on_call(&mut self, sim: &Sim, entry: &TraceEntry) {
-        if entry.call.is_action() && entry.result.is_ok() {
-            self.calls
-                .push((serde_json::to_value(&entry.call).unwrap(), observe(sim)));
-        }
-    }
-}
+mod oracle_common;
+use oracle_common::Keyframes;
 
 fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodiment) {
     let scene = TaskConfig::single(kind, 2, obst, 1, embodiment)

@@ -10,23 +10,12 @@ use nesy_core::predicates::{Tier, Vocabulary};
 use nesy_core::state::State;
 use nesy_core::symbol::Symbol;
 use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
-use nesy_sim::{Embodiment, Sim, SimHook, TraceEntry, observe};
+use nesy_sim::{Embodiment, Sim, observe};
 use nesy_vlm::context::InductionContext;
 use nesy_vlm::oracle::{WorldDomain, induce};
 
-#[derive(Default)]
-struct Keyframes {
-    calls: Vec<(serde_json::Value, State)>,
-}
-
-impl SimHook for Keyframes {
-    fn on_call(&mut self, sim: &Sim, entry: &TraceEntry) {
-        if entry.call.is_action() && entry.result.is_ok() {
-            self.calls
-                .push((serde_json::to_value(&entry.call).unwrap(), observe(sim)));
-        }
-    }
-}
+mod oracle_common;
+use oracle_common::Keyframes;
 
 struct Transitions {
     objects: Vec<Symbol>,
