@@ -12,6 +12,12 @@
 //! [`GoalMonitor`] runs a checker as a [`SimHook`]; [`GoalMonitor::finish`] runs spec §7's
 //! post-run settle (100 steps; if anything is still undecided, the final call and 100 more)
 //! and returns an [`EpisodeOutcome`].
+//!
+//! The latch is the authors' metric (spec §10.9) and SR/GC keep it. Beyond it, the outcome
+//! lists the latched objects that are out of place when the episode ends
+//! ([`EpisodeOutcome::displaced`]): a demonstration is adapted towards its final state, so
+//! a demonstration whose arm knocked a counted object out again does not show its goal
+//! ([`EpisodeOutcome::demonstrates_goal`]).
 
 use std::sync::{Arc, Mutex, MutexGuard};
 
@@ -142,6 +148,11 @@ pub struct EpisodeOutcome {
     pub final_call: bool,
     /// Control step at which the episode ended.
     pub end_step: u64,
+    /// Objects that were counted as placed (latched) but no longer meet their subtask's
+    /// placement condition when the outcome was taken, in config then label order. The
+    /// verdicts above do not look at it (the authors' latch); a recorded demonstration does.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub displaced: Vec<String>,
 }
 
 impl EpisodeOutcome {
@@ -166,6 +177,13 @@ impl EpisodeOutcome {
         }
         let ok = self.subtasks.iter().filter(|s| s.result.is_success()).count();
         ok as f64 / self.subtasks.len() as f64
+    }
+
+    /// Every subtask `full_success` and every counted object still in place at the end: the
+    /// episode's final state shows its goal, which is what a demonstration must do (its
+    /// final state becomes the goal of adaptation).
+    pub fn demonstrates_goal(&self) -> bool {
+        self.full_success() && self.displaced.is_empty()
     }
 
     /// One line per subtask, e.g. `pick_place: full_success`.
@@ -356,6 +374,15 @@ impl SubtaskChecker {
     pub fn closure_pending(&self) -> bool {
         self.closure == Closure::Pending
     }
+
+    /// The latched objects that do not meet the placement condition in `view` now (label
+    /// order).
+    pub fn displaced(&self, view: &dyn GoalView) -> Vec<String> {
+        (0..self.latched.len())
+            .filter(|&i| self.latched[i].is_some() && !self.placed(view, i))
+            .map(|i| self.goal.objects()[i].to_owned())
+            .collect()
+    }
 }
 
 /// The goal checks of a whole scene.
@@ -406,7 +433,8 @@ impl GoalChecker {
     }
 
     /// The outcome so far (undecided subtasks are reported as `fail` at the last check;
-    /// use [`GoalMonitor::finish`] for the real end of an episode).
+    /// use [`GoalMonitor::finish`] for the real end of an episode), without
+    /// [`EpisodeOutcome::displaced`] (it needs the world: [`GoalChecker::outcome_in`]).
     pub fn outcome(&self, end_step: u64) -> EpisodeOutcome {
         let mut decision_order = self.decision_order.clone();
         let subtasks: Vec<SubtaskOutcome> = self
@@ -446,7 +474,15 @@ impl GoalChecker {
             achieved_sequence,
             final_call: self.final_call,
             end_step,
+            displaced: Vec::new(),
         }
+    }
+
+    /// [`GoalChecker::outcome`] with [`EpisodeOutcome::displaced`] filled from `view`.
+    pub fn outcome_in(&self, view: &dyn GoalView, end_step: u64) -> EpisodeOutcome {
+        let mut outcome = self.outcome(end_step);
+        outcome.displaced = self.subtasks.iter().flat_map(|s| s.displaced(view)).collect();
+        outcome
     }
 }
 
@@ -504,12 +540,13 @@ impl GoalMonitor {
 
     /// The outcome so far, without stepping (undecided subtasks shown as `fail`).
     pub fn peek(&self, sim: &Sim) -> EpisodeOutcome {
-        lock(&self.checker).outcome(sim.step_count())
+        lock(&self.checker).outcome_in(sim, sim.step_count())
     }
 
     /// Ends the episode (spec §7): the world settles for 100 control steps with the robot
     /// still; if some subtask is still undecided, the next checks are final and the world
-    /// settles for 100 more. Returns the outcome.
+    /// settles for 100 more. Returns the outcome, with the latched objects that are out of
+    /// place after the settle in [`EpisodeOutcome::displaced`].
     pub fn finish(&self, sim: &mut Sim) -> EpisodeOutcome {
         sim.step_idle(SETTLE_STEPS);
         if !lock(&self.checker).all_decided() {
@@ -522,7 +559,7 @@ impl GoalMonitor {
                 checker.check(sim, sim.step_count());
             }
         }
-        lock(&self.checker).outcome(sim.step_count())
+        lock(&self.checker).outcome_in(sim, sim.step_count())
     }
 }
 
@@ -836,6 +873,96 @@ mod tests {
         let outcome = checker.outcome(90);
         assert_eq!(outcome.subtasks[0].result, SubtaskResult::FullSuccess);
         assert_eq!(outcome.achieved_sequence, ["black_rook", "white_rook"]);
+    }
+
+    /// The grip_high_00_s0 demonstration: the sweep latched the black rook in its box, then
+    /// the lifting finger carried it out and dropped it on the table.
+    #[test]
+    fn a_latched_object_knocked_out_again_is_displaced_but_still_counts() {
+        let goal = SubtaskGoal::Sweep {
+            placements: vec![
+                Placement {
+                    object: "white_rook".into(),
+                    container: "left_chess_box".into(),
+                },
+                Placement {
+                    object: "black_rook".into(),
+                    container: "right_chess_box".into(),
+                },
+            ],
+        };
+        let mut world = GoalSnapshot::default();
+        let chess_box = |y: f64| Aabb {
+            min: [0.27, y - 0.04, 0.5],
+            max: [0.43, y + 0.04, 0.5245],
+        };
+        world.aabbs.insert("left_chess_box".into(), chess_box(-0.287));
+        world.aabbs.insert("right_chess_box".into(), chess_box(-0.113));
+        world
+            .aabbs
+            .insert("white_rook".into(), cube([0.31, -0.275, 0.53], 0.015));
+        // Measured in the replay: in the box at the check after the push ...
+        world.aabbs.insert(
+            "black_rook".into(),
+            Aabb {
+                min: [0.391, -0.142, 0.504],
+                max: [0.420, -0.109, 0.558],
+            },
+        );
+        let mut checker = GoalChecker::new(&[goal]);
+        checker.check(&world, 3750);
+        assert!(checker.all_decided());
+        assert!(checker.outcome_in(&world, 3750).demonstrates_goal());
+        // ... and lying on the table at the end.
+        world.aabbs.insert(
+            "black_rook".into(),
+            Aabb {
+                min: [0.541, -0.003, 0.500],
+                max: [0.591, 0.054, 0.529],
+            },
+        );
+        let outcome = checker.outcome_in(&world, 9000);
+        assert_eq!(outcome.subtasks[0].result, SubtaskResult::FullSuccess);
+        assert!(outcome.full_success() && outcome.success());
+        assert_eq!(outcome.displaced, ["black_rook"]);
+        assert!(!outcome.demonstrates_goal());
+        // Without the world there is nothing to compare with.
+        assert!(checker.outcome(9000).displaced.is_empty());
+    }
+
+    #[test]
+    fn a_latched_object_held_at_the_end_is_displaced() {
+        let (goal, mut world) = pick_place_world();
+        let mut checker = GoalChecker::new(&[goal]);
+        for (k, name) in ["red", "green", "blue"].into_iter().enumerate() {
+            put_in_box(&mut world, name, -0.04 + 0.04 * k as f64);
+        }
+        checker.check(&world, 30);
+        world.held.push("green".into());
+        let outcome = checker.outcome_in(&world, 60);
+        assert!(outcome.full_success());
+        assert_eq!(outcome.displaced, ["green"]);
+        world.held.clear();
+        assert!(checker.outcome_in(&world, 90).demonstrates_goal());
+    }
+
+    #[test]
+    fn displaced_is_left_out_of_the_json_when_empty_and_read_back() {
+        let (goal, mut world) = pick_place_world();
+        let mut checker = GoalChecker::new(&[goal]);
+        for (k, name) in ["red", "green", "blue"].into_iter().enumerate() {
+            put_in_box(&mut world, name, -0.04 + 0.04 * k as f64);
+        }
+        checker.check(&world, 30);
+        let clean = checker.outcome_in(&world, 30);
+        let text = serde_json::to_string(&clean).unwrap();
+        assert!(!text.contains("displaced"), "{text}");
+        assert_eq!(serde_json::from_str::<EpisodeOutcome>(&text).unwrap(), clean);
+        world.aabbs.insert("red".into(), cube([0.3, 0.0, 0.52], 0.02));
+        let knocked = checker.outcome_in(&world, 60);
+        let text = serde_json::to_string(&knocked).unwrap();
+        assert!(text.contains(r#""displaced":["red"]"#), "{text}");
+        assert_eq!(serde_json::from_str::<EpisodeOutcome>(&text).unwrap(), knocked);
     }
 
     #[test]
