@@ -307,8 +307,9 @@ struct CompiledStep {
 /// of verifying a procedure, and the adaptation loop re-verifies procedures that differ from
 /// the previous version by one patch: with a cache, an unchanged action is grounded once.
 /// The cache is keyed by the whole operator (name, preconditions, effects, parameters), so a
-/// changed literal is a different entry; it empties itself when the universe changes (e.g. a
-/// patch mentions a new object), since quantifiers then range over other objects.
+/// changed literal is a different entry; when the universe changes (e.g. a patch mentions a
+/// new object) it drops every entry that quantifies, since quantifiers then range over other
+/// objects.
 ///
 /// Ground operators (no parameters) are grounded conjunct by conjunct, and each distinct
 /// precondition conjunct and top-level effect is grounded once too: actions of one procedure
@@ -327,8 +328,11 @@ impl GroundingCache {
         if self.universe.as_ref() != Some(universe) {
             self.universe = Some(universe.clone());
             self.entries.clear();
-            self.conjuncts.clear();
-            self.effects.clear();
+            // Without quantifiers a conjunct or effect grounds to the same atoms over any
+            // universe, so only the quantified ones go: a patch that names a new object then
+            // re-grounds a few `forall`s, not every literal of the procedure.
+            self.conjuncts.retain(|f, _| f.is_quantifier_free());
+            self.effects.retain(|e, _| e.is_quantifier_free());
         }
         if let Some(g) = self.entries.get(op) {
             return g.clone();
@@ -369,7 +373,7 @@ impl GroundingCache {
             }
         }
         let mut effects = GroundEffects::default();
-        for e in &op.eff {
+        for e in op.eff.iter() {
             if !self.effects.contains_key(e) {
                 let mut part = GroundEffects::default();
                 e.ground(universe, &mut Bindings::new(), None, &mut part)?;
@@ -593,5 +597,66 @@ impl CompiledProcedure {
             goal,
             goal_error,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::text::{parse_effect, parse_formula};
+
+    fn op(pre: &[&str], eff: &[&str]) -> Operator {
+        Operator::new(
+            "Act",
+            pre.iter().map(|p| parse_formula(p).unwrap()).collect::<Vec<_>>(),
+            eff.iter().map(|e| parse_effect(e).unwrap()).collect::<Vec<_>>(),
+        )
+    }
+
+    #[test]
+    fn quantifier_freedom() {
+        assert!(
+            parse_formula("(not (and (A x) (= x y)))")
+                .unwrap()
+                .is_quantifier_free()
+        );
+        assert!(
+            !parse_formula("(or (A x) (exists (?y - thing) (B ?y)))")
+                .unwrap()
+                .is_quantifier_free()
+        );
+        assert!(parse_effect("(when (A x) (B x))").unwrap().is_quantifier_free());
+        assert!(
+            !parse_effect("(when (forall (?y - thing) (A ?y)) (B x))")
+                .unwrap()
+                .is_quantifier_free()
+        );
+        assert!(
+            !parse_effect("(forall (?y - thing) (not (B ?y)))")
+                .unwrap()
+                .is_quantifier_free()
+        );
+    }
+
+    #[test]
+    fn cache_across_a_universe_change_grounds_like_compile() {
+        let action = op(
+            &["(A x)", "(forall (?y - thing) (not (Held ?y)))"],
+            &["(B x)", "(forall (?y - thing) (not (Over x ?y)))"],
+        );
+        let mut cache = GroundingCache::default();
+        let small = Universe::of_things([Symbol::new("x"), Symbol::new("y")]);
+        let big = Universe::of_things([Symbol::new("x"), Symbol::new("y"), Symbol::new("z")]);
+        for universe in [&small, &big, &small] {
+            let cached = cache.grounded(universe, &action);
+            let fresh = action.compile(universe).unwrap();
+            let cached = cached.compiled.as_ref().unwrap();
+            assert_eq!(cached.pre, fresh.pre);
+            assert_eq!(cached.effects, fresh.effects);
+        }
+        // The quantifier-free literals survived the changes; the quantified ones were
+        // re-grounded for the last universe only.
+        assert_eq!(cache.conjuncts.len(), 2);
+        assert_eq!(cache.effects.len(), 2);
     }
 }

@@ -171,6 +171,18 @@ impl Formula {
         }
     }
 
+    /// True if no `forall` or `exists` occurs in the formula: its grounding then does not
+    /// depend on the universe.
+    pub fn is_quantifier_free(&self) -> bool {
+        match self {
+            Formula::Atom(_) | Formula::Eq(..) => true,
+            Formula::Not(f) => f.is_quantifier_free(),
+            Formula::And(fs) | Formula::Or(fs) => fs.iter().all(Formula::is_quantifier_free),
+            Formula::Imply(a, b) => a.is_quantifier_free() && b.is_quantifier_free(),
+            Formula::Forall(..) | Formula::Exists(..) => false,
+        }
+    }
+
     /// Grounds the formula over a universe with the given variable bindings.
     pub fn ground(&self, universe: &Universe, env: &mut Bindings) -> Result<Ground, GroundError> {
         Ok(match self {
@@ -316,6 +328,18 @@ impl Effect {
             Effect::When(c, es) => {
                 c.constants(out);
                 es.iter().for_each(|e| e.constants(out));
+            }
+        }
+    }
+
+    /// True if no `forall` occurs in the effect or its `when` conditions: its grounding then
+    /// does not depend on the universe.
+    pub fn is_quantifier_free(&self) -> bool {
+        match self {
+            Effect::Add(_) | Effect::Del(_) => true,
+            Effect::Forall(..) => false,
+            Effect::When(cond, effects) => {
+                cond.is_quantifier_free() && effects.iter().all(Effect::is_quantifier_free)
             }
         }
     }

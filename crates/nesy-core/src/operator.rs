@@ -3,6 +3,7 @@
 //! action schemas), and their compiled form.
 
 use std::fmt;
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
@@ -27,10 +28,12 @@ pub struct Operator {
     /// The objects an instantiated schema was bound to; empty otherwise.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub args: Vec<Symbol>,
-    /// Preconditions, a conjunction of formulas; empty means none.
-    pub pre: Vec<Formula>,
-    /// Effects; applied with PDDL semantics (deletes first, then adds).
-    pub eff: Vec<Effect>,
+    /// Preconditions, a conjunction of formulas; empty means none. Shared (`Arc`): the
+    /// adaptation loop copies whole procedures into every request and trace event, and a
+    /// copy must not duplicate every formula.
+    pub pre: Arc<[Formula]>,
+    /// Effects; applied with PDDL semantics (deletes first, then adds). Shared like `pre`.
+    pub eff: Arc<[Effect]>,
 }
 
 mod typed_vars_serde {
@@ -60,13 +63,17 @@ mod typed_vars_serde {
 
 impl Operator {
     /// A ground operator with the given name, preconditions and effects.
-    pub fn new(name: impl Into<String>, pre: Vec<Formula>, eff: Vec<Effect>) -> Self {
+    pub fn new(
+        name: impl Into<String>,
+        pre: impl Into<Arc<[Formula]>>,
+        eff: impl Into<Arc<[Effect]>>,
+    ) -> Self {
         Operator {
             name: name.into(),
             params: Vec::new(),
             args: Vec::new(),
-            pre,
-            eff,
+            pre: pre.into(),
+            eff: eff.into(),
         }
     }
 
@@ -154,7 +161,7 @@ impl Operator {
             }
         }
         let mut effects = GroundEffects::default();
-        for e in &self.eff {
+        for e in self.eff.iter() {
             e.ground(universe, &mut env, None, &mut effects)?;
         }
         effects.normalize();
@@ -190,14 +197,14 @@ impl fmt::Display for Operator {
         if self.pre.is_empty() {
             f.write_str("\tNone\n")?;
         }
-        for p in &self.pre {
+        for p in self.pre.iter() {
             writeln!(f, "\t{p}")?;
         }
         f.write_str("- Effects:")?;
         if self.eff.is_empty() {
             f.write_str("\n\tNone")?;
         }
-        for e in &self.eff {
+        for e in self.eff.iter() {
             write!(f, "\n\t{e}")?;
         }
         Ok(())

@@ -345,8 +345,8 @@ fn parse_action(
         name: name.to_string(),
         params,
         args: vec![],
-        pre,
-        eff,
+        pre: pre.into(),
+        eff: eff.into(),
     })
 }
 
@@ -648,9 +648,9 @@ impl fmt::Display for Domain {
         for a in &self.actions {
             writeln!(f, "  (:action {}", a.name)?;
             writeln!(f, "    :parameters ({})", fmt_typed_vars(&a.params))?;
-            writeln!(f, "    :precondition {}", Formula::And(a.pre.clone()))?;
+            writeln!(f, "    :precondition {}", Formula::And(a.pre.to_vec()))?;
             f.write_str("    :effect (and")?;
-            for e in &a.eff {
+            for e in a.eff.iter() {
                 write!(f, " {e}")?;
             }
             f.write_str("))\n")?;

@@ -130,7 +130,7 @@ fn reference_apply(
         return Err(unmet);
     }
     let (mut adds, mut dels) = (BTreeSet::new(), BTreeSet::new());
-    for e in &op.eff {
+    for e in op.eff.iter() {
         collect(e, s, &env, objects, &mut adds, &mut dels);
     }
     let mut next: BTreeSet<String> = s.difference(&dels).cloned().collect();

@@ -146,8 +146,8 @@ fn random_pddl(rng: &mut SeedRng) -> (Domain, Problem, Vec<PlanStep>) {
             name: name.to_string(),
             params,
             args: vec![],
-            pre,
-            eff,
+            pre: pre.into(),
+            eff: eff.into(),
         });
     }
     let domain = Domain {

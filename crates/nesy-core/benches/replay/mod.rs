@@ -122,15 +122,19 @@ impl Reasoner for ScriptedReasoner {
     }
 }
 
-/// The corpus directory.
+/// The corpus directory: `NESY_ADAPT_CORPUS` if set (to time other recorded runs, e.g. a
+/// fresh `scripts/make_adapt_corpus.py --out DIR`), else `tests/adapt_corpus`.
 pub fn corpus_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/adapt_corpus")
+    match std::env::var_os("NESY_ADAPT_CORPUS") {
+        Some(dir) => PathBuf::from(dir),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/adapt_corpus"),
+    }
 }
 
 /// Every recorded run, sorted by scenario id.
 pub fn load_all() -> Vec<RecordedRun> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(corpus_dir())
-        .expect("tests/adapt_corpus exists")
+        .unwrap_or_else(|e| panic!("{}: {e}", corpus_dir().display()))
         .map(|e| e.expect("readable directory entry").path())
         .filter(|p| p.extension().is_some_and(|x| x == "json"))
         .collect();

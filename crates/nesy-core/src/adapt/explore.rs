@@ -12,21 +12,43 @@ use crate::operator::Operator;
 use crate::patch::{AppliedPatch, apply_patch};
 use crate::state::State;
 use crate::text::parse_refinement_reply;
+use crate::types::Universe;
 
-/// Verifies `procedure` from `init` towards `goal` over the universe of the target's
-/// objects plus every constant the procedure and goal mention.
+/// The universe the loop verifies over: every object of the target's initial state, the
+/// demonstrated procedure, the goal and the target's object list, then any object a later
+/// procedure version names. It only grows. A patch that drops the last action naming some
+/// object (a drawer handle the target no longer needs) therefore keeps the universe, and with
+/// it every grounded action in the cache. No action names the object any more, so no atom
+/// about it can become true: a `forall` over negated atoms or an `exists` over atoms (the
+/// quantified forms actions are written with) has the same truth with it in range or not.
+fn loop_universe(
+    init: &State,
+    demonstrated: &[Operator],
+    goal: &Formula,
+    target_objects: &[crate::symbol::Symbol],
+) -> Universe {
+    let mut universe = implicit_universe(init, demonstrated, Some(goal));
+    for o in target_objects {
+        universe.add_thing(*o);
+    }
+    universe
+}
+
+/// Verifies `procedure` from `init` towards `goal`, first adding to `universe` the objects
+/// the procedure names that it lacks.
 fn verify(
     init: &State,
-    target_objects: &[crate::symbol::Symbol],
+    universe: &mut Universe,
     procedure: &[Operator],
     goal: &Formula,
     cache: &mut GroundingCache,
 ) -> Report {
-    let mut universe = implicit_universe(init, procedure, Some(goal));
-    for o in target_objects {
-        universe.add_thing(*o);
+    for op in procedure {
+        for c in op.constants().into_iter().chain(op.args.iter().copied()) {
+            universe.add_thing(c);
+        }
     }
-    CompiledProcedure::new_cached(&universe, procedure, Some(goal), cache).verify(init)
+    CompiledProcedure::new_cached(universe, procedure, Some(goal), cache).verify(init)
 }
 
 /// Eq. 6: the first inconsistency of a verified procedure — the first failing step's unmet
@@ -194,12 +216,12 @@ pub async fn explore<R: Reasoner>(
 ) -> Result<ExplorationResult, AdaptError> {
     let ablation = config.ablation;
     let goal = &world_model.goal;
-    let objects = &target.task.objects;
     let mut procedure = world_model.procedure.clone();
     // Every verification of this loop runs over the same initial state and goal, and
     // successive procedures share most actions: each distinct action is grounded once.
     let mut cache = GroundingCache::default();
-    let mut report = verify(&target.init, objects, &procedure, goal, &mut cache);
+    let mut universe = loop_universe(&target.init, &procedure, goal, &target.task.objects);
+    let mut report = verify(&target.init, &mut universe, &procedure, goal, &mut cache);
     let mut best = (progress(&report), procedure.clone());
     let mut feedback: Vec<Feedback> = Vec::new();
     let mut last_violation: Option<ViolationInfo> = None;
@@ -331,7 +353,7 @@ pub async fn explore<R: Reasoner>(
             }
             let applied = apply_patch(&procedure, &r.patches[0], near)
                 .map_err(|error| Problem::PatchDidNotApply { error })?;
-            let new_report = verify(&target.init, objects, &applied.procedure, goal, &mut cache);
+            let new_report = verify(&target.init, &mut universe, &applied.procedure, goal, &mut cache);
             if ablation.verification {
                 if ablation.identification {
                     resolves(&visible, &applied, &new_report)?;

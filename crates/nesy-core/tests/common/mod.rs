@@ -158,10 +158,10 @@ pub fn effect(rng: &mut SeedRng, depth: usize, scope: &mut Vec<Symbol>) -> Effec
 }
 
 pub fn operator(rng: &mut SeedRng, name: &str) -> Operator {
-    let pre = (0..rng.below(4))
+    let pre: Vec<_> = (0..rng.below(4))
         .map(|_| formula(rng, 3, &mut Vec::new()))
         .collect();
-    let eff = (0..1 + rng.below(4))
+    let eff: Vec<_> = (0..1 + rng.below(4))
         .map(|_| effect(rng, 2, &mut Vec::new()))
         .collect();
     Operator::new(name, pre, eff)

@@ -288,7 +288,7 @@ pub fn induce(world: &WorldDomain, ctx: &InductionContext) -> Result<InducedActi
         .cloned()
         .collect();
     let eff = if exact {
-        best.op.eff.clone()
+        best.op.eff.to_vec()
     } else {
         observed_changes(&req.previous, &req.next)
     };
@@ -355,11 +355,11 @@ pub fn format_reply(action: &InducedAction, call: Option<&RecordedCall>) -> Stri
     if action.operator.pre.is_empty() {
         out.push_str("None\n");
     }
-    for p in &action.operator.pre {
+    for p in action.operator.pre.iter() {
         out.push_str(&format!("- {p}\n"));
     }
     out.push_str("Effect:\n");
-    for e in &action.operator.eff {
+    for e in action.operator.eff.iter() {
         out.push_str(&format!("- {e}\n"));
     }
     out

@@ -165,7 +165,7 @@ impl NoiseRng {
 pub fn perturb_operator(op: &mut Operator, noise: &OracleNoise, rng: &mut NoiseRng) -> usize {
     let mut changed = 0;
     let mut pre = Vec::new();
-    for f in op.pre.drain(..) {
+    for f in op.pre.iter().cloned() {
         if rng.chance(noise.drop) {
             changed += 1;
         } else if rng.chance(noise.flip) {
@@ -178,10 +178,10 @@ pub fn perturb_operator(op: &mut Operator, noise: &OracleNoise, rng: &mut NoiseR
             pre.push(f);
         }
     }
-    op.pre = pre;
+    op.pre = pre.into();
     let total = op.eff.len();
     let mut eff = Vec::new();
-    for (k, e) in op.eff.drain(..).enumerate() {
+    for (k, e) in op.eff.iter().cloned().enumerate() {
         let last_chance = eff.is_empty() && k + 1 == total;
         if !last_chance && rng.chance(noise.drop) {
             changed += 1;
@@ -196,7 +196,7 @@ pub fn perturb_operator(op: &mut Operator, noise: &OracleNoise, rng: &mut NoiseR
             eff.push(e);
         }
     }
-    op.eff = eff;
+    op.eff = eff.into();
     changed
 }
 

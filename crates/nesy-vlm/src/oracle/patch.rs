@@ -138,7 +138,7 @@ impl Planning<'_> {
 /// end-effector atom when the scene's states do not state it.
 pub fn printable(step: &Operator, state_names_embodiment: bool) -> Operator {
     let name = normalize_action_name(&semantic(&step.name, &step.args)).unwrap_or_else(|| step.name.clone());
-    let pre = step
+    let pre: Vec<Formula> = step
         .pre
         .iter()
         .filter(|f| {
@@ -324,7 +324,7 @@ pub fn propose(
             // Plan to all of the erroneous action's preconditions (so that making the unmet
             // ones true does not undo the others, e.g. the hand must be empty again after
             // moving a blocker away), and to the unmet ones alone as a fallback.
-            let whole = Formula::And(erroneous.pre.clone());
+            let whole = Formula::And(erroneous.pre.to_vec());
             for goal in [whole, goal_of(&unmet)] {
                 match planning.plan(&error_state, &goal) {
                     Ok((plan, _)) if !plan.is_empty() => {
