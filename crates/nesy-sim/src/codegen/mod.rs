@@ -580,9 +580,18 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
                 };
                 let hang = e.hang(&format!("get_obj_size({x:?})[2]"));
                 e.line(&format!("box = get_obj_bbox({b:?})"));
-                e.line(&format!(
-                    "move_to_position([(box[0][0] + box[1][0]) / 2 + {dx}, (box[0][1] + box[1][1]) / 2 + {dy}, box[1][2] + {hang} + 0.01])"
-                ));
+                if b.ends_with("chess_box") {
+                    // Every piece into the box's centre would land the second on the first: a
+                    // piece keeps its own x (distinct per piece, as the sweep pushes them straight
+                    // across), kept inside the box.
+                    e.line(&format!(
+                        "move_to_position([min(max(get_obj_pos({x:?})[0], box[0][0] + 0.025), box[1][0] - 0.025), (box[0][1] + box[1][1]) / 2, box[1][2] + {hang} + 0.01])"
+                    ));
+                } else {
+                    e.line(&format!(
+                        "move_to_position([(box[0][0] + box[1][0]) / 2 + {dx}, (box[0][1] + box[1][1]) / 2 + {dy}, box[1][2] + {hang} + 0.01])"
+                    ));
+                }
             }
             CarryOverHinge => {
                 let x = arg(0);
@@ -766,6 +775,38 @@ mod tests {
         assert!(!finger.contains("move_gripper_to(\"apple\""), "{finger}");
         let vacuum = compile_policy(&procedure, &o, Embodiment::Vacuum).unwrap().code;
         assert!(!vacuum.contains("clear_angle"), "{vacuum}");
+    }
+
+    #[test]
+    fn carried_pieces_keep_their_own_place_along_the_chess_box() {
+        let o: Vec<String> = [
+            "floor",
+            "board",
+            "white_rook",
+            "white_bishop",
+            "left_chess_box",
+            "toy_box",
+            "red_cube",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let procedure = ops(&[
+            "MoveToSurroundWhiteRook",
+            "GraspWhiteRook",
+            "CarryIntoWhiteRookLeftChessBox",
+            "MoveToSurroundRedCube",
+            "GraspRedCube",
+            "CarryIntoRedCubeToyBox",
+        ]);
+        let code = compile_policy(&procedure, &o, Embodiment::Vacuum).unwrap().code;
+        // The piece's own x, clamped inside the box (two pieces at the centre would stack);
+        // the cube still goes to the toy box's centre.
+        assert!(
+            code.contains("get_obj_pos(\"white_rook\")[0], box[0][0] + 0.025), box[1][0] - 0.025)"),
+            "{code}"
+        );
+        assert!(!code.contains("get_obj_pos(\"red_cube\")[0]"), "{code}");
     }
 
     #[test]

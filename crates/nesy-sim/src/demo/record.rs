@@ -62,6 +62,12 @@ impl Recording {
     pub fn full_success(&self) -> bool {
         self.expert_error.is_none() && self.outcome.full_success()
     }
+
+    /// [`Recording::full_success`], and no counted object was knocked out of place later:
+    /// the demo's final state shows its goal, which adaptation derives from it.
+    pub fn demonstrates_goal(&self) -> bool {
+        self.expert_error.is_none() && self.outcome.demonstrates_goal()
+    }
 }
 
 /// Why a scene could not be recorded at all.
