@@ -18,6 +18,8 @@ pub const HANDLE_REACH: f64 = 0.1;
 /// top (the kinematic arm would crush it). Deeper requests stop here, as a real hand stops on
 /// contact.
 pub const MAX_FINGER_DEPTH: f64 = 0.027;
+/// How far (m) the finger hand backs off against its last push before it lifts.
+const PUSH_BACK_OFF: f64 = 0.015;
 /// Control steps for the fingers to open or close (0.04 m at 0.2 m/s takes 20).
 const GRIPPER_STEPS: u32 = 25;
 
@@ -197,13 +199,28 @@ impl Sim {
             clearance
         };
         let mut waypoints = Vec::new();
+        // After a push the trailing finger pad stands against the piece, under the overhang
+        // of a chess piece's head (the pads push the neck); lifting straight up hooked the
+        // head and carried the piece off. Back off against the push first.
+        let mut lift_from = current.translation.vector;
+        if let Some(push) = self.last_push.take()
+            && clearance > 0.0
+            && self.held.is_none()
+            && self.handle_grasp.is_none()
+        {
+            lift_from -= array_to_na(push) * PUSH_BACK_OFF;
+            waypoints.push(ToolGoal {
+                position: lift_from,
+                rotation: current.rotation,
+            });
+        }
         // The move from the lift point (or the start) to the approach point is the free
         // transit the planner keeps clear of loose objects.
         let mut transit = None;
         if clearance > 0.0 {
             if self.moved_since_reset {
                 waypoints.push(ToolGoal {
-                    position: current.translation.vector - current_dir * clearance,
+                    position: lift_from - current_dir * clearance,
                     rotation: current.rotation,
                 });
             }
@@ -333,6 +350,10 @@ impl Sim {
         )?;
         self.execute_at_least(&plan, SETTLE_STEPS, crate::motion::PARALLEL_MIN_DURATION);
         self.moved_since_reset = true;
+        let sideways = dir != Direction::Up;
+        let empty_fingers =
+            self.scene.embodiment == Embodiment::Finger && self.held.is_none() && self.handle_grasp.is_none();
+        self.last_push = (sideways && empty_fingers).then(|| dir.unit());
         Ok(())
     }
 
@@ -354,8 +375,22 @@ impl Sim {
         if let Some(grasp) = self.handle_grasp {
             target = (self.width_across_fingers(grasp.part) / 2.0).min(FINGER_OPEN);
         } else if self.held.is_none() {
+            // Of the loose objects between the pads, the one nearest the pads' midpoint: the
+            // first in scene order (the authors' rule) could be a neighbour whose box merely
+            // grazes the pad line, and the fingers then carried off a cube next to the fruit
+            // they closed on.
+            let mid = self
+                .pad_centres()
+                .map(|[a, b]| std::array::from_fn::<f64, 3, _>(|k| (a[k] + b[k]) / 2.0));
             let candidate = (0..self.parts.len())
-                .find(|&i| self.parts[i].role == PartRole::Loose && self.part_in_gripper(i));
+                .filter(|&i| self.parts[i].role == PartRole::Loose && self.part_in_gripper(i))
+                .min_by(|&i, &j| {
+                    let d = |p: usize| {
+                        let c = self.part_aabb(p).centre();
+                        mid.map_or(0.0, |m| (0..3).map(|k| (c[k] - m[k]).powi(2)).sum::<f64>())
+                    };
+                    d(i).total_cmp(&d(j)).then(i.cmp(&j))
+                });
             if let Some(i) = candidate {
                 let width = self.width_across_fingers(i);
                 if width <= 2.0 * FINGER_OPEN + 1e-3 {

@@ -18,6 +18,23 @@ pub const FRICTION: f32 = 1.0;
 /// 0.3 still lets them stop within a few millimetres once the push ends.
 pub const PIECE_FRICTION: f32 = 0.3;
 
+/// Angular damping (1/s) of round objects' bodies. Rapier has no rolling resistance: a fruit
+/// or a fallen cylinder touched by the arm or a neighbour rolled (or wobbled on its rounded
+/// rim) at a few cm/s without ever stopping, until it left the workspace or fell off the
+/// table. Damping the spin makes the friction at the contact stop the roll within a second;
+/// it does not slow free falls or slides.
+pub const ROUND_ANGULAR_DAMPING: f32 = 50.0;
+
+/// Angular damping of a kind's body.
+pub fn angular_damping(kind: ObjectKind) -> f32 {
+    match kind {
+        ObjectKind::Apple | ObjectKind::Orange | ObjectKind::Lemon | ObjectKind::Cylinder => {
+            ROUND_ANGULAR_DAMPING
+        }
+        _ => 0.0,
+    }
+}
+
 /// Friction of a kind's colliders and how it combines with the other collider's.
 pub fn friction(kind: ObjectKind) -> (f32, rapier3d::prelude::CoefficientCombineRule) {
     use rapier3d::prelude::CoefficientCombineRule;

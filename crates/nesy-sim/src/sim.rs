@@ -179,6 +179,9 @@ pub struct Sim {
     pub(crate) actions_used: usize,
     pub(crate) steps: u64,
     pub(crate) moved_since_reset: bool,
+    /// Unit direction of the last `move_parallel` the open, empty finger hand made sideways
+    /// (a push), until the next `move_to_position` backs off from it.
+    pub(crate) last_push: Option<[f64; 3]>,
     pub(crate) hooks: Vec<Box<dyn SimHook>>,
 }
 
@@ -316,6 +319,7 @@ impl Sim {
                 let body_builder = match build.motion {
                     PartMotion::Dynamic => RigidBodyBuilder::dynamic()
                         .ccd_enabled(DYNAMIC_CCD)
+                        .angular_damping(objects::angular_damping(spec.kind))
                         .can_sleep(false),
                     PartMotion::Fixed => RigidBodyBuilder::fixed(),
                     PartMotion::Articulated => RigidBodyBuilder::kinematic_position_based().can_sleep(false),
@@ -453,6 +457,7 @@ impl Sim {
             actions_used: 0,
             steps: 0,
             moved_since_reset: false,
+            last_push: None,
             hooks: Vec::new(),
         };
         sim.check_interpenetration()?;

@@ -107,6 +107,26 @@ fn benchmark_targets_comb() {
     benchmark_targets("comb");
 }
 
+/// One side of a benchmark scenario.
+fn benchmark_scene(id: &str, side: Side) {
+    let files = scenario::generate_suite();
+    assert_full_success(&scenario::find(&files, id).unwrap().task(side));
+}
+
+/// A sweep push followed by a pick: the finger hand backs off from the pushed rook before it
+/// lifts (it used to carry the rook off by its head and weld it instead of the red cube).
+#[test]
+fn finger_lets_go_of_a_pushed_piece() {
+    benchmark_scene("vacu_low_02_s0", Side::Target);
+}
+
+/// The suction tool's forearm knocks the lemon over on its way to the drawer handle; without
+/// the fruits' angular damping it rolled off the table.
+#[test]
+fn knocked_fruit_stops_rolling() {
+    benchmark_scene("grip_medium_11_s1", Side::Target);
+}
+
 #[test]
 #[ignore = "heavy: run with --ignored (or use the expert_sweep example)"]
 fn expert_sweep_over_generated_tasks() {
