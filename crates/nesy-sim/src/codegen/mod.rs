@@ -459,9 +459,12 @@ impl Emitter {
                 "move_to_position([spot[0], spot[1], 0.5 + {hang} + 0.01])"
             ));
         } else {
+            // The piece keeps its own x (the sweep pushes it straight across), but a piece no
+            // longer above the board (knocked beside it) is put down on it: clamped into the
+            // board's extent, as a carry into a chess box is clamped into the box.
             self.line(&format!("surface = get_obj_bbox({surface:?})"));
             self.line(&format!(
-                "move_to_position([get_obj_pos({x:?})[0], (surface[0][1] + surface[1][1]) / 2, surface[1][2] + {hang} + 0.01])"
+                "move_to_position([min(max(get_obj_pos({x:?})[0], surface[0][0] + 0.025), surface[1][0] - 0.025), (surface[0][1] + surface[1][1]) / 2, surface[1][2] + {hang} + 0.01])"
             ));
         }
     }
@@ -807,6 +810,32 @@ mod tests {
             "{code}"
         );
         assert!(!code.contains("get_obj_pos(\"red_cube\")[0]"), "{code}");
+    }
+
+    #[test]
+    fn a_piece_carried_onto_the_board_is_put_down_within_the_board() {
+        let o: Vec<String> = ["floor", "board", "white_bishop", "left_chess_box"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let procedure = ops(&[
+            "MoveToSurroundWhiteBishop",
+            "GraspWhiteBishop",
+            "CarryOntoWhiteBishopBoard",
+            "PutDownWhiteBishopBoard",
+            "SweepIntoWhiteBishopLeftChessBox",
+        ]);
+        for embodiment in [Embodiment::Finger, Embodiment::Vacuum] {
+            let code = compile_policy(&procedure, &o, embodiment).unwrap().code;
+            // A piece knocked beside the board (affo_medium_00_s0: x 0.238 beside a board from
+            // 0.265) keeps its own x only inside the board's extent.
+            assert!(
+                code.contains(
+                    "move_to_position([min(max(get_obj_pos(\"white_bishop\")[0], surface[0][0] + 0.025), surface[1][0] - 0.025), (surface[0][1] + surface[1][1]) / 2"
+                ),
+                "{code}"
+            );
+        }
     }
 
     #[test]
