@@ -282,63 +282,10 @@ impl Sim {
                 return route;
             }
         }
-        // The arm can be on a branch from which no straight line reaches the waypoint (after a
-        // lid swing with the wrist turned, joints 3 and 7 run into their limits on the way,
-        // and the joint-space fallback swung the hand down through the chess pieces). Change
-        // branch high above the table instead: up, a joint move to the crossing point solved
-        // from the home configuration, then straight down.
-        for height in DETOUR_HEIGHTS {
-            if let Some(route) = self.rebranching_detour(
-                q_from,
-                pose_from,
-                wp,
-                pointing,
-                &obstacles,
-                tallest + height + below,
-            ) {
-                return route;
-            }
-        }
         if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
             eprintln!("  no clear detour");
         }
         vec![direct]
-    }
-
-    /// Up to height `z` (clamped like the detours), a joint-space move to an IK solution of
-    /// the crossing point above `wp` seeded from the home configuration, and the straight line
-    /// down to `wp`; `None` unless every part is reachable and clear of `obstacles`.
-    fn rebranching_detour(
-        &self,
-        q_from: &[f64],
-        pose_from: &Iso,
-        wp: &ToolGoal,
-        pointing: Direction,
-        obstacles: &[Obstacle<'_>],
-        z: f64,
-    ) -> Option<Vec<Vec<Vec<f64>>>> {
-        let start = pose_from.translation.vector;
-        let z = z.max(start.z).max(wp.position.z).min(TABLE_TOP + DETOUR_CEILING);
-        let up = ToolGoal {
-            position: nalgebra::Vector3::new(start.x, start.y, z),
-            rotation: pose_from.rotation,
-        };
-        let across = ToolGoal {
-            position: nalgebra::Vector3::new(wp.position.x, wp.position.y, z),
-            rotation: wp.rotation,
-        };
-        let rise = self.segment(q_from, pose_from, &up, pointing).ok()?;
-        let q_up = rise.last()?.clone();
-        let q_across = self.ik(&across, &crate::robot::HOME_ARM, &IkOptions::default())?;
-        let cross = vec![q_up, q_across.clone()];
-        let across_pose = Iso::from_parts(nalgebra::Translation3::from(across.position), across.rotation);
-        let descent = self.segment(&q_across, &across_pose, wp, pointing).ok()?;
-        let route = vec![rise, cross, descent];
-        let clear = route.iter().all(|path| self.path_is_clear(path, obstacles));
-        if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
-            eprintln!("  rebranching detour at {z:.3}: clear {clear}");
-        }
-        clear.then_some(route)
     }
 
     /// The approach distance for a move to `goal` along `dir` (unit, the pointing): the
