@@ -639,6 +639,37 @@ mod tests {
         world.aabbs.insert(name.into(), cube([dx, 0.0, 0.525], 0.02));
     }
 
+    /// Red, green and blue side by side in the box, in label order.
+    fn put_all_in_box(world: &mut GoalSnapshot) {
+        for (k, name) in ["red", "green", "blue"].into_iter().enumerate() {
+            put_in_box(world, name, -0.04 + 0.04 * k as f64);
+        }
+    }
+
+    /// The white rook into the left chess box, the black rook into the right one.
+    fn rook_sweep_goal() -> SubtaskGoal {
+        SubtaskGoal::Sweep {
+            placements: vec![
+                Placement {
+                    object: "white_rook".into(),
+                    container: "left_chess_box".into(),
+                },
+                Placement {
+                    object: "black_rook".into(),
+                    container: "right_chess_box".into(),
+                },
+            ],
+        }
+    }
+
+    /// A chess box centred at `y` on the benchmark's x range.
+    fn chess_box(y: f64) -> Aabb {
+        Aabb {
+            min: [0.27, y - 0.04, 0.5],
+            max: [0.43, y + 0.04, 0.5245],
+        }
+    }
+
     fn names(achieved: &[Achievement]) -> Vec<&str> {
         achieved.iter().map(|a| a.name.as_str()).collect()
     }
@@ -833,23 +864,8 @@ mod tests {
 
     #[test]
     fn sweep_is_full_success_in_any_order() {
-        let goal = SubtaskGoal::Sweep {
-            placements: vec![
-                Placement {
-                    object: "white_rook".into(),
-                    container: "left_chess_box".into(),
-                },
-                Placement {
-                    object: "black_rook".into(),
-                    container: "right_chess_box".into(),
-                },
-            ],
-        };
+        let goal = rook_sweep_goal();
         let mut world = GoalSnapshot::default();
-        let chess_box = |y: f64| Aabb {
-            min: [0.27, y - 0.04, 0.5],
-            max: [0.43, y + 0.04, 0.5245],
-        };
         world.aabbs.insert("left_chess_box".into(), chess_box(-0.09));
         world.aabbs.insert("right_chess_box".into(), chess_box(0.09));
         world
@@ -879,23 +895,8 @@ mod tests {
     /// the lifting finger carried it out and dropped it on the table.
     #[test]
     fn a_latched_object_knocked_out_again_is_displaced_but_still_counts() {
-        let goal = SubtaskGoal::Sweep {
-            placements: vec![
-                Placement {
-                    object: "white_rook".into(),
-                    container: "left_chess_box".into(),
-                },
-                Placement {
-                    object: "black_rook".into(),
-                    container: "right_chess_box".into(),
-                },
-            ],
-        };
+        let goal = rook_sweep_goal();
         let mut world = GoalSnapshot::default();
-        let chess_box = |y: f64| Aabb {
-            min: [0.27, y - 0.04, 0.5],
-            max: [0.43, y + 0.04, 0.5245],
-        };
         world.aabbs.insert("left_chess_box".into(), chess_box(-0.287));
         world.aabbs.insert("right_chess_box".into(), chess_box(-0.113));
         world
@@ -934,9 +935,7 @@ mod tests {
     fn a_latched_object_held_at_the_end_is_displaced() {
         let (goal, mut world) = pick_place_world();
         let mut checker = GoalChecker::new(&[goal]);
-        for (k, name) in ["red", "green", "blue"].into_iter().enumerate() {
-            put_in_box(&mut world, name, -0.04 + 0.04 * k as f64);
-        }
+        put_all_in_box(&mut world);
         checker.check(&world, 30);
         world.held.push("green".into());
         let outcome = checker.outcome_in(&world, 60);
@@ -950,9 +949,7 @@ mod tests {
     fn displaced_is_left_out_of_the_json_when_empty_and_read_back() {
         let (goal, mut world) = pick_place_world();
         let mut checker = GoalChecker::new(&[goal]);
-        for (k, name) in ["red", "green", "blue"].into_iter().enumerate() {
-            put_in_box(&mut world, name, -0.04 + 0.04 * k as f64);
-        }
+        put_all_in_box(&mut world);
         checker.check(&world, 30);
         let clean = checker.outcome_in(&world, 30);
         let text = serde_json::to_string(&clean).unwrap();
