@@ -451,6 +451,15 @@ impl Emitter {
         }
     }
 
+    /// A move that holds `x` just above the bounding box in the policy variable `bbox`, at
+    /// the box's middle y and at `x`'s own x clamped 2.5 cm inside the box (pieces pushed
+    /// straight across keep distinct x; a piece knocked off to one side is brought back in).
+    fn over_at_own_x(&mut self, x: &str, bbox: &str, hang: &str) {
+        self.line(&format!(
+            "move_to_position([min(max(get_obj_pos({x:?})[0], {bbox}[0][0] + 0.025), {bbox}[1][0] - 0.025), ({bbox}[0][1] + {bbox}[1][1]) / 2, {bbox}[1][2] + {hang} + 0.01])"
+        ));
+    }
+
     fn carry_onto(&mut self, x: &str, surface: &str) {
         let hang = self.hang(&format!("get_obj_size({x:?})[2]"));
         if surface == "floor" {
@@ -463,9 +472,7 @@ impl Emitter {
             // longer above the board (knocked beside it) is put down on it: clamped into the
             // board's extent, as a carry into a chess box is clamped into the box.
             self.line(&format!("surface = get_obj_bbox({surface:?})"));
-            self.line(&format!(
-                "move_to_position([min(max(get_obj_pos({x:?})[0], surface[0][0] + 0.025), surface[1][0] - 0.025), (surface[0][1] + surface[1][1]) / 2, surface[1][2] + {hang} + 0.01])"
-            ));
+            self.over_at_own_x(x, "surface", &hang);
         }
     }
 
@@ -587,9 +594,7 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
                     // Every piece into the box's centre would land the second on the first: a
                     // piece keeps its own x (distinct per piece, as the sweep pushes them straight
                     // across), kept inside the box.
-                    e.line(&format!(
-                        "move_to_position([min(max(get_obj_pos({x:?})[0], box[0][0] + 0.025), box[1][0] - 0.025), (box[0][1] + box[1][1]) / 2, box[1][2] + {hang} + 0.01])"
-                    ));
+                    e.over_at_own_x(x, "box", &hang);
                 } else {
                     e.line(&format!(
                         "move_to_position([(box[0][0] + box[1][0]) / 2 + {dx}, (box[0][1] + box[1][1]) / 2 + {dy}, box[1][2] + {hang} + 0.01])"
@@ -714,8 +719,12 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
 mod tests {
     use super::*;
 
+    fn names(list: &[&str]) -> Vec<String> {
+        list.iter().map(|s| s.to_string()).collect()
+    }
+
     fn objects() -> Vec<String> {
-        [
+        names(&[
             "floor",
             "toy_box",
             "red_cube",
@@ -723,10 +732,7 @@ mod tests {
             "board",
             "left_chess_box",
             "hinge_handle",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect()
+        ])
     }
 
     #[test]
@@ -758,10 +764,7 @@ mod tests {
 
     #[test]
     fn fruits_are_taken_with_the_fingers_turned_clear_of_their_neighbours() {
-        let o: Vec<String> = ["floor", "apple", "red_cube", "hinge_body", "hinge_lid"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let o = names(&["floor", "apple", "red_cube", "hinge_body", "hinge_lid"]);
         let procedure = ops(&[
             "MoveToSurroundRedCube",
             "GraspRedCube",
@@ -782,7 +785,7 @@ mod tests {
 
     #[test]
     fn carried_pieces_keep_their_own_place_along_the_chess_box() {
-        let o: Vec<String> = [
+        let o = names(&[
             "floor",
             "board",
             "white_rook",
@@ -790,10 +793,7 @@ mod tests {
             "left_chess_box",
             "toy_box",
             "red_cube",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+        ]);
         let procedure = ops(&[
             "MoveToSurroundWhiteRook",
             "GraspWhiteRook",
@@ -814,10 +814,7 @@ mod tests {
 
     #[test]
     fn a_piece_carried_onto_the_board_is_put_down_within_the_board() {
-        let o: Vec<String> = ["floor", "board", "white_bishop", "left_chess_box"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let o = names(&["floor", "board", "white_bishop", "left_chess_box"]);
         let procedure = ops(&[
             "MoveToSurroundWhiteBishop",
             "GraspWhiteBishop",
@@ -840,10 +837,7 @@ mod tests {
 
     #[test]
     fn a_push_right_after_a_put_down_approaches_the_piece_first() {
-        let o: Vec<String> = ["floor", "board", "white_rook", "left_chess_box"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let o = names(&["floor", "board", "white_rook", "left_chess_box"]);
         let procedure = ops(&[
             "MoveToSurroundWhiteRook",
             "GraspWhiteRook",
