@@ -22,6 +22,22 @@ pub const MAX_FINGER_DEPTH: f64 = 0.027;
 const PUSH_BACK_OFF: f64 = 0.015;
 /// Control steps for the fingers to open or close (0.04 m at 0.2 m/s takes 20).
 const GRIPPER_STEPS: u32 = 25;
+/// Distances (m) from the object's centre, along the closing axis, that the open fingers
+/// pass through on the way down (the pads sit at the [`FINGER_OPEN`] travel, about 1 cm
+/// thick).
+const FINGER_SWEEP: [f64; 3] = [FINGER_OPEN - 0.01, FINGER_OPEN, FINGER_OPEN + 0.012];
+/// Half the width (m) of a finger pad across the closing axis.
+const FINGER_HALF_WIDTH: f64 = 0.01;
+/// Height (m) of the palm's underside above the tool point.
+const PALM_ABOVE_TOOL: f64 = 0.034;
+/// Half the palm's length (m) along the closing axis, and half its width across it.
+const PALM_HALF_LENGTH: f64 = 0.1;
+const PALM_HALF_WIDTH: f64 = 0.025;
+/// Gap (m) a finger wants beside a neighbour's box.
+const FINGER_MARGIN: f64 = 0.005;
+/// A neighbour counts as beside the object when its top is this much (m) above the object's
+/// bottom.
+const LEVEL_TOLERANCE: f64 = 0.005;
 
 impl Sim {
     fn known_names(&self) -> String {
@@ -318,10 +334,86 @@ impl Sim {
                     }
                     _ => std::f64::consts::PI,
                 };
-                self.nearest_spin(pointing, object_yaw + p.grasp_yaw, step)
+                self.uncrowded_spin(part, pointing, object_yaw + p.grasp_yaw, step, target[2])
             }
         };
         self.do_move_to_position(target, pointing, crate::api::DEFAULT_LIFT_CLEARANCE, yaw)
+    }
+
+    /// Of the finger grasp spins `angle + k·step`, the one nearest the current tool whose
+    /// hand comes down to `tool_z` clear of every other loose object; when every spin touches
+    /// one, the spin whose tallest touched neighbour is lowest. Two parts of the hand can hit a neighbour: the open fingers, beside the
+    /// object at its own level (a cube grasped with one finger on its neighbour too drags the
+    /// neighbour along), and the 20 cm long palm, above any neighbour taller than the grasp
+    /// (a two-cube stack beside the object is knocked over).
+    fn uncrowded_spin(&self, part: usize, pointing: Direction, angle: f64, step: f64, tool_z: f64) -> f64 {
+        let spins = self.spins_by_nearness(pointing, angle, step);
+        let Some(&nearest) = spins.first() else {
+            return angle;
+        };
+        if pointing != Direction::Down {
+            return nearest;
+        }
+        let object = self.part_aabb(part);
+        let centre = object.centre();
+        let held = self.held.map(|h| h.part);
+        let neighbours: Vec<Aabb> = (0..self.parts.len())
+            .filter(|&i| i != part && Some(i) != held && self.parts[i].role == PartRole::Loose)
+            .map(|i| self.part_aabb(i))
+            .collect();
+        let palm_z = tool_z + PALM_ABOVE_TOOL;
+        // A sample point of the hand: distance along the closing axis, across it, and which
+        // neighbours it can meet.
+        // How bad a spin is: the height of the tallest neighbour the hand would touch (a
+        // tower knocked over scatters more than a single cube nudged), or 0 when none.
+        let crowding = |spin: f64| {
+            let rotation = Sim::pointing(pointing, spin);
+            let along = rotation * Vector3::y();
+            let across = rotation * Vector3::x();
+            // The tallest neighbour that `reaches` the hand's sample point at `s` along the
+            // closing axis and `t` across it.
+            let touched = |s: f64, t: f64, reaches: &dyn Fn(&Aabb) -> bool| {
+                let at = [
+                    centre[0] + along.x * s + across.x * t,
+                    centre[1] + along.y * s + across.y * t,
+                ];
+                neighbours
+                    .iter()
+                    .filter(|n| {
+                        reaches(n)
+                            && (0..2)
+                                .all(|i| at[i] > n.min[i] - FINGER_MARGIN && at[i] < n.max[i] + FINGER_MARGIN)
+                    })
+                    .map(|n| n.max[2] - TABLE_TOP)
+                    .fold(0.0, f64::max)
+            };
+            let beside = |n: &Aabb| n.max[2] > object.min[2] + LEVEL_TOLERANCE && n.min[2] < object.max[2];
+            let under_palm = |n: &Aabb| n.max[2] > palm_z;
+            let fingers = FINGER_SWEEP
+                .iter()
+                .flat_map(|&s| [s, -s])
+                .flat_map(|s| [-FINGER_HALF_WIDTH, 0.0, FINGER_HALF_WIDTH].map(|t| (s, t)))
+                .map(|(s, t)| touched(s, t, &beside))
+                .fold(0.0, f64::max);
+            let palm = (-4..=4)
+                .map(|k| PALM_HALF_LENGTH * f64::from(k) / 4.0)
+                .flat_map(|s| [-PALM_HALF_WIDTH, 0.0, PALM_HALF_WIDTH].map(|t| (s, t)))
+                .map(|(s, t)| touched(s, t, &under_palm))
+                .fold(0.0, f64::max);
+            f64::max(fingers, palm)
+        };
+        let scored: Vec<(f64, f64)> = spins.iter().map(|&spin| (spin, crowding(spin))).collect();
+        if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
+            eprintln!(
+                "grasp spins of {} (spin, crowding): {scored:?}",
+                self.parts[part].name
+            );
+        }
+        // The least crowded; among equals, the nearest (min_by keeps the first).
+        scored
+            .iter()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(nearest, |&(spin, _)| spin)
     }
 
     fn do_move_parallel(&mut self, dir: Direction, offset: f64) -> Result<(), ApiError> {

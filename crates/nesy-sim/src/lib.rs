@@ -19,6 +19,7 @@ pub mod kinematics;
 pub mod motion;
 pub mod objects;
 pub mod observer;
+pub mod planner;
 pub mod render;
 pub mod rng;
 pub mod robot;

@@ -9,6 +9,8 @@ use crate::api::{ApiError, Direction, Embodiment};
 use crate::geometry::{array_to_na, iso_to_pose};
 use crate::kinematics::{IkOptions, Iso, OrientationGoal, pointing_rotation};
 use crate::objects::PartRole;
+use crate::planner::{self, PlannerOptions};
+use crate::rng::Stream;
 use crate::sim::{CONTROL_DT, Sim, TABLE_TOP};
 
 /// The quadratic ease-in/out profile of spec §4: `2t²` below ½, `1 − 2(1 − t)²` above.
@@ -42,6 +44,8 @@ const CHECK_SPACING: f64 = 0.03;
 const DETOUR_HEIGHTS: [f64; 3] = [0.06, 0.12, 0.2];
 /// Highest tool position (m above the table) a detour uses; above it the arm runs out of reach.
 const DETOUR_CEILING: f64 = 0.55;
+/// Distance (rad) the joint-space planner keeps from every joint limit.
+const LIMIT_MARGIN: f64 = 0.05;
 
 /// Fractions of the lift clearance tried, longest first, for an approach point next to an
 /// object.
@@ -88,16 +92,25 @@ impl Sim {
 
     /// Of the spins `angle + k·step`, the one whose rotation is closest to the current tool.
     pub(crate) fn nearest_spin(&self, dir: Direction, angle: f64, step: f64) -> f64 {
+        self.spins_by_nearness(dir, angle, step)
+            .first()
+            .copied()
+            .unwrap_or(angle)
+    }
+
+    /// The spins `angle + k·step` (one full turn), closest to the current tool rotation first.
+    pub(crate) fn spins_by_nearness(&self, dir: Direction, angle: f64, step: f64) -> Vec<f64> {
         let current = self.tool_pose().rotation;
         let n = (std::f64::consts::TAU / step).round().max(1.0) as usize;
-        (0..n)
-            .map(|k| crate::geometry::wrap_angle(angle + k as f64 * step))
-            .min_by(|a, b| {
-                let da = Sim::pointing(dir, *a).angle_to(&current);
-                let db = Sim::pointing(dir, *b).angle_to(&current);
-                da.total_cmp(&db)
+        let mut spins: Vec<(f64, f64)> = (0..n)
+            .map(|k| {
+                let spin = crate::geometry::wrap_angle(angle + k as f64 * step);
+                (spin, Sim::pointing(dir, spin).angle_to(&current))
             })
-            .unwrap_or(angle)
+            .collect();
+        // Stable: equally near spins keep their k order.
+        spins.sort_by(|a, b| a.1.total_cmp(&b.1));
+        spins.into_iter().map(|(spin, _)| spin).collect()
     }
 
     /// Plans joint paths through the tool waypoints (each reached by IK, nothing moved).
@@ -282,10 +295,98 @@ impl Sim {
                 return route;
             }
         }
+        // No tool-space route is clear (typically the arm is on a branch from which straight
+        // lines run joints into their limits, so the segments fell back to joint interpolation
+        // through the objects): search joint space for a collision-free path instead.
+        if let Some(route) = self.joint_space_transit(&direct, q_from, wp) {
+            return vec![route];
+        }
         if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
-            eprintln!("  no clear detour");
+            eprintln!("  no clear detour and no joint-space path");
         }
         vec![direct]
+    }
+
+    /// A collision-free joint path from `q_from` to an IK solution of `wp` (the direct
+    /// transit's own, or one on the home branch), found by [`planner::plan`]. It avoids every
+    /// object that is not held, fixed ones included (the search may swing the arm anywhere),
+    /// except those already within reach of the arm at either end, and keeps every moving
+    /// collider that starts above the table top above it.
+    fn joint_space_transit(
+        &self,
+        direct: &[Vec<f64>],
+        q_from: &[f64],
+        wp: &ToolGoal,
+    ) -> Option<Vec<Vec<f64>>> {
+        let mut goals: Vec<Vec<f64>> = direct.last().cloned().into_iter().collect();
+        if let Some(q) = self.ik(wp, &crate::robot::HOME_ARM, &IkOptions::default())
+            && goals.iter().all(|g| max_delta(g, &q) > 1e-3)
+        {
+            goals.push(q);
+        }
+        let obstacles: Vec<Obstacle<'_>> = self
+            .planning_obstacles()
+            .into_iter()
+            .filter(|o| {
+                let one = std::slice::from_ref(o);
+                self.configuration_is_clear(q_from, one)
+                    && goals.iter().any(|g| self.configuration_is_clear(g, one))
+            })
+            .collect();
+        // Colliders (in `moving_shapes` order) that start clear of the table and must stay so.
+        let above_table: Vec<bool> = self
+            .moving_shapes(q_from)
+            .iter()
+            .map(|(shape, pose)| {
+                f64::from(shape.compute_aabb(pose).mins.z) > TABLE_TOP + f64::from(TRANSIT_GAP)
+            })
+            .collect();
+        let is_valid = |q: &[f64]| {
+            let moving = self.moving_shapes(q);
+            let table_clear = moving.iter().zip(&above_table).all(|((shape, pose), &check)| {
+                !check || f64::from(shape.compute_aabb(pose).mins.z) > TABLE_TOP + f64::from(TRANSIT_GAP)
+            });
+            table_clear && shapes_are_clear(&moving, &obstacles)
+        };
+        let limits: Vec<(f64, f64)> = self
+            .robot
+            .model
+            .arm_limits
+            .iter()
+            .map(|&(lo, hi)| (lo + LIMIT_MARGIN, hi - LIMIT_MARGIN))
+            .collect();
+        // Seeded by the problem itself, so a replayed run plans the same path.
+        let seed = q_from
+            .iter()
+            .chain(wp.position.iter())
+            .fold(0u64, |h, v| h.rotate_left(7) ^ v.to_bits());
+        let mut rng = Stream::new("motion/joint-space-transit", seed);
+        let options = PlannerOptions {
+            check_spacing: CHECK_SPACING,
+            ..PlannerOptions::default()
+        };
+        let path = planner::plan(q_from, &goals, &limits, is_valid, &mut rng, &options);
+        if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
+            eprintln!(
+                "  joint-space transit ({} goals, {} obstacles): {}",
+                goals.len(),
+                obstacles.len(),
+                path.as_ref()
+                    .map_or("none".to_string(), |p| format!("{} configurations", p.len()))
+            );
+        }
+        path
+    }
+
+    /// Every object that is not held (loose, fixed and articulated), with its current shapes.
+    fn planning_obstacles(&self) -> Vec<Obstacle<'_>> {
+        let held = self.held.map(|h| h.part);
+        self.parts
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| Some(*i) != held)
+            .map(|(i, p)| self.obstacle(i, &p.colliders))
+            .collect()
     }
 
     /// The approach distance for a move to `goal` along `dir` (unit, the pointing): the
@@ -337,16 +438,18 @@ impl Sim {
             .iter()
             .enumerate()
             .filter(|(i, p)| p.role == PartRole::Loose && Some(*i) != held)
-            .map(|(i, p)| {
-                let aabb = self.part_aabb(i);
-                Obstacle {
-                    part: i,
-                    shapes: self.collider_shapes(&p.colliders),
-                    min: aabb.min.map(|v| v as f32),
-                    max: aabb.max.map(|v| v as f32),
-                }
-            })
+            .map(|(i, p)| self.obstacle(i, &p.colliders))
             .collect()
+    }
+
+    fn obstacle(&self, part: usize, colliders: &[ColliderHandle]) -> Obstacle<'_> {
+        let aabb = self.part_aabb(part);
+        Obstacle {
+            part,
+            shapes: self.collider_shapes(colliders),
+            min: aabb.min.map(|v| v as f32),
+            max: aabb.max.map(|v| v as f32),
+        }
     }
 
     fn collider_shapes(&self, colliders: &[ColliderHandle]) -> Vec<(&dyn rapier3d::prelude::Shape, Pose)> {
@@ -381,6 +484,11 @@ impl Sim {
     }
 
     fn configuration_is_clear(&self, q: &[f64], obstacles: &[Obstacle<'_>]) -> bool {
+        shapes_are_clear(&self.moving_shapes(q), obstacles)
+    }
+
+    /// The shapes and world poses of the arm, the gripper and the carried object at `q`.
+    fn moving_shapes(&self, q: &[f64]) -> Vec<(&dyn rapier3d::prelude::Shape, Pose)> {
         let poses = self.robot.model.link_poses(q, self.gripper);
         let mut moving: Vec<(&dyn rapier3d::prelude::Shape, Pose)> = Vec::new();
         for &(li, body) in &self.robot.bodies {
@@ -400,26 +508,7 @@ impl Sim {
                 moving.push((collider.shape(), carrier * held.relative * local));
             }
         }
-        for (shape, pose) in &moving {
-            let aabb = shape.compute_aabb(pose);
-            for obstacle in obstacles {
-                let apart = (0..3).any(|i| {
-                    aabb.mins[i] > obstacle.max[i] + TRANSIT_GAP
-                        || obstacle.min[i] > aabb.maxs[i] + TRANSIT_GAP
-                });
-                if apart {
-                    continue;
-                }
-                for (other, other_pose) in &obstacle.shapes {
-                    let near = rapier3d::parry::query::distance(pose, *shape, other_pose, *other)
-                        .map_or(true, |d| d.distance < TRANSIT_GAP);
-                    if near {
-                        return false;
-                    }
-                }
-            }
-        }
-        true
+        moving
     }
 
     /// Plays planned segments back with eased timing, then settles.
@@ -454,6 +543,29 @@ impl Sim {
         }
         self.step_idle(settle);
     }
+}
+
+/// Whether every moving shape stays [`TRANSIT_GAP`] away from every obstacle.
+fn shapes_are_clear(moving: &[(&dyn rapier3d::prelude::Shape, Pose)], obstacles: &[Obstacle<'_>]) -> bool {
+    for (shape, pose) in moving {
+        let aabb = shape.compute_aabb(pose);
+        for obstacle in obstacles {
+            let apart = (0..3).any(|i| {
+                aabb.mins[i] > obstacle.max[i] + TRANSIT_GAP || obstacle.min[i] > aabb.maxs[i] + TRANSIT_GAP
+            });
+            if apart {
+                continue;
+            }
+            for (other, other_pose) in &obstacle.shapes {
+                let near = rapier3d::parry::query::distance(pose, *shape, other_pose, *other)
+                    .map_or(true, |d| d.distance < TRANSIT_GAP);
+                if near {
+                    return false;
+                }
+            }
+        }
+    }
+    true
 }
 
 fn max_delta(a: &[f64], b: &[f64]) -> f64 {

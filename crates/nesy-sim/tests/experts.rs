@@ -127,6 +127,22 @@ fn knocked_fruit_stops_rolling() {
     benchmark_scene("grip_medium_11_s1", Side::Target);
 }
 
+/// After the lid swing the wrist is on a branch from which no straight line reaches the next
+/// chess piece, and joint interpolation swung the hand through the pieces; the transit now
+/// falls back to the joint-space planner, which goes around them.
+#[test]
+fn transit_after_lid_swing_plans_in_joint_space() {
+    benchmark_scene("vacu_medium_01_s0", Side::Target);
+}
+
+/// Grasping a cube beside a two-cube stack: the spin whose fingers meet the stack knocked
+/// the top cube onto its neighbour, which then rode into the box out of order; the grasp now
+/// turns its fingers toward the lower neighbour.
+#[test]
+fn grasp_spin_avoids_a_neighbouring_stack() {
+    benchmark_scene("comb_high_06_s1", Side::Target);
+}
+
 #[test]
 #[ignore = "heavy: run with --ignored (or use the expert_sweep example)"]
 fn expert_sweep_over_generated_tasks() {
