@@ -14,6 +14,7 @@
 //! span several lines, and an empty section is `None`. Names are normalised with
 //! [`super::normalize_action_name`].
 
+use super::direct;
 use super::lines::{Line, header, is_content_line, normalize_action_name, paren_delta, split_lines};
 use super::sexpr::{Item, parse_items};
 use super::syntax::Converter;
@@ -52,7 +53,9 @@ fn section(
     let mut i = header_idx + 1;
     while i < lines.len() {
         let l = &lines[i];
-        if depth > 0 {
+        // A line opening a formula (the bulk of a body) is content: not a fence, not blank,
+        // not a header. The general tests below agree; this skips them.
+        if depth > 0 || l.text.trim_start().starts_with('(') {
             depth += paren_delta(l.text);
             end = l.end();
             i += 1;
@@ -89,6 +92,22 @@ fn section(
 
 /// Parses the formulas of a precondition body (`None` or formulas).
 pub(crate) fn precondition_items(doc: &str, start: usize, end: usize) -> Result<Vec<Formula>, ParseError> {
+    if let Some(formulas) = direct::preconditions(doc, start, end) {
+        // Debug builds (every test, the fuzz targets) check that the direct reader agrees
+        // with the general path wherever it answers.
+        debug_assert_eq!(
+            Ok(&formulas),
+            general_precondition_items(doc, start, end).as_ref(),
+            "direct reader disagrees on {:?}",
+            &doc[start..end]
+        );
+        return Ok(formulas);
+    }
+    general_precondition_items(doc, start, end)
+}
+
+/// [`precondition_items`] through the s-expression tree: every input, and every error.
+fn general_precondition_items(doc: &str, start: usize, end: usize) -> Result<Vec<Formula>, ParseError> {
     let conv = Converter::new(doc, false);
     let items = parse_items(doc, start, end)?;
     let mut out = Vec::new();
@@ -112,6 +131,20 @@ pub(crate) fn precondition_items(doc: &str, start: usize, end: usize) -> Result<
 
 /// Parses the effects of an effect body (`None` or effects; `(and ...)` is flattened).
 pub(crate) fn effect_items(doc: &str, start: usize, end: usize) -> Result<Vec<Effect>, ParseError> {
+    if let Some(effects) = direct::effects(doc, start, end) {
+        debug_assert_eq!(
+            Ok(&effects),
+            general_effect_items(doc, start, end).as_ref(),
+            "direct reader disagrees on {:?}",
+            &doc[start..end]
+        );
+        return Ok(effects);
+    }
+    general_effect_items(doc, start, end)
+}
+
+/// [`effect_items`] through the s-expression tree: every input, and every error.
+fn general_effect_items(doc: &str, start: usize, end: usize) -> Result<Vec<Effect>, ParseError> {
     let conv = Converter::new(doc, false);
     let items = parse_items(doc, start, end)?;
     let mut out = Vec::new();
@@ -279,6 +312,73 @@ mod tests {
         );
         assert_eq!(parse_procedure(&format_procedure(&ops)).unwrap(), ops);
         assert_eq!(parse_procedure("None").unwrap(), vec![]);
+    }
+
+    /// The direct reader against the general path on well-formed bodies and on every
+    /// variant with one character deleted or one structural piece inserted: where the direct
+    /// reader answers, the answer is the general path's.
+    #[test]
+    fn direct_reader_agrees_with_the_general_path() {
+        const BODIES: [&str; 7] = [
+            "\n\t(VacuumSuction)\n\t(forall (?y - thing) (not (OnTopOf ?y green_cylinder)))\n",
+            "- (exists (?a ?b - block ?c) (and (on ?a ?b) (not (= ?a ?c))))\n* (imply (A) (or (B x) (C)))",
+            "1. (and (A) (not (B)))\n2) (forall (?x - thing)\n   (when (C ?x) (and (D ?x) (not (E ?x)))))",
+            "\tNone\n",
+            "(not (GripperHolding orange)) (OverOf orange floor)",
+            "+ (forall (?x ?y - thing) (when (and (P ?x) (Q ?y)) (not (R ?x ?y))))",
+            "(or) (and) (= a b)",
+        ];
+        const PIECES: [&str; 12] = [
+            "(", ")", " ", "?", "-", "x", "None", "\n- ", ";", "•", "and ", "?y",
+        ];
+        let mut checked = 0;
+        let mut answered = 0;
+        let mut check = |text: &str| {
+            let end = text.len();
+            if let Some(fast) = direct::preconditions(text, 0, end) {
+                assert_eq!(Ok(fast), general_precondition_items(text, 0, end), "{text:?}");
+                answered += 1;
+            }
+            if let Some(fast) = direct::effects(text, 0, end) {
+                assert_eq!(Ok(fast), general_effect_items(text, 0, end), "{text:?}");
+                answered += 1;
+            }
+            checked += 1;
+        };
+        for body in BODIES {
+            check(body);
+            for (at, c) in body.char_indices() {
+                check(&format!("{}{}", &body[..at], &body[at + c.len_utf8()..]));
+                for piece in PIECES {
+                    check(&format!("{}{piece}{}", &body[..at], &body[at..]));
+                }
+            }
+        }
+        // Several random edits at once.
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |n: usize| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % n as u64) as usize
+        };
+        for _ in 0..20_000 {
+            let mut text = BODIES[next(BODIES.len())].to_string();
+            for _ in 0..1 + next(4) {
+                let at = next(text.len() + 1);
+                let at = (0..=at).rev().find(|&i| text.is_char_boundary(i)).unwrap_or(0);
+                if next(2) == 0 && at < text.len() {
+                    text.remove(at);
+                } else {
+                    text.insert_str(at, PIECES[next(PIECES.len())]);
+                }
+            }
+            check(&text);
+        }
+        assert!(
+            checked > 20_000 && answered > 5_000,
+            "{checked} checked, {answered} answered"
+        );
     }
 
     #[test]

@@ -18,6 +18,7 @@
 //! hands each section's text to the s-expression parser.
 
 mod action_block;
+mod direct;
 mod induction;
 pub(crate) mod lines;
 mod refinement;

@@ -36,6 +36,11 @@ enum Marker {
 
 fn marker(line: &Line<'_>) -> Option<Marker> {
     let t = line.text.trim();
+    // Fast reject for the bulk of lines (formulas, names, headers): a marker line starts
+    // with a marker character or a backtick.
+    if !matches!(t.as_bytes().first(), Some(b'<' | b'=' | b'>' | b'`')) {
+        return None;
+    }
     let t = t.trim_start_matches('`').trim_end_matches('`').trim();
     let run = |c: char| t.chars().take_while(|x| *x == c).count();
     let rest = |n: usize| t[n..].trim();
@@ -104,11 +109,11 @@ pub fn parse_refinement_reply(text: &str) -> Result<RefinementReply, ParseError>
                 }
                 let replace_lines = &lines[d + 1..r];
                 let only_none = {
-                    let sig: Vec<_> = replace_lines
-                        .iter()
-                        .filter(|l| !l.is_blank() && !l.is_fence())
-                        .collect();
-                    sig.len() == 1 && sig[0].text.trim().eq_ignore_ascii_case("none")
+                    let mut sig = replace_lines.iter().filter(|l| !l.is_blank() && !l.is_fence());
+                    match (sig.next(), sig.next()) {
+                        (Some(l), None) => l.text.trim().eq_ignore_ascii_case("none"),
+                        _ => false,
+                    }
                 };
                 let replace = if only_none {
                     Vec::new()
