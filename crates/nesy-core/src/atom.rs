@@ -49,7 +49,53 @@ pub(crate) fn locate(id: u32) -> (usize, usize) {
     (k, (u64::from(id) - start) as usize)
 }
 
+/// Slots of the per-thread memo in front of the shared table (a power of two).
+const MEMO_SLOTS: usize = 4096;
+
+/// One memo slot: predicate and up to three argument indices, the arity plus one (0 marks
+/// an empty slot) and the atom's id.
+#[derive(Clone, Copy)]
+struct MemoSlot {
+    key: [u32; 4],
+    arity: u32,
+    id: u32,
+}
+
+thread_local! {
+    /// Grounding interns the same atoms over and over (every quantifier instance, every
+    /// verification); a direct-mapped memo answers those without the shared table's lock
+    /// and hash probe. Ids never change once handed out, so a slot can never be stale.
+    static MEMO: std::cell::RefCell<Box<[MemoSlot]>> = std::cell::RefCell::new(
+        vec![MemoSlot { key: [0; 4], arity: 0, id: 0 }; MEMO_SLOTS].into_boxed_slice()
+    );
+}
+
 fn intern(pred: Symbol, args: Args) -> u32 {
+    if args.len() > 3 {
+        return intern_shared(pred, args);
+    }
+    let mut key = [pred.index(), 0, 0, 0];
+    for (k, a) in key[1..].iter_mut().zip(&args) {
+        *k = a.index();
+    }
+    let arity = args.len() as u32 + 1;
+    let hash = key.iter().chain(std::iter::once(&arity)).fold(0u64, |h, &x| {
+        (h.rotate_left(5) ^ u64::from(x)).wrapping_mul(0x517c_c1b7_2722_0a95)
+    });
+    let slot = (hash >> 52) as usize % MEMO_SLOTS;
+    MEMO.with_borrow_mut(|memo| {
+        let entry = &mut memo[slot];
+        if entry.arity == arity && entry.key == key {
+            return entry.id;
+        }
+        let id = intern_shared(pred, args);
+        *entry = MemoSlot { key, arity, id };
+        id
+    })
+}
+
+/// Looks up or creates the id of `(pred, args)` in the process-wide table.
+fn intern_shared(pred: Symbol, args: Args) -> u32 {
     let key = (pred, args);
     if let Some(&id) = ATOMS.read().unwrap_or_else(|e| e.into_inner()).get(&key) {
         return id;
@@ -267,6 +313,30 @@ mod tests {
         assert_ne!(a, Atom::new("OnTopOf", &["y", "x"]));
         assert_eq!(a.arity(), 2);
         assert!(a.mentions(Symbol::new("y")));
+    }
+
+    #[test]
+    fn memo_collisions_keep_identity() {
+        // Far more atoms than memo slots, of every arity the memo covers and one it does
+        // not, interned twice in different orders and from another thread.
+        let keys: Vec<(String, Vec<String>)> = (0..12_000)
+            .map(|i| {
+                let args = (0..i % 5).map(|j| format!("memo_o{}", (i + j) % 97)).collect();
+                (format!("MemoP{}", i % 41), args)
+            })
+            .collect();
+        let build = |(p, args): &(String, Vec<String>)| {
+            Atom::new(p, &args.iter().map(String::as_str).collect::<Vec<_>>())
+        };
+        let first: Vec<Atom> = keys.iter().map(build).collect();
+        for (key, atom) in keys.iter().zip(&first).rev() {
+            assert_eq!(build(key), *atom);
+            assert_eq!(atom.pred().as_str(), key.0);
+            assert_eq!(atom.args().len(), key.1.len());
+        }
+        let again = std::thread::scope(|s| s.spawn(|| keys.iter().map(build).collect::<Vec<_>>()).join());
+        assert_eq!(again.unwrap(), first);
+        assert_ne!(first[0], first[41]);
     }
 
     #[test]

@@ -54,6 +54,11 @@ impl Symbol {
         })
     }
 
+    /// The dense interned index (stable for the life of the process).
+    pub(crate) fn index(self) -> u32 {
+        self.0.into_usize() as u32
+    }
+
     /// Returns the symbol for `name` only if it has been interned already.
     pub fn lookup(name: &str) -> Option<Self> {
         INTERNER.get(name).map(Symbol)

@@ -24,6 +24,8 @@ use crate::operator::Operator;
 
 const PRE_LABELS: &[&str] = &["precondition", "pre condition"];
 const EFF_LABELS: &[&str] = &["effect"];
+/// Either section header (one pass instead of two over an action-name line).
+const SECTION_LABELS: &[&str] = &["precondition", "pre condition", "effect"];
 
 /// Section bodies as (start, end) byte ranges, plus the index of the line after the block.
 struct SectionSpan {
@@ -32,16 +34,18 @@ struct SectionSpan {
 }
 
 /// Collects a section body that starts at `inline` (offset on the header line) and
-/// continues over the following content lines. Returns the span and the index of the first
-/// line after it. With `allow_blank`, blank lines inside the body are skipped (used for
-/// preconditions, which must be followed by the effects header anyway).
+/// continues over the following content lines. Returns the span, the index of the first
+/// line after it and, if that line is a header with one of the `stop` labels, the offset of
+/// its inline content (what [`header`] returns for it). With `allow_blank`, blank lines
+/// inside the body are skipped (used for preconditions, which must be followed by the
+/// effects header anyway).
 fn section(
     lines: &[Line<'_>],
     header_idx: usize,
     inline: usize,
     stop: &[&str],
     allow_blank: bool,
-) -> (SectionSpan, usize) {
+) -> (SectionSpan, usize, Option<usize>) {
     let header_line = &lines[header_idx];
     let inline_text = &header_line.text[inline - header_line.start..];
     let mut depth = paren_delta(inline_text);
@@ -51,6 +55,7 @@ fn section(
         header_line.end()
     };
     let mut i = header_idx + 1;
+    let mut stopped_at = None;
     while i < lines.len() {
         let l = &lines[i];
         // A line opening a formula (the bulk of a body) is content: not a fence, not blank,
@@ -71,7 +76,10 @@ fn section(
             }
             break;
         }
-        if !stop.is_empty() && header(l, stop).is_some() {
+        if !stop.is_empty()
+            && let Some(at) = header(l, stop)
+        {
+            stopped_at = Some(at);
             break;
         }
         if !is_content_line(l.text) {
@@ -87,6 +95,7 @@ fn section(
             end: end.max(inline),
         },
         i,
+        stopped_at,
     )
 }
 
@@ -183,7 +192,7 @@ pub(crate) fn parse_blocks(doc: &str, lines: &[Line<'_>], strict: bool) -> Resul
             i += 1;
             continue;
         }
-        if header(l, PRE_LABELS).is_some() || header(l, EFF_LABELS).is_some() {
+        if header(l, SECTION_LABELS).is_some() {
             return Err(ParseError::at(
                 doc,
                 l.content_start(),
@@ -230,10 +239,9 @@ pub(crate) fn parse_blocks(doc: &str, lines: &[Line<'_>], strict: bool) -> Resul
                 "an action name",
             ));
         };
-        let (pre_span, after_pre) = section(lines, pre_idx, pre_inline, EFF_LABELS, true);
-        let eff_header = (after_pre < lines.len())
-            .then(|| header(&lines[after_pre], EFF_LABELS))
-            .flatten();
+        // The preconditions end at the effects header, if there is one: a fence, a prose
+        // line or the end of the lines are not one.
+        let (pre_span, after_pre, eff_header) = section(lines, pre_idx, pre_inline, EFF_LABELS, true);
         let Some(eff_inline) = eff_header else {
             let at = lines.get(after_pre).map_or(doc.len(), |l| l.content_start());
             return Err(ParseError::at(
@@ -243,7 +251,7 @@ pub(crate) fn parse_blocks(doc: &str, lines: &[Line<'_>], strict: bool) -> Resul
                 format!("a `- Effects:` line for action {name}, or a formula of its preconditions"),
             ));
         };
-        let (eff_span, after_eff) = section(lines, after_pre, eff_inline, &[], false);
+        let (eff_span, after_eff, _) = section(lines, after_pre, eff_inline, &[], false);
         let pre = precondition_items(doc, pre_span.start, pre_span.end)?;
         let eff = effect_items(doc, eff_span.start, eff_span.end)?;
         ops.push(Operator::new(name, pre, eff));
