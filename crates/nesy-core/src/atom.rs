@@ -71,11 +71,17 @@ thread_local! {
 }
 
 fn intern(pred: Symbol, args: Args) -> u32 {
+    intern_slice(pred, &args)
+}
+
+/// [`intern`] from borrowed arguments: the argument list is copied only when the shared
+/// table has to be consulted.
+fn intern_slice(pred: Symbol, args: &[Symbol]) -> u32 {
     if args.len() > 3 {
-        return intern_shared(pred, args);
+        return intern_shared(pred, args.iter().copied().collect());
     }
     let mut key = [pred.index(), 0, 0, 0];
-    for (k, a) in key[1..].iter_mut().zip(&args) {
+    for (k, a) in key[1..].iter_mut().zip(args) {
         *k = a.index();
     }
     let arity = args.len() as u32 + 1;
@@ -88,7 +94,7 @@ fn intern(pred: Symbol, args: Args) -> u32 {
         if entry.arity == arity && entry.key == key {
             return entry.id;
         }
-        let id = intern_shared(pred, args);
+        let id = intern_shared(pred, args.iter().copied().collect());
         *entry = MemoSlot { key, arity, id };
         id
     })
@@ -147,6 +153,12 @@ impl Atom {
     /// Builds an atom from already interned symbols.
     pub fn from_symbols(pred: Symbol, args: impl IntoIterator<Item = Symbol>) -> Self {
         Atom(intern(pred, args.into_iter().collect()))
+    }
+
+    /// [`Atom::from_symbols`] from a slice (grounding's hot path: no argument list is built
+    /// when the atom is already known to this thread).
+    pub(crate) fn from_slice(pred: Symbol, args: &[Symbol]) -> Self {
+        Atom(intern_slice(pred, args))
     }
 
     fn data(self) -> &'static AtomData {

@@ -71,7 +71,7 @@ impl AtomPattern {
         for t in &self.args {
             args.push(env.resolve(*t)?);
         }
-        Ok(Atom::from_symbols(self.pred, args))
+        Ok(Atom::from_slice(self.pred, &args))
     }
 }
 
