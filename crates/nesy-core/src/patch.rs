@@ -10,6 +10,7 @@
 //! An empty REPLACE removes the matched actions; an empty SEARCH is an error (there is no
 //! anchor to insert at).
 
+use std::cell::OnceCell;
 use std::fmt;
 use std::hash::{Hash, Hasher};
 
@@ -105,11 +106,13 @@ impl ActionKey {
 /// printed form parses back to the same formula, which `tests/roundtrip.rs` checks), so two
 /// formulas are equal exactly when their canonical printed forms are, and `MatchKey`s are
 /// equal exactly when the corresponding `ActionKey`s are. Matching a SEARCH block against a
-/// procedure compares every action; only the error message needs the printed forms.
+/// procedure compares every action; only the error message needs the printed forms. The
+/// formula sets are built on first use: most comparisons are settled by the names.
 struct MatchKey<'a> {
     name: String,
-    pre: Vec<(u64, &'a Formula)>,
-    eff: Vec<(u64, &'a Effect)>,
+    op: &'a Operator,
+    pre: OnceCell<Vec<(u64, &'a Formula)>>,
+    eff: OnceCell<Vec<(u64, &'a Effect)>>,
 }
 
 /// The items with their hashes, duplicates removed (a set).
@@ -140,15 +143,24 @@ impl<'a> MatchKey<'a> {
         };
         MatchKey {
             name,
-            pre: hashed_set(&op.pre),
-            eff: hashed_set(&op.eff),
+            op,
+            pre: OnceCell::new(),
+            eff: OnceCell::new(),
         }
+    }
+
+    fn pre(&self) -> &[(u64, &'a Formula)] {
+        self.pre.get_or_init(|| hashed_set(&self.op.pre))
+    }
+
+    fn eff(&self) -> &[(u64, &'a Effect)] {
+        self.eff.get_or_init(|| hashed_set(&self.op.eff))
     }
 }
 
 impl PartialEq for MatchKey<'_> {
     fn eq(&self, other: &Self) -> bool {
-        self.name == other.name && same_set(&self.pre, &other.pre) && same_set(&self.eff, &other.eff)
+        self.name == other.name && same_set(self.pre(), other.pre()) && same_set(self.eff(), other.eff())
     }
 }
 
