@@ -85,6 +85,7 @@ fn main() {
         .collect();
     let next = AtomicUsize::new(0);
     let ok = AtomicUsize::new(0);
+    let displaced = AtomicUsize::new(0);
     let out = Mutex::new(());
     let started = Instant::now();
     std::thread::scope(|scope| {
@@ -109,14 +110,19 @@ fn main() {
                         results,
                         run.expert_error.map(|e| format!(" -- {e}")).unwrap_or_default()
                     );
+                    if !run.outcome.displaced.is_empty() {
+                        displaced.fetch_add(1, Ordering::Relaxed);
+                        println!("     displaced at the end: {}", run.outcome.displaced.join(", "));
+                    }
                 }
             });
         }
     });
     println!(
-        "{}/{} full_success in {:.1} s",
+        "{}/{} full_success in {:.1} s; {} end with a latched object displaced",
         ok.load(Ordering::Relaxed),
         jobs.len(),
-        started.elapsed().as_secs_f64()
+        started.elapsed().as_secs_f64(),
+        displaced.load(Ordering::Relaxed)
     );
 }

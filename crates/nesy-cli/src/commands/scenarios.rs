@@ -156,6 +156,9 @@ struct SceneResult {
     full_success: bool,
     results: Vec<&'static str>,
     expert_error: Option<String>,
+    /// Latched objects out of place at the end: the scene passes the authors' latch, but a
+    /// demo recorded from it does not show its goal (`nesy record` refuses it).
+    displaced: Vec<String>,
     actions: usize,
     sim_seconds: f64,
     wall_seconds: f64,
@@ -244,6 +247,25 @@ fn sweep(
         let ok = of_side.iter().filter(|(_, r)| r.full_success).count();
         outln!("  {side}: {ok}/{}", of_side.len())?;
     }
+    let displaced: Vec<_> = results
+        .iter()
+        .filter(|(_, r)| r.full_success && !r.displaced.is_empty())
+        .collect();
+    if !displaced.is_empty() {
+        outln!(
+            "of the full_success scenes, {} end with a latched object out of place (unusable as demos):",
+            displaced.len()
+        )?;
+        for (_, r) in &displaced {
+            outln!(
+                "  {} {} ({}): {}",
+                r.scenario,
+                r.side,
+                r.embodiment,
+                r.displaced.join(", ")
+            )?;
+        }
+    }
     let failures: Vec<_> = results.iter().filter(|(_, r)| !r.full_success).collect();
     if !failures.is_empty() {
         outln!("failures:")?;
@@ -286,6 +308,7 @@ fn run_one(s: &Scenario, side: Side) -> SceneResult {
             full_success: run.full_success(),
             results: run.outcome.subtasks.iter().map(|o| o.result.as_str()).collect(),
             expert_error: run.expert_error.map(|e| e.to_string()),
+            displaced: run.outcome.displaced.clone(),
             actions: run.actions,
             sim_seconds: run.sim_seconds,
             wall_seconds: started.elapsed().as_secs_f64(),
@@ -297,6 +320,7 @@ fn run_one(s: &Scenario, side: Side) -> SceneResult {
             full_success: false,
             results: Vec::new(),
             expert_error: Some(message),
+            displaced: Vec::new(),
             actions: 0,
             sim_seconds: 0.0,
             wall_seconds: started.elapsed().as_secs_f64(),
