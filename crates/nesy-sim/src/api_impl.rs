@@ -342,10 +342,11 @@ impl Sim {
 
     /// Of the finger grasp spins `angle + k·step`, the one nearest the current tool whose
     /// hand comes down to `tool_z` clear of every other loose object; when every spin touches
-    /// one, the spin whose tallest touched neighbour is lowest. Two parts of the hand can hit a neighbour: the open fingers, beside the
-    /// object at its own level (a cube grasped with one finger on its neighbour too drags the
-    /// neighbour along), and the 20 cm long palm, above any neighbour taller than the grasp
-    /// (a two-cube stack beside the object is knocked over).
+    /// one, the spin whose tallest touched neighbour is lowest. Two parts of the hand can hit
+    /// a neighbour: the open fingers, beside the object at its own level (a cube grasped with
+    /// one finger on its neighbour too drags the neighbour along), and the 20 cm long palm,
+    /// above any neighbour taller than the grasp (a two-cube stack beside the object is
+    /// knocked over).
     fn uncrowded_spin(&self, part: usize, pointing: Direction, angle: f64, step: f64, tool_z: f64) -> f64 {
         let spins = self.spins_by_nearness(pointing, angle, step);
         let Some(&nearest) = spins.first() else {
@@ -362,8 +363,6 @@ impl Sim {
             .map(|i| self.part_aabb(i))
             .collect();
         let palm_z = tool_z + PALM_ABOVE_TOOL;
-        // A sample point of the hand: distance along the closing axis, across it, and which
-        // neighbours it can meet.
         // How bad a spin is: the height of the tallest neighbour the hand would touch (a
         // tower knocked over scatters more than a single cube nudged), or 0 when none.
         let crowding = |spin: f64| {

@@ -325,7 +325,7 @@ impl Sim {
             goals.push(q);
         }
         let obstacles: Vec<Obstacle<'_>> = self
-            .planning_obstacles()
+            .unheld_obstacles(|_| true)
             .into_iter()
             .filter(|o| {
                 let one = std::slice::from_ref(o);
@@ -378,17 +378,6 @@ impl Sim {
         path
     }
 
-    /// Every object that is not held (loose, fixed and articulated), with its current shapes.
-    fn planning_obstacles(&self) -> Vec<Obstacle<'_>> {
-        let held = self.held.map(|h| h.part);
-        self.parts
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| Some(*i) != held)
-            .map(|(i, p)| self.obstacle(i, &p.colliders))
-            .collect()
-    }
-
     /// The approach distance for a move to `goal` along `dir` (unit, the pointing): the
     /// longest of `clearance` and its fractions in [`APPROACH_FRACTIONS`] at which the arm
     /// reaches the approach point `goal − dir·c` without touching a loose object (the
@@ -431,25 +420,29 @@ impl Sim {
         clearance
     }
 
-    /// The loose objects that are not held, with their current shapes and boxes.
-    fn transit_obstacles(&self) -> Vec<Obstacle<'_>> {
+    /// The objects that are not held and whose role `keep` accepts, with their current shapes
+    /// and boxes.
+    fn unheld_obstacles(&self, keep: impl Fn(PartRole) -> bool) -> Vec<Obstacle<'_>> {
         let held = self.held.map(|h| h.part);
         self.parts
             .iter()
             .enumerate()
-            .filter(|(i, p)| p.role == PartRole::Loose && Some(*i) != held)
-            .map(|(i, p)| self.obstacle(i, &p.colliders))
+            .filter(|&(i, p)| keep(p.role) && Some(i) != held)
+            .map(|(i, p)| {
+                let aabb = self.part_aabb(i);
+                Obstacle {
+                    part: i,
+                    shapes: self.collider_shapes(&p.colliders),
+                    min: aabb.min.map(|v| v as f32),
+                    max: aabb.max.map(|v| v as f32),
+                }
+            })
             .collect()
     }
 
-    fn obstacle(&self, part: usize, colliders: &[ColliderHandle]) -> Obstacle<'_> {
-        let aabb = self.part_aabb(part);
-        Obstacle {
-            part,
-            shapes: self.collider_shapes(colliders),
-            min: aabb.min.map(|v| v as f32),
-            max: aabb.max.map(|v| v as f32),
-        }
+    /// The loose objects that are not held: what a transit must not touch.
+    fn transit_obstacles(&self) -> Vec<Obstacle<'_>> {
+        self.unheld_obstacles(|role| role == PartRole::Loose)
     }
 
     fn collider_shapes(&self, colliders: &[ColliderHandle]) -> Vec<(&dyn rapier3d::prelude::Shape, Pose)> {

@@ -241,6 +241,9 @@ fn shortcut(
 mod tests {
     use super::*;
 
+    /// The tests' joint limits: both joints in [0, 1].
+    const UNIT_SQUARE: [(f64, f64); 2] = [(0.0, 1.0), (0.0, 1.0)];
+
     /// A 2-D world with a wall at x ∈ [0.4, 0.6] that leaves a gap only at y > 0.8.
     fn outside_wall(q: &[f64]) -> bool {
         !((0.4..=0.6).contains(&q[0]) && q[1] < 0.8)
@@ -261,7 +264,7 @@ mod tests {
         let path = plan(
             &[0.1, 0.1],
             &[vec![0.3, 0.2]],
-            &[(0.0, 1.0), (0.0, 1.0)],
+            &UNIT_SQUARE,
             outside_wall,
             &mut rng,
             &options(),
@@ -278,7 +281,7 @@ mod tests {
         let path = plan(
             &start,
             std::slice::from_ref(&goal),
-            &[(0.0, 1.0), (0.0, 1.0)],
+            &UNIT_SQUARE,
             outside_wall,
             &mut rng,
             &options(),
@@ -306,7 +309,7 @@ mod tests {
             plan(
                 &[0.1, 0.1],
                 &[vec![0.9, 0.1]],
-                &[(0.0, 1.0), (0.0, 1.0)],
+                &UNIT_SQUARE,
                 outside_wall,
                 &mut rng,
                 &options(),
@@ -327,7 +330,7 @@ mod tests {
             plan(
                 &[0.1, 0.1],
                 &[vec![0.9, 0.1]],
-                &[(0.0, 1.0), (0.0, 1.0)],
+                &UNIT_SQUARE,
                 sealed,
                 &mut rng,
                 &quick
@@ -339,7 +342,7 @@ mod tests {
     #[test]
     fn invalid_start_or_goals_give_none() {
         let mut rng = Stream::new("planner/test", 3);
-        let limits = [(0.0, 1.0), (0.0, 1.0)];
+        let limits = UNIT_SQUARE;
         assert!(
             plan(
                 &[0.5, 0.1],

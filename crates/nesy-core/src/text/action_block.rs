@@ -101,18 +101,29 @@ fn section(
 
 /// Parses the formulas of a precondition body (`None` or formulas).
 pub(crate) fn precondition_items(doc: &str, start: usize, end: usize) -> Result<Vec<Formula>, ParseError> {
-    if let Some(formulas) = direct::preconditions(doc, start, end) {
-        // Debug builds (every test, the fuzz targets) check that the direct reader agrees
-        // with the general path wherever it answers.
-        debug_assert_eq!(
-            Ok(&formulas),
-            general_precondition_items(doc, start, end).as_ref(),
-            "direct reader disagrees on {:?}",
-            &doc[start..end]
-        );
-        return Ok(formulas);
-    }
-    general_precondition_items(doc, start, end)
+    direct_or_general(doc, start, end, direct::preconditions, general_precondition_items)
+}
+
+/// The direct reader's answer for the body `doc[start..end]`, or the general path's where the
+/// direct reader defers (every error comes from the general path). Debug builds (every test,
+/// the fuzz targets) check that the two agree wherever the direct reader answers.
+fn direct_or_general<T: PartialEq + std::fmt::Debug>(
+    doc: &str,
+    start: usize,
+    end: usize,
+    direct: fn(&str, usize, usize) -> Option<T>,
+    general: fn(&str, usize, usize) -> Result<T, ParseError>,
+) -> Result<T, ParseError> {
+    let Some(items) = direct(doc, start, end) else {
+        return general(doc, start, end);
+    };
+    debug_assert_eq!(
+        Ok(&items),
+        general(doc, start, end).as_ref(),
+        "direct reader disagrees on {:?}",
+        &doc[start..end]
+    );
+    Ok(items)
 }
 
 /// [`precondition_items`] through the s-expression tree: every input, and every error.
@@ -140,16 +151,7 @@ fn general_precondition_items(doc: &str, start: usize, end: usize) -> Result<Vec
 
 /// Parses the effects of an effect body (`None` or effects; `(and ...)` is flattened).
 pub(crate) fn effect_items(doc: &str, start: usize, end: usize) -> Result<Vec<Effect>, ParseError> {
-    if let Some(effects) = direct::effects(doc, start, end) {
-        debug_assert_eq!(
-            Ok(&effects),
-            general_effect_items(doc, start, end).as_ref(),
-            "direct reader disagrees on {:?}",
-            &doc[start..end]
-        );
-        return Ok(effects);
-    }
-    general_effect_items(doc, start, end)
+    direct_or_general(doc, start, end, direct::effects, general_effect_items)
 }
 
 /// [`effect_items`] through the s-expression tree: every input, and every error.
