@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 /// The robot's end effector.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schemars", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum Embodiment {
     /// Franka hand with two prismatic fingers (9 DoF in all).

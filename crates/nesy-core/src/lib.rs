@@ -10,6 +10,7 @@
 
 pub mod adapt;
 pub mod atom;
+pub mod benchmark;
 pub mod embodiment;
 pub mod exec;
 pub mod formula;
@@ -20,6 +21,7 @@ pub mod patch;
 pub mod pddl;
 pub mod planner;
 pub mod predicates;
+pub mod rng;
 pub mod state;
 pub mod symbol;
 pub mod text;

@@ -1,4 +1,7 @@
-//! The benchmark's metrics, exactly as benchmark spec §7 defines them:
+//! The benchmark's metrics, exactly as `docs/benchmark.md` §7 defines them. This module is
+//! their one definition: the simulator's goal checks, the sandbox's reports, the pipeline and
+//! the benchmark harness all score episodes with it.
+//!
 //!
 //! - **SR** per episode is 1 iff every subtask ended in `full_success` or
 //!   `partial_success` (partial success — everything placed, in another order — counts).
@@ -12,23 +15,68 @@
 
 use serde::{Deserialize, Serialize};
 
-/// How one subtask ended.
+/// How one subtask ended: the goal checks' verdict, under the authors' names.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schemars", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum SubtaskResult {
-    /// Achieved, in the demonstrated order.
+    /// Every object placed (and the container closed), in label order.
     FullSuccess,
-    /// Achieved, in another order (counts as success).
+    /// Every object placed (and the container closed), in another order; counts as success.
     PartialSuccess,
-    /// Not achieved.
+    /// Not achieved by the final call.
     Fail,
 }
 
 impl SubtaskResult {
-    /// True for full and partial success.
+    /// True for full and partial success (both count toward SR).
     pub fn is_success(self) -> bool {
         self != SubtaskResult::Fail
     }
+
+    /// The authors' name: `full_success`, `partial_success` or `fail`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SubtaskResult::FullSuccess => "full_success",
+            SubtaskResult::PartialSuccess => "partial_success",
+            SubtaskResult::Fail => "fail",
+        }
+    }
+}
+
+impl std::fmt::Display for SubtaskResult {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Merges per-subtask achievements, each a `(name, control step)` list in time order, into
+/// the episode's achieved sequence: time order, ties broken by subtask (config) order and
+/// then by the order within the subtask.
+///
+/// ```
+/// use nesy_core::metrics::achieved_in_time_order;
+///
+/// let drawer = vec![("red_cylinder", 30), ("bottom_drawer", 90)];
+/// let cubes = vec![("red_cube", 30), ("blue_cube", 60)];
+/// assert_eq!(
+///     achieved_in_time_order([drawer, cubes]),
+///     ["red_cylinder", "red_cube", "blue_cube", "bottom_drawer"]
+/// );
+/// ```
+pub fn achieved_in_time_order<S, I, A>(per_subtask: I) -> Vec<String>
+where
+    S: AsRef<str>,
+    I: IntoIterator<Item = A>,
+    A: IntoIterator<Item = (S, u64)>,
+{
+    let mut merged: Vec<(u64, String)> = per_subtask
+        .into_iter()
+        .flat_map(|a| a.into_iter().map(|(name, step)| (step, name.as_ref().to_owned())))
+        .collect();
+    // Stable: equal steps keep subtask order, then the order within the subtask.
+    merged.sort_by_key(|(step, _)| *step);
+    merged.into_iter().map(|(_, name)| name).collect()
 }
 
 /// What an episode produced.

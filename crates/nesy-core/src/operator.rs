@@ -178,7 +178,7 @@ impl Operator {
     }
 }
 
-/// Prints the action block of benchmark spec §9:
+/// Prints the action block of `docs/benchmark.md` §9:
 ///
 /// ```text
 /// Name

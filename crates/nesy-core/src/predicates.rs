@@ -3,7 +3,7 @@
 //!
 //! The built-in set follows the paper's predicate figure: five physics-related predicates
 //! (`OverOf`, `OnTopOf`, `InsideOf`, `Open`, `Closed`) and ten embodiment-specific ones
-//! (gripper and vacuum). Tiers select what a prompt shows (benchmark spec §9):
+//! (gripper and vacuum). Tiers select what a prompt shows (`docs/benchmark.md` §9):
 //!
 //! | tier | predicates |
 //! |---|---|
@@ -34,7 +34,7 @@ pub enum Category {
     Embodiment,
 }
 
-/// A prompt tier: which predicates a prompt defines (benchmark spec §9).
+/// A prompt tier: which predicates a prompt defines (`docs/benchmark.md` §9).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Tier {

@@ -154,7 +154,7 @@ proptest! {
 
     #[test]
     fn apply_agrees(seed in any::<u64>()) {
-        let mut rng = SeedRng(seed);
+        let mut rng = SeedRng::new(seed);
         let (u, objects) = universe();
         let s = state(&mut rng, 10);
         let op = operator(&mut rng, "Op");
@@ -178,7 +178,7 @@ proptest! {
 
     #[test]
     fn verify_agrees(seed in any::<u64>()) {
-        let mut rng = SeedRng(seed);
+        let mut rng = SeedRng::new(seed);
         let (u, objects) = universe();
         let init = state(&mut rng, 10);
         let ops = procedure(&mut rng, 6);
@@ -207,7 +207,7 @@ proptest! {
 
     #[test]
     fn with_changes_is_deletes_then_adds(seed in any::<u64>()) {
-        let mut rng = SeedRng(seed);
+        let mut rng = SeedRng::new(seed);
         let s = state(&mut rng, 60);
         let mut dels: Vec<nesy_core::Atom> = (0..rng.below(8)).map(|_| ground_atom(&mut rng)).collect();
         let mut adds: Vec<nesy_core::Atom> = (0..rng.below(8)).map(|_| ground_atom(&mut rng)).collect();

@@ -19,19 +19,19 @@ proptest! {
 
     #[test]
     fn states(seed in any::<u64>()) {
-        let s = state(&mut SeedRng(seed), 12);
+        let s = state(&mut SeedRng::new(seed), 12);
         prop_assert_eq!(parse_state_list(&s.to_string()).unwrap(), s);
     }
 
     #[test]
     fn formulas(seed in any::<u64>()) {
-        let f = formula(&mut SeedRng(seed), 4, &mut Vec::new());
+        let f = formula(&mut SeedRng::new(seed), 4, &mut Vec::new());
         prop_assert_eq!(parse_formula(&f.to_string()).unwrap(), f);
     }
 
     #[test]
     fn procedures(seed in any::<u64>()) {
-        let ops = procedure(&mut SeedRng(seed), 4);
+        let ops = procedure(&mut SeedRng::new(seed), 4);
         let text = format_procedure(&ops);
         let back = parse_procedure(&text).map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
         prop_assert_eq!(back, ops);
@@ -39,7 +39,7 @@ proptest! {
 
     #[test]
     fn patches(seed in any::<u64>()) {
-        let mut rng = SeedRng(seed);
+        let mut rng = SeedRng::new(seed);
         let mut search = procedure(&mut rng, 3);
         if search.is_empty() {
             search.push(operator(&mut rng, "OnlyAction"));
@@ -53,7 +53,7 @@ proptest! {
 
     #[test]
     fn pddl(seed in any::<u64>()) {
-        let mut rng = SeedRng(seed);
+        let mut rng = SeedRng::new(seed);
         let (domain, problem, plan) = random_pddl(&mut rng);
         let text = domain.to_string();
         let d = parse_domain(&text).map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;

@@ -1,5 +1,5 @@
 //! What a policy runs against: an [`Episode`] is a robot (the [`RobotApi`]) that can also
-//! finish the episode with the post-run settle and goal checks of spec §7.
+//! finish the episode with the post-run settle and goal checks of `docs/benchmark.md` §7.
 
 use std::path::PathBuf;
 
@@ -7,12 +7,12 @@ use nesy_core::State;
 use nesy_sim::api::{Embodiment, RobotApi};
 use serde::{Deserialize, Serialize};
 
-use crate::result::SubtaskResult;
+use crate::result::SubtaskReport;
 
 /// A robot a policy can drive, plus the end-of-episode goal checks.
 pub trait Episode: RobotApi + Send {
     /// Called once after the policy ended (in any way but a kill): runs the post-run
-    /// settle steps (spec §7: 100 steps, then, if undecided, 100 more with the final check)
+    /// settle steps (`docs/benchmark.md` §7: 100 steps, then, if undecided, 100 more with the final check)
     /// and returns what the episode achieved.
     fn finish(&mut self) -> EpisodeEnd;
 }
@@ -21,7 +21,7 @@ pub trait Episode: RobotApi + Send {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct EpisodeEnd {
     /// Goal-check results; `None` if this robot has no goal checks.
-    pub subtasks: Option<Vec<SubtaskResult>>,
+    pub subtasks: Option<Vec<SubtaskReport>>,
     /// The observed symbolic state after settling; `None` if the robot has no world.
     pub final_state: Option<State>,
 }
@@ -56,5 +56,27 @@ pub trait EpisodeFactory {
 
 /// Why an episode could not be built.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error, Serialize, Deserialize)]
-#[error("cannot build the episode: {0}")]
-pub struct EpisodeBuildError(pub String);
+pub enum EpisodeBuildError {
+    /// The scene file did not load, validate or build into a world.
+    #[error("cannot build the episode: {}: {message}", path.display())]
+    Scene {
+        /// The scene file.
+        path: PathBuf,
+        /// Why (the scene error, naming the JSON field).
+        message: String,
+    },
+    /// The scene's goals cannot be checked in the built world.
+    #[error("cannot build the episode: {}: goal checks: {message}", path.display())]
+    GoalChecks {
+        /// The scene file.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// The episode asks for something this build does not do.
+    #[error("cannot build the episode: {feature} is not implemented yet")]
+    Unsupported {
+        /// What was asked for.
+        feature: String,
+    },
+}

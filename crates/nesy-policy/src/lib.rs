@@ -12,7 +12,42 @@
 //!    wall-clock kill ([`worker`]).
 //!
 //! The entry point for pipelines is [`worker::run_policy`]: source + [`EpisodeSpec`] +
-//! [`Limits`] in, [`ExecutionResult`] out.
+//! [`Limits`] in, [`ExecutionResult`] out. It runs the policy in a worker process, the
+//! hidden `nesy policy-worker` subcommand of the running binary:
+//!
+//! ```no_run
+//! use nesy_policy::{EpisodeSpec, Limits, WorkerCommand, run_policy};
+//!
+//! let worker = WorkerCommand::current_exe().unwrap(); // the running `nesy` binary
+//! let spec = EpisodeSpec::Scene {
+//!     path: "scene.json".into(),
+//!     embodiment: None,
+//!     render_every: 0,
+//! };
+//! let result = run_policy(&worker, "open_gripper()\n", &spec, &Limits::default()).unwrap();
+//! println!("{:?}: {} API calls", result.outcome, result.trace.len());
+//! ```
+//!
+//! [`run_in_process`] runs the same layers but the process boundary, for tests: here against
+//! the recording double, whose trace shows what the policy called.
+//!
+//! ```
+//! use nesy_policy::testing::RecordingRobot;
+//! use nesy_policy::{Limits, run_in_process};
+//! use nesy_sim::Embodiment;
+//!
+//! let robot = Box::new(RecordingRobot::new(Embodiment::Finger));
+//! let source = "move_gripper_to('red_cube')\nclose_gripper()\n";
+//! let result = run_in_process(source, robot, &Limits::default(), None).unwrap();
+//! assert!(result.is_ok());
+//! let calls: Vec<&str> = result.trace.iter().map(|e| e.call.name()).collect();
+//! assert_eq!(calls, ["move_gripper_to", "close_gripper"]);
+//!
+//! // A program that reaches outside the robot API never runs.
+//! let escape = Box::new(RecordingRobot::new(Embodiment::Finger));
+//! let result = run_in_process("import os\n", escape, &Limits::default(), None).unwrap();
+//! assert!(!result.is_ok());
+//! ```
 
 pub mod episode;
 pub mod limits;
@@ -27,9 +62,9 @@ pub use episode::{Episode, EpisodeBuildError, EpisodeEnd, EpisodeFactory, Episod
 pub use limits::Limits;
 pub use python::interpreter::{InitError, StartupTimes, initialize};
 pub use result::{
-    CapturedText, ExecutionResult, Outcome, PythonError, StaticViolation, SubtaskResult, SubtaskStatus,
-    TimeLimit, TracebackFrame, WorkerReport,
+    CapturedText, ExecutionResult, Outcome, PythonError, StaticViolation, SubtaskReport, TimeLimit,
+    TracebackFrame, WorkerReport,
 };
 pub use runner::{POLICY_FILE, api_function_names, api_signatures, check_source, run_in_process};
-pub use sim_episode::{SETTLE_STEPS, SimEpisodes};
+pub use sim_episode::SimEpisodes;
 pub use worker::{RunError, WorkerCommand, run_policy};

@@ -1,6 +1,7 @@
 //! What running a policy produced: [`ExecutionResult`] and its [`Outcome`].
 
 use nesy_core::State;
+use nesy_core::metrics::SubtaskResult;
 use nesy_sim::api::TraceEntry;
 use serde::{Deserialize, Serialize};
 
@@ -19,9 +20,9 @@ pub struct ExecutionResult {
     /// Wall-clock time from the start of the episode to its end, in seconds (for worker
     /// runs: from spawning the worker to collecting its result).
     pub wall_time_s: f64,
-    /// Goal-check results after the post-run settle steps of spec §7; `None` when the robot
+    /// Goal-check results after the post-run settle steps of `docs/benchmark.md` §7; `None` when the robot
     /// behind the episode has no goal checks (e.g. the sandbox test double).
-    pub subtasks: Option<Vec<SubtaskResult>>,
+    pub subtasks: Option<Vec<SubtaskReport>>,
     /// The observed symbolic state after the settle steps (`None` for robots without a
     /// world, such as the test double, and for episodes that were killed or rejected).
     pub final_state: Option<State>,
@@ -181,14 +182,14 @@ impl CapturedText {
     }
 }
 
-/// The goal-check result of one subtask after the post-run settle (spec §7).
+/// The goal-check result of one subtask after the post-run settle (`docs/benchmark.md` §7).
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct SubtaskResult {
+pub struct SubtaskReport {
     /// Subtask name, e.g. `pick_place`.
     pub subtask: String,
     /// The verdict.
-    pub status: SubtaskStatus,
-    /// The subtask's goal label (spec §2): its objects in the demonstrated order, then the
+    pub status: SubtaskResult,
+    /// The subtask's goal label (`docs/benchmark.md` §2): its objects in the demonstrated order, then the
     /// closure (`hinge`, `bottom_drawer`) for the articulated subtasks.
     #[serde(default)]
     pub label: Vec<String>,
@@ -196,18 +197,6 @@ pub struct SubtaskResult {
     /// (for the procedure deviation, PD, over all subtasks merged in time order).
     #[serde(default)]
     pub achieved: Vec<(String, u64)>,
-}
-
-/// Verdict of a subtask goal check (spec §7 metrics: partial counts as success).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SubtaskStatus {
-    /// Every object placed, in the demonstrated order.
-    FullSuccess,
-    /// Every object placed, in another order.
-    PartialSuccess,
-    /// Not achieved.
-    Failure,
 }
 
 /// How the worker process ended, reported by the parent.

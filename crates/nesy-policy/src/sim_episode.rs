@@ -1,30 +1,26 @@
 //! The simulator as an [`Episode`]: nesy-sim's [`Sim`] runs the robot API; after the policy
-//! it settles for the post-run steps of spec §7 and reports the goal checks' subtask results
+//! it settles for the post-run steps of `docs/benchmark.md` §7 and reports the goal checks' subtask results
 //! (for scenes with goals) and the observed symbolic state.
 
-use nesy_sim::goal::{GoalMonitor, SubtaskOutcome, SubtaskResult as GoalResult};
+use nesy_sim::tasks::goal::{GoalMonitor, POST_RUN_SETTLE_STEPS, SubtaskOutcome};
 use nesy_sim::{Sim, observe};
 
 use crate::episode::{Episode, EpisodeBuildError, EpisodeEnd, EpisodeFactory, EpisodeSpec};
-use crate::result::{SubtaskResult, SubtaskStatus};
+use crate::result::SubtaskReport;
 use crate::testing::RecordingRobot;
-
-/// Control steps the world settles after the policy ends before the goal check (spec §7:
-/// `check_result` first steps 100 times; the second 100 steps, with the final check, run
-/// only while the result is undecided, which needs the goal checks of nesy-sim).
-pub const SETTLE_STEPS: u32 = 100;
 
 impl Episode for Sim {
     fn finish(&mut self) -> EpisodeEnd {
-        // With goal checks attached (scenes with goals), the goal monitor runs spec §7's
+        // With goal checks attached (scenes with goals), the goal monitor runs the post-run
         // settle: 100 steps, and 100 more with the final check if something is undecided.
-        match nesy_sim::goal::finish_episode(self) {
+        // Without goals the world settles for the first phase only.
+        match nesy_sim::tasks::goal::finish_episode(self) {
             Some(outcome) => EpisodeEnd {
                 subtasks: Some(outcome.subtasks.iter().map(subtask_result).collect()),
                 final_state: Some(observe(self)),
             },
             None => {
-                self.step_idle(SETTLE_STEPS);
+                self.step_idle(POST_RUN_SETTLE_STEPS);
                 EpisodeEnd {
                     subtasks: None,
                     final_state: Some(observe(self)),
@@ -34,14 +30,10 @@ impl Episode for Sim {
     }
 }
 
-fn subtask_result(outcome: &SubtaskOutcome) -> SubtaskResult {
-    SubtaskResult {
+fn subtask_result(outcome: &SubtaskOutcome) -> SubtaskReport {
+    SubtaskReport {
         subtask: outcome.subtask.as_str().to_owned(),
-        status: match outcome.result {
-            GoalResult::FullSuccess => SubtaskStatus::FullSuccess,
-            GoalResult::PartialSuccess => SubtaskStatus::PartialSuccess,
-            GoalResult::Fail => SubtaskStatus::Failure,
-        },
+        status: outcome.result,
         label: outcome.label.clone(),
         achieved: outcome
             .achieved
@@ -64,24 +56,31 @@ impl EpisodeFactory for SimEpisodes {
                 render_every,
             } => {
                 if *render_every != 0 {
-                    return Err(EpisodeBuildError(
-                        "rendering during a policy run (--render-every) is not implemented yet".to_owned(),
-                    ));
+                    return Err(EpisodeBuildError::Unsupported {
+                        feature: "rendering during a policy run (--render-every)".to_owned(),
+                    });
                 }
-                let mut scene = nesy_sim::SceneSpec::from_file(path)
-                    .map_err(|e| EpisodeBuildError(format!("{}: {e}", path.display())))?;
+                let mut scene = nesy_sim::SceneSpec::from_file(path).map_err(|e| scene_error(path, e))?;
                 if let Some(embodiment) = embodiment {
                     scene.embodiment = *embodiment;
                 }
-                let mut sim =
-                    Sim::new(&scene).map_err(|e| EpisodeBuildError(format!("{}: {e}", path.display())))?;
+                let mut sim = Sim::new(&scene).map_err(|e| scene_error(path, e))?;
                 if !scene.goals.is_empty() {
-                    GoalMonitor::attach(&mut sim)
-                        .map_err(|e| EpisodeBuildError(format!("{}: goal checks: {e}", path.display())))?;
+                    GoalMonitor::attach(&mut sim).map_err(|e| EpisodeBuildError::GoalChecks {
+                        path: path.clone(),
+                        message: e.to_string(),
+                    })?;
                 }
                 Ok(Box::new(sim))
             }
             EpisodeSpec::RecordingDouble { embodiment } => Ok(Box::new(RecordingRobot::new(*embodiment))),
         }
+    }
+}
+
+fn scene_error(path: &std::path::Path, error: nesy_sim::SceneError) -> EpisodeBuildError {
+    EpisodeBuildError::Scene {
+        path: path.to_owned(),
+        message: error.to_string(),
     }
 }

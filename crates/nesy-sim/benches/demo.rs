@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nesy_sim::demo::mcap_format;
-use nesy_sim::scenario;
+use nesy_sim::tasks::scenario;
 
 fn benches(c: &mut Criterion) {
     let mut group = c.benchmark_group("demo");

@@ -5,7 +5,7 @@ use std::hint::black_box;
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use nesy_sim::render::{VIEW_SIZE, render_views};
+use nesy_sim::perception::render::{VIEW_SIZE, render_views};
 use nesy_sim::{Direction, RobotApi, SceneSpec, Sim, observe};
 
 fn scene(name: &str) -> SceneSpec {

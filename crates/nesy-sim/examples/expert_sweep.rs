@@ -15,9 +15,10 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use nesy_sim::Embodiment;
-use nesy_sim::expert::run_scene;
-use nesy_sim::rng::Stream;
-use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
+use nesy_sim::scene::SubtaskKind;
+use nesy_sim::tasks::experts::run_scene;
+use nesy_sim::tasks::{SubtaskConfig, TaskConfig};
+use nesy_sim::world::rng::Stream;
 
 fn arg(args: &[String], name: &str, default: usize) -> usize {
     args.iter()

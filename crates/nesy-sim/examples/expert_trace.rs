@@ -13,9 +13,10 @@
 //! the loose objects that moved more than 2 cm during it are listed, so an object knocked by
 //! the arm shows at the call that knocked it.
 
-use nesy_sim::goal::GoalMonitor;
-use nesy_sim::sim::SimHook;
-use nesy_sim::task::{SubtaskKind, TaskConfig};
+use nesy_sim::scene::SubtaskKind;
+use nesy_sim::tasks::TaskConfig;
+use nesy_sim::tasks::goal::GoalMonitor;
+use nesy_sim::world::SimHook;
 use nesy_sim::{Embodiment, Sim, TraceEntry};
 
 /// Prints every action call with its result and the articulations' joint positions after it.
@@ -136,7 +137,7 @@ fn trace(scene: &nesy_sim::SceneSpec) -> Result<(), Box<dyn std::error::Error>> 
         articulations: scene.articulations.keys().cloned().collect(),
         tracked,
     }));
-    let result = nesy_sim::expert::run(&mut sim, &scene.goals);
+    let result = nesy_sim::tasks::experts::run(&mut sim, scene);
     println!("\n{}", nesy_sim::observe(&sim));
     for name in scene.goals.iter().flat_map(|g| g.objects()) {
         println!("{name}: {:?}", sim.object_aabb(name));

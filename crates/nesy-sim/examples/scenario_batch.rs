@@ -17,7 +17,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use nesy_sim::demo::run_expert;
-use nesy_sim::scenario::{Scenario, Side, generate_suite, scenarios};
+use nesy_sim::tasks::scenario::{Scenario, Side, generate_suite, scenarios};
 
 fn side_of(name: &str) -> Side {
     match name {

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use nesy_sim::render::{VIEW_SIZE, render_views};
+use nesy_sim::perception::render::{VIEW_SIZE, render_views};
 use nesy_sim::{Direction, RobotApi, SceneSpec, Sim, observe};
 
 fn cpu_seconds() -> f64 {

@@ -1,5 +1,5 @@
 //! The robot API that generated code policies call (the paper's Tables 7–8, with the
-//! names, defaults and semantics of the benchmark spec §4).
+//! names, defaults and semantics of the `docs/benchmark.md` §4).
 //!
 //! [`RobotApi`] is the contract between the simulator, which implements it, and the
 //! embedded-Python runtime and scripted experts, which call it. Every call, perception
@@ -9,6 +9,16 @@
 use serde::{Deserialize, Serialize};
 
 pub use nesy_core::Embodiment;
+
+/// Largest distance (m) between the tool and a handle's centre at which `grasp_handle`
+/// (or `attach_vacuum_handle`) takes it, and beyond which a grasped handle slips out
+/// (`docs/benchmark.md` §4).
+pub const HANDLE_REACH: f64 = 0.1;
+/// Deepest `move_gripper_to` depth for the finger gripper (m): the palm's underside is
+/// 3.4 cm above the pads' centre, so a deeper target would drive the palm into the object's
+/// top (the kinematic arm would crush it). Deeper requests stop here, as a real hand stops on
+/// contact.
+pub const MAX_FINGER_DEPTH: f64 = 0.027;
 
 /// A world-frame direction in the API's naming, which is inverted compared with ROS:
 /// left = −y, right = +y, front = +x, back = −x, up = +z, down = −z.
@@ -299,7 +309,7 @@ pub trait RobotApi {
     /// True if the object is in the grasp region (between the finger pads, or under the
     /// suction tip).
     fn obj_in_gripper(&mut self, obj_name: &str) -> Result<bool, ApiError>;
-    /// A free table position, in the search region of spec §4, for placing `obj_name`.
+    /// A free table position, in the search region of `docs/benchmark.md` §4, for placing `obj_name`.
     fn get_empty_floor_xy(&mut self, obj_name: &str) -> Result<[f64; 2], ApiError>;
 
     /// Moves the tool to the object: `depth` below its top surface when pointing down.

@@ -4,32 +4,41 @@
 //! or vacuum tool) at a table, the benchmark's objects, the robot API of the paper, and
 //! the symbolic observer that turns geometry into `nesy_core::State`.
 //!
-//! Entry points: [`scene::SceneSpec`] (the `scene.json` format), [`Sim`] (the world; it
-//! implements [`api::RobotApi`]), [`observer::observe`] and [`render::render_views`].
+//! The modules are layers, lowest first:
+//!
+//! - [`api`]: the robot API contract ([`RobotApi`]) that policies and experts call.
+//! - [`scene`]: the `scene.json` format, part names and joints, subtask goals.
+//! - [`world`]: the Rapier world ([`Sim`]) built from a scene; it implements the API.
+//! - [`robot`]: the Panda models, kinematics, motion generation and the planner.
+//! - [`perception`]: the symbolic observer and the renderer.
+//! - [`tasks`]: the benchmark's tasks, goal checks, scripted experts and scenarios.
+//! - [`demo`]: recorded demonstrations (MCAP and folders) and the recorder.
+//! - [`codegen`]: the template compiler from symbolic actions to robot-API code.
+//!
+//! ```
+//! use nesy_sim::scene::SubtaskKind;
+//! use nesy_sim::tasks::TaskConfig;
+//! use nesy_sim::{Embodiment, RobotApi, Sim, observe};
+//!
+//! let task = TaskConfig::single(SubtaskKind::PickPlace, 3, 0, 0, Embodiment::Finger)
+//!     .generate()
+//!     .unwrap();
+//! let mut sim = Sim::new(&task.scene).unwrap();
+//! assert!(sim.get_obj_names().contains(&"toy_box".to_owned()));
+//! let state = observe(&sim);
+//! assert!(state.to_string().contains("(GripperOpen)"));
+//! ```
 
 pub mod api;
-mod api_impl;
 pub mod codegen;
 pub mod demo;
-pub mod expert;
-pub mod floor;
-pub mod geometry;
-pub mod goal;
-pub mod kinematics;
-pub mod motion;
-pub mod objects;
-pub mod observer;
-pub mod planner;
-pub mod render;
-pub mod rng;
+pub mod perception;
 pub mod robot;
-pub mod scenario;
 pub mod scene;
-pub mod sim;
-pub mod task;
+pub mod tasks;
+pub mod world;
 
 pub use api::{ApiCall, ApiError, ApiValue, Direction, Embodiment, RobotApi, TraceEntry};
-pub use api_impl::HANDLE_REACH;
-pub use observer::observe;
+pub use perception::observe;
 pub use scene::{SceneError, SceneSpec};
-pub use sim::{Sim, SimConfig, SimHook};
+pub use world::{Sim, SimConfig, SimHook};

@@ -11,8 +11,9 @@ use nesy_sim::demo::mcap_format::{self, ACTION_TOPIC, STATE_TOPIC, image_topic, 
 use nesy_sim::demo::{
     CameraImages, CameraName, Demo, DemoError, DemoMetadata, Keyframe, KeyframeViews, RecordOptions,
 };
-use nesy_sim::render::Image;
-use nesy_sim::task::{SubtaskKind, TaskConfig};
+use nesy_sim::perception::render::Image;
+use nesy_sim::scene::SubtaskKind;
+use nesy_sim::tasks::TaskConfig;
 use sha2::Digest;
 
 fn png(seed: u8) -> Vec<u8> {
@@ -412,9 +413,9 @@ fn fixture_tasks() -> Vec<(&'static str, TaskConfig, TaskConfig)> {
         embodiment_in_state: in_state,
         ..TaskConfig::single(kind, variant, obst, 0, embodiment)
     };
-    let files = nesy_sim::scenario::generate_suite();
-    let composite = nesy_sim::scenario::find(&files, FIXTURE_COMPOSITE).unwrap();
-    use nesy_sim::scenario::Side;
+    let files = nesy_sim::tasks::scenario::generate_suite();
+    let composite = nesy_sim::tasks::scenario::find(&files, FIXTURE_COMPOSITE).unwrap();
+    use nesy_sim::tasks::scenario::Side;
     vec![
         (
             "pick_place_obst_0to1_finger",
@@ -454,7 +455,7 @@ fn record_fixture_demos() {
         let target_scene = target.generate().unwrap().scene;
         let options = RecordOptions {
             image_size: FIXTURE_IMAGE_SIZE,
-            render_threads: nesy_sim::render::default_threads(),
+            render_threads: nesy_sim::perception::render::default_threads(),
             scenario_id: Some(name.to_owned()),
             side: Some("source".into()),
             target_scene: Some(target_scene.clone()),

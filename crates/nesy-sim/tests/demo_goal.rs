@@ -8,9 +8,9 @@
 //! has `(OnTopOf black_rook floor)`. [`EpisodeOutcome::displaced`] names such objects.
 
 use nesy_core::Atom;
-use nesy_sim::goal::{EpisodeOutcome, GoalMonitor};
-use nesy_sim::scenario::{self, Side};
 use nesy_sim::scene::SubtaskGoal;
+use nesy_sim::tasks::goal::{EpisodeOutcome, GoalMonitor};
+use nesy_sim::tasks::scenario::{self, Side};
 use nesy_sim::{Sim, observe};
 
 /// Runs the expert on the source scene of `id`; returns the outcome and the final state.
@@ -22,7 +22,7 @@ fn demonstrate(id: &str) -> (Vec<SubtaskGoal>, EpisodeOutcome, nesy_core::State)
     let scene = scenario.generate(Side::Source).unwrap().scene;
     let mut sim = Sim::new(&scene).unwrap();
     let monitor = GoalMonitor::attach(&mut sim).unwrap();
-    nesy_sim::expert::run(&mut sim, &scene.goals).unwrap();
+    nesy_sim::tasks::experts::run(&mut sim, &scene).unwrap();
     let outcome = monitor.finish(&mut sim);
     (scene.goals.clone(), outcome, observe(&sim))
 }

@@ -5,9 +5,10 @@
 //! factor × complexity (episode 00, seed 0); `nesy scenarios sweep` runs all 880 scenes.
 
 use nesy_sim::Embodiment;
-use nesy_sim::expert::run_scene;
-use nesy_sim::scenario::{self, Side};
-use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
+use nesy_sim::scene::SubtaskKind;
+use nesy_sim::tasks::experts::run_scene;
+use nesy_sim::tasks::scenario::{self, Side};
+use nesy_sim::tasks::{SubtaskConfig, TaskConfig};
 
 #[track_caller]
 fn assert_full_success(config: &TaskConfig) {

@@ -3,8 +3,8 @@
 
 use nalgebra::{Matrix3, Vector3};
 use nesy_sim::Embodiment;
-use nesy_sim::kinematics::{IkOptions, OrientationGoal, pointing_rotation};
-use nesy_sim::robot::{HOME_ARM, base_pose, load_model};
+use nesy_sim::robot::kinematics::{IkOptions, OrientationGoal, pointing_rotation};
+use nesy_sim::robot::model::{HOME_ARM, base_pose, load_model};
 
 #[test]
 fn fk_matches_published_check_poses() {

@@ -346,9 +346,9 @@ fn degenerate_inputs_do_not_panic() {
         Err(ApiError::InvalidArgument { .. })
     ));
     assert_eq!(sim.get_obj_pos("floor").unwrap()[2], 0.5);
-    let views = nesy_sim::render::render_views(&sim, 0, 2);
+    let views = nesy_sim::perception::render::render_views(&sim, 0, 2);
     assert!(views.iter().all(|v| v.image.rgb.is_empty()));
-    let views = nesy_sim::render::render_views(&sim, 17, 3);
+    let views = nesy_sim::perception::render::render_views(&sim, 17, 3);
     assert!(
         views
             .iter()

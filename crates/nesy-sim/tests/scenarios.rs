@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use nesy_sim::scenario::{self, Complexity, CountTable, Factor, Side};
+use nesy_sim::tasks::scenario::{self, Complexity, CountTable, Factor, Side};
 
 fn repo(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(path)

@@ -3,27 +3,21 @@
 
 mod common;
 
+use nesy_core::rng::SplitMix64;
 use nesy_sim::scene::{ObjectKind, ObjectSpec, PoseSpec, SceneSpec};
 use nesy_sim::{Direction, Embodiment, RobotApi, Sim};
 
-/// SplitMix64 for test layouts.
-struct Rng(u64);
+/// Test layouts draw from nesy-core's SplitMix64.
+struct Rng(SplitMix64);
 impl Rng {
-    fn unit(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
     fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
+        lo + (hi - lo) * self.0.unit()
     }
 }
 
 fn episode(embodiment: Embodiment, seed: u64) -> Result<(), String> {
-    let mut rng = Rng(seed);
-    // pick_place takes the default offset or the composite's low offsets (spec §3).
+    let mut rng = Rng(SplitMix64::new(seed));
+    // pick_place takes the default offset or the composite's low offsets (`docs/benchmark.md` §3).
     let (ox, oy) = [(0.5, 0.0), (0.35, 0.2), (0.35, -0.2)][(seed % 3) as usize];
     let object = |name: &str, kind, x: f64, y: f64, yaw: f64| ObjectSpec {
         name: name.into(),

@@ -197,22 +197,16 @@ impl VlmConfig {
             .config
             .clone()
             .or_else(|| env.var("NESY_VLM_CONFIG").map(PathBuf::from));
-        let file = match &file_path {
+        let mut file = match &file_path {
             Some(path) => FileConfig::load(path)?,
             None => FileConfig::default(),
         };
-        let file_origin = |key: &str| match &file_path {
-            Some(path) => format!("{}: `{key}`", path.display()),
-            None => key.to_string(),
+        let sources = Sources {
+            flags,
+            env,
+            file_path: file_path.as_deref(),
         };
-        let from_env = |name: &'static str| env.var(name).map(|value| (value, name.to_string()));
-
-        let backend = match (flags.backend, from_env("NESY_VLM_BACKEND"), &file.backend) {
-            (Some(backend), _, _) => backend,
-            (None, Some((value, origin)), _) => parse(&value, &origin)?,
-            (None, None, Some(value)) => parse(value, &file_origin("backend"))?,
-            (None, None, None) => BackendKind::OpenAi,
-        };
+        let backend = sources.backend(&file)?;
         let model = flags
             .model
             .clone()
@@ -223,16 +217,93 @@ impl VlmConfig {
                 hint: "set NESY_VLM_MODEL, pass --vlm-model, or put `model` in the config file".into(),
             })?;
         let mut config = Self::new(backend, model);
+        config.base_url = normalise_base_url(backend, &sources.base_url(backend, &file)?);
+        config.api_key = sources.api_key(backend, &file);
+        sources.azure(&mut config, file.azure.take().unwrap_or_default());
+        sources.request_defaults(&mut config, &file)?;
+        sources.retry(&mut config, file.retry.take().unwrap_or_default())?;
+        sources.timeouts(&mut config, file.timeouts.take().unwrap_or_default())?;
+        config.cassette = sources.cassette(file.cassette.take().unwrap_or_default())?;
+        config.prices = file.prices.unwrap_or_default();
+        Ok(config)
+    }
+}
 
-        let azure = file.azure.unwrap_or_default();
-        let base_url = flags
+/// The three layers a setting can come from, highest first: flags, the environment, the
+/// TOML file. Each step of [`VlmConfig::resolve`] reads one group of settings through it.
+struct Sources<'a> {
+    flags: &'a ConfigOverrides,
+    env: &'a dyn EnvSource,
+    file_path: Option<&'a std::path::Path>,
+}
+
+impl Sources<'_> {
+    /// How a file key is named in errors: the file and the key.
+    fn file_origin(&self, key: &str) -> String {
+        match self.file_path {
+            Some(path) => format!("{}: `{key}`", path.display()),
+            None => key.to_string(),
+        }
+    }
+
+    /// The flag's value, else the environment variable's (parsed), else the file's.
+    fn setting<T: FromStr>(
+        &self,
+        flag: Option<T>,
+        var: &'static str,
+        file: Option<T>,
+    ) -> Result<Option<T>, ConfigError>
+    where
+        T::Err: std::fmt::Display,
+    {
+        Ok(match (flag, self.env.var(var), file) {
+            (Some(value), _, _) => Some(value),
+            (None, Some(value), _) => Some(parse(&value, var)?),
+            (None, None, Some(value)) => Some(value),
+            (None, None, None) => None,
+        })
+    }
+
+    /// A duration in seconds from the flag, the environment variable or the file key.
+    fn seconds_setting(
+        &self,
+        flag: Option<f64>,
+        var: &'static str,
+        file: Option<f64>,
+        key: &str,
+    ) -> Result<Option<Duration>, ConfigError> {
+        match (flag, self.env.var(var), file) {
+            (Some(v), _, _) => Ok(Some(seconds(v, "flag")?)),
+            (None, Some(v), _) => Ok(Some(seconds(parse(&v, var)?, var)?)),
+            (None, None, Some(v)) => Ok(Some(seconds(v, &self.file_origin(key))?)),
+            (None, None, None) => Ok(None),
+        }
+    }
+
+    fn backend(&self, file: &FileConfig) -> Result<BackendKind, ConfigError> {
+        Ok(
+            match (
+                self.flags.backend,
+                self.env.var("NESY_VLM_BACKEND"),
+                &file.backend,
+            ) {
+                (Some(backend), _, _) => backend,
+                (None, Some(value), _) => parse(&value, "NESY_VLM_BACKEND")?,
+                (None, None, Some(value)) => parse(value, &self.file_origin("backend"))?,
+                (None, None, None) => BackendKind::OpenAi,
+            },
+        )
+    }
+
+    fn base_url(&self, backend: BackendKind, file: &FileConfig) -> Result<String, ConfigError> {
+        self.flags
             .base_url
             .clone()
-            .or_else(|| env.var("NESY_VLM_BASE_URL"))
+            .or_else(|| self.env.var("NESY_VLM_BASE_URL"))
             .or(file.base_url.clone())
             .or_else(|| {
                 matches!(backend, BackendKind::Azure | BackendKind::AzureV1)
-                    .then(|| env.var("AZURE_OPENAI_ENDPOINT"))
+                    .then(|| self.env.var("AZURE_OPENAI_ENDPOINT"))
                     .flatten()
             })
             .or_else(|| backend.default_base_url().map(str::to_string))
@@ -242,97 +313,87 @@ impl VlmConfig {
                     "the {backend} backend needs the resource endpoint (https://NAME.openai.azure.com): set \
                      NESY_VLM_BASE_URL or AZURE_OPENAI_ENDPOINT, or pass --vlm-base-url"
                 ),
-            })?;
-        config.base_url = normalise_base_url(backend, &base_url);
+            })
+    }
 
-        let key_var = file.api_key_env.clone();
-        config.api_key = env
-            .var("NESY_VLM_API_KEY")
-            .or_else(|| key_var.as_deref().and_then(|name| env.var(name)))
+    /// The key: `NESY_VLM_API_KEY`, the variable the file names, or the backend's usual
+    /// variable. Keys never come from flags or the file itself.
+    fn api_key(&self, backend: BackendKind, file: &FileConfig) -> Option<SecretString> {
+        let env = self.env;
+        env.var("NESY_VLM_API_KEY")
+            .or_else(|| file.api_key_env.as_deref().and_then(|name| env.var(name)))
             .or_else(|| match backend {
                 BackendKind::OpenAi => env.var("OPENAI_API_KEY"),
                 BackendKind::Azure | BackendKind::AzureV1 => env.var("AZURE_OPENAI_API_KEY"),
                 // A cloud key is never sent to a local server by accident.
                 BackendKind::Vllm | BackendKind::Ollama | BackendKind::LlamaCpp => None,
             })
-            .map(SecretString::new);
+            .map(SecretString::new)
+    }
 
-        config.azure_deployment = env
+    fn azure(&self, config: &mut VlmConfig, azure: FileAzure) {
+        config.azure_deployment = self
+            .env
             .var("NESY_VLM_AZURE_DEPLOYMENT")
             .or(azure.deployment)
-            .or(config.azure_deployment);
-        if let Some(version) = env
+            .or(config.azure_deployment.take());
+        if let Some(version) = self
+            .env
             .var("NESY_VLM_AZURE_API_VERSION")
-            .or_else(|| env.var("OPENAI_API_VERSION"))
+            .or_else(|| self.env.var("OPENAI_API_VERSION"))
             .or(azure.api_version)
         {
             config.azure_api_version = version;
         }
+    }
 
-        macro_rules! setting {
-            ($flag:expr, $var:literal, $file:expr, $key:literal) => {
-                match ($flag, env.var($var), $file) {
-                    (Some(value), _, _) => Some(value),
-                    (None, Some(value), _) => Some(parse(&value, $var)?),
-                    (None, None, Some(value)) => Some(value),
-                    (None, None, None) => None,
-                }
-            };
-        }
-        if let Some(mode) = setting!(flags.reasoning, "NESY_VLM_REASONING", file.reasoning, "reasoning") {
+    /// Reasoning mode and effort, token cap, temperature, image detail, concurrency.
+    fn request_defaults(&self, config: &mut VlmConfig, file: &FileConfig) -> Result<(), ConfigError> {
+        let flags = self.flags;
+        if let Some(mode) = self.setting(flags.reasoning, "NESY_VLM_REASONING", file.reasoning)? {
             config.reasoning = mode;
         }
-        if let Some(effort) = setting!(
+        if let Some(effort) = self.setting(
             flags.reasoning_effort,
             "NESY_VLM_REASONING_EFFORT",
             file.reasoning_effort,
-            "reasoning_effort"
-        ) {
+        )? {
             config.defaults.reasoning_effort = Some(effort);
         }
-        if let Some(tokens) = setting!(
+        if let Some(tokens) = self.setting(
             flags.max_output_tokens,
             "NESY_VLM_MAX_TOKENS",
             file.max_output_tokens,
-            "max_output_tokens"
-        ) {
+        )? {
             config.defaults.max_output_tokens = Some(tokens);
         }
-        if let Some(temperature) = setting!(
-            flags.temperature,
-            "NESY_VLM_TEMPERATURE",
-            file.temperature,
-            "temperature"
-        ) {
+        if let Some(temperature) =
+            self.setting(flags.temperature, "NESY_VLM_TEMPERATURE", file.temperature)?
+        {
             config.defaults.temperature = Some(temperature);
         }
-        if let Some(detail) = setting!(
-            flags.image_detail,
-            "NESY_VLM_IMAGE_DETAIL",
-            file.image_detail,
-            "image_detail"
-        ) {
+        if let Some(detail) = self.setting(flags.image_detail, "NESY_VLM_IMAGE_DETAIL", file.image_detail)? {
             config.defaults.image_detail = Some(detail);
         }
-        if let Some(limit) = setting!(
+        if let Some(limit) = self.setting(
             flags.max_concurrency,
             "NESY_VLM_MAX_CONCURRENCY",
             file.max_concurrency,
-            "max_concurrency"
-        ) {
+        )? {
             if limit == 0 {
                 return Err(invalid("max_concurrency", "must be at least 1"));
             }
             config.max_concurrency = limit;
         }
+        Ok(())
+    }
 
-        let retry = file.retry.unwrap_or_default();
-        if let Some(attempts) = setting!(
-            flags.max_attempts,
+    fn retry(&self, config: &mut VlmConfig, retry: FileRetry) -> Result<(), ConfigError> {
+        if let Some(attempts) = self.setting(
+            self.flags.max_attempts,
             "NESY_VLM_MAX_ATTEMPTS",
             retry.max_attempts,
-            "max_attempts"
-        ) {
+        )? {
             if attempts == 0 {
                 return Err(invalid("max_attempts", "must be at least 1"));
             }
@@ -345,20 +406,13 @@ impl VlmConfig {
             config.retry.max_delay = Duration::from_millis(ms);
         }
         if let Some(secs) = retry.max_retry_after_secs {
-            config.retry.max_retry_after = seconds(secs, &file_origin("retry.max_retry_after_secs"))?;
+            config.retry.max_retry_after = seconds(secs, &self.file_origin("retry.max_retry_after_secs"))?;
         }
+        Ok(())
+    }
 
-        let timeouts = file.timeouts.unwrap_or_default();
-        let pick =
-            |flag: Option<f64>, var: &'static str, file: Option<f64>, key: &str| -> Result<_, ConfigError> {
-                match (flag, env.var(var), file) {
-                    (Some(v), _, _) => Ok(Some(seconds(v, "flag")?)),
-                    (None, Some(v), _) => Ok(Some(seconds(parse(&v, var)?, var)?)),
-                    (None, None, Some(v)) => Ok(Some(seconds(v, &file_origin(key))?)),
-                    (None, None, None) => Ok(None),
-                }
-            };
-        if let Some(t) = pick(
+    fn timeouts(&self, config: &mut VlmConfig, timeouts: FileTimeouts) -> Result<(), ConfigError> {
+        if let Some(t) = self.seconds_setting(
             None,
             "NESY_VLM_TIMEOUT_CONNECT_SECS",
             timeouts.connect_secs,
@@ -366,7 +420,7 @@ impl VlmConfig {
         )? {
             config.timeouts.connect = Some(t);
         }
-        if let Some(t) = pick(
+        if let Some(t) = self.seconds_setting(
             None,
             "NESY_VLM_TIMEOUT_READ_SECS",
             timeouts.read_secs,
@@ -374,47 +428,46 @@ impl VlmConfig {
         )? {
             config.timeouts.read = Some(t);
         }
-        if let Some(t) = pick(
-            flags.timeout_secs,
+        if let Some(t) = self.seconds_setting(
+            self.flags.timeout_secs,
             "NESY_VLM_TIMEOUT_TOTAL_SECS",
             timeouts.total_secs,
             "timeouts.total_secs",
         )? {
             config.timeouts.total = Some(t);
         }
+        Ok(())
+    }
 
-        let cassette = file.cassette.unwrap_or_default();
-        let cassette_path = flags
+    fn cassette(&self, cassette: FileCassette) -> Result<Option<CassetteSettings>, ConfigError> {
+        let flags = self.flags;
+        let Some(path) = flags
             .cassette
             .clone()
-            .or_else(|| env.var("NESY_CASSETTE").map(PathBuf::from))
-            .or(cassette.path);
-        if let Some(path) = cassette_path {
-            let mode = setting!(
-                flags.cassette_mode,
-                "NESY_CASSETTE_MODE",
-                cassette.mode,
-                "cassette.mode"
-            )
+            .or_else(|| self.env.var("NESY_CASSETTE").map(PathBuf::from))
+            .or(cassette.path)
+        else {
+            return Ok(None);
+        };
+        let mode = self
+            .setting(flags.cassette_mode, "NESY_CASSETTE_MODE", cassette.mode)?
             .unwrap_or(CassetteMode::None);
-            let strict = flags.cassette_strict
-                || match env.var("NESY_CASSETTE_STRICT") {
-                    Some(v) => parse_bool(&v, "NESY_CASSETTE_STRICT")?,
-                    None => cassette.strict.unwrap_or(false),
-                };
-            let usage_report = env
-                .var("NESY_CASSETTE_USAGE")
-                .map(PathBuf::from)
-                .or(cassette.usage_report);
-            config.cassette = Some(CassetteSettings {
-                path,
-                mode,
-                strict,
-                usage_report,
-            });
-        }
-        config.prices = file.prices.unwrap_or_default();
-        Ok(config)
+        let strict = flags.cassette_strict
+            || match self.env.var("NESY_CASSETTE_STRICT") {
+                Some(v) => parse_bool(&v, "NESY_CASSETTE_STRICT")?,
+                None => cassette.strict.unwrap_or(false),
+            };
+        let usage_report = self
+            .env
+            .var("NESY_CASSETTE_USAGE")
+            .map(PathBuf::from)
+            .or(cassette.usage_report);
+        Ok(Some(CassetteSettings {
+            path,
+            mode,
+            strict,
+            usage_report,
+        }))
     }
 }
 

@@ -34,6 +34,45 @@
 //! client.finish()?;
 //! # Ok(()) }
 //! ```
+//!
+//! Settings resolve from flags over the environment over a TOML file over defaults; keys come
+//! from the environment only:
+//!
+//! ```
+//! use std::collections::HashMap;
+//! use nesy_vlm::{BackendKind, ConfigOverrides, VlmConfig};
+//!
+//! let env: HashMap<String, String> = [
+//!     ("NESY_VLM_BACKEND", "vllm"),
+//!     ("NESY_VLM_BASE_URL", "http://gpu-host:8000/v1/"),
+//!     ("NESY_VLM_MODEL", "Qwen/Qwen2.5-VL-7B-Instruct"),
+//!     ("NESY_VLM_MAX_TOKENS", "2048"),
+//! ]
+//! .into_iter()
+//! .map(|(k, v)| (k.to_owned(), v.to_owned()))
+//! .collect();
+//! let flags = ConfigOverrides { max_output_tokens: Some(4096), ..ConfigOverrides::default() };
+//! let config = VlmConfig::resolve(&flags, &env).unwrap();
+//! assert_eq!(config.backend, BackendKind::Vllm);
+//! assert_eq!(config.base_url, "http://gpu-host:8000/v1");
+//! assert_eq!(config.defaults.max_output_tokens, Some(4096)); // the flag wins
+//! assert!(config.api_key.is_none()); // a cloud key is never sent to a local server
+//! ```
+//!
+//! The offline reference responder plugs in where HTTP would; a compiler turns verified
+//! procedures into code for its code-generation answers:
+//!
+//! ```
+//! use std::sync::Arc;
+//! use nesy_vlm::{BackendKind, OracleNoise, OracleTransport, VlmClient, VlmConfig};
+//!
+//! let noise: OracleNoise = "drop=0.1,bad-patch=0.2".parse().unwrap();
+//! let oracle = Arc::new(OracleTransport::new().unwrap().with_noise(noise, 7));
+//! let config = VlmConfig::new(BackendKind::OpenAi, "oracle");
+//! let client = VlmClient::with_transport(&config, oracle.clone());
+//! assert_eq!(oracle.stats().inductions, 0);
+//! # drop(client);
+//! ```
 
 pub mod accounting;
 pub mod cassette;
@@ -69,7 +108,7 @@ pub use context::{
 };
 pub use error::{ProviderError, TimeoutPhase, TransportError, VlmError};
 pub use keyframes::{KeyframeImages, KeyframeList, NoKeyframes, Views};
-pub use oracle::{OracleNoise, OracleTransport, PolicyCompiler};
+pub use oracle::{OracleNoise, OracleTransport, PolicyCompileError, PolicyCompiler};
 pub use profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, TokenCapField};
 pub use prompts::{PromptError, Prompts};
 pub use reasoner::VlmReasoner;

@@ -4,7 +4,9 @@
 
 use std::sync::Arc;
 
-use nesy_core::adapt::{Feedback, InductionRequest, PatchRequest, Reasoner, ReasonerError};
+use nesy_core::adapt::{
+    Feedback, InductionRequest, PatchRequest, Reasoner, ReasonerError, ReasonerErrorKind,
+};
 
 use crate::client::VlmClient;
 use crate::codegen::{self, CodeGenerationRequest, CodegenError, PolicySource};
@@ -170,7 +172,8 @@ impl VlmReasoner {
         what: &str,
         chat: Result<ChatRequest, PromptError>,
     ) -> Result<String, ReasonerError> {
-        let chat = chat.map_err(|e| ReasonerError::new(format!("{what}: {e}")))?;
+        let chat =
+            chat.map_err(|e| ReasonerError::new(ReasonerErrorKind::Request, format!("{what}: {e}")))?;
         match self.client.chat(chat).await {
             Ok(response) => Ok(response.text),
             Err(error) => Err(reasoner_error(what, &error)),
@@ -180,7 +183,7 @@ impl VlmReasoner {
 
 fn reasoner_error(what: &str, error: &VlmError) -> ReasonerError {
     // VlmError's message already carries its cause (transport, cassette, provider body).
-    ReasonerError::new(format!("{what}: {error}"))
+    ReasonerError::new(error.reasoner_kind(), format!("{what}: {error}"))
 }
 
 impl Reasoner for VlmReasoner {

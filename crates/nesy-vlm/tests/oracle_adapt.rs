@@ -7,16 +7,18 @@
 use std::sync::Arc;
 
 use nesy_core::adapt::{AdaptConfig, Demonstration, Outcome, Target, TaskContext, run};
+use nesy_core::metrics::SubtaskResult;
 use nesy_core::predicates::{Tier, Vocabulary};
 use nesy_core::symbol::Symbol;
-use nesy_policy::{Limits, SubtaskStatus, run_in_process};
-use nesy_sim::goal::GoalMonitor;
+use nesy_policy::{Limits, run_in_process};
 use nesy_sim::scene::SceneSpec;
-use nesy_sim::task::{SubtaskKind, TaskConfig};
+use nesy_sim::scene::SubtaskKind;
+use nesy_sim::tasks::TaskConfig;
+use nesy_sim::tasks::goal::GoalMonitor;
 use nesy_sim::{Embodiment, Sim, observe};
 use nesy_vlm::codegen::CodeGenerationRequest;
 use nesy_vlm::context::CodeGenerationContext;
-use nesy_vlm::oracle::{OracleNoise, OracleTransport, PolicyCompiler};
+use nesy_vlm::oracle::{OracleNoise, OracleTransport, PolicyCompileError, PolicyCompiler};
 use nesy_vlm::{BackendKind, KeyframeList, VlmClient, VlmConfig, VlmReasoner};
 
 mod oracle_common;
@@ -27,10 +29,14 @@ use oracle_common::Keyframes;
 struct TemplateCompiler;
 
 impl PolicyCompiler for TemplateCompiler {
-    fn compile(&self, request: &CodeGenerationContext) -> Result<String, String> {
+    fn compile(&self, request: &CodeGenerationContext) -> Result<String, PolicyCompileError> {
         nesy_sim::codegen::compile_policy(&request.procedure, &request.objects, request.embodiment)
             .map(|p| p.code)
-            .map_err(|e| e.to_string())
+            .map_err(|e| {
+                let detail = e.to_string();
+                let nesy_sim::codegen::CodegenError::UnknownAction { index, name } = e;
+                PolicyCompileError::UnknownAction { index, name, detail }
+            })
     }
 }
 
@@ -45,7 +51,7 @@ fn scene(kind: SubtaskKind, obst: u8, embodiment: Embodiment, in_state: bool) ->
 }
 
 fn objects(sim: &Sim) -> Vec<Symbol> {
-    nesy_sim::observer::snapshot(sim)
+    nesy_sim::perception::observer::snapshot(sim)
         .objects
         .iter()
         .map(|o| Symbol::new(&o.name))
@@ -63,7 +69,7 @@ struct Case {
 struct RunResult {
     outcome: Outcome,
     stats: nesy_vlm::oracle::OracleStats,
-    statuses: Vec<SubtaskStatus>,
+    statuses: Vec<SubtaskResult>,
     code: String,
 }
 
@@ -76,7 +82,7 @@ async fn adapt_and_execute(case: &Case, noise: OracleNoise, budget: usize) -> Ru
     let source_objects = objects(&sim);
     let init = observe(&sim);
     sim.add_hook(Box::new(Keyframes::default()));
-    nesy_sim::expert::run(&mut sim, &source_scene.goals).unwrap();
+    nesy_sim::tasks::experts::run(&mut sim, &source_scene).unwrap();
     let recorded = &sim.hook::<Keyframes>().unwrap().calls;
     let mut states = vec![init];
     states.extend(recorded.iter().map(|(_, s)| s.clone()));
@@ -163,7 +169,7 @@ fn assert_full_success(r: &RunResult) {
     assert!(r.outcome.is_adapted(), "{:?}", r.outcome);
     assert!(!r.statuses.is_empty(), "no goal checks ran\n{}", r.code);
     assert!(
-        r.statuses.iter().all(|s| *s == SubtaskStatus::FullSuccess),
+        r.statuses.iter().all(|s| *s == SubtaskResult::FullSuccess),
         "{:?}\n{}",
         r.statuses,
         r.code

@@ -5,12 +5,14 @@
 //! on both end effectors runs with `--ignored`.
 
 use nesy_core::adapt::{InductionRequest, TaskContext};
+use nesy_core::metrics::SubtaskResult;
 use nesy_core::operator::Operator;
 use nesy_core::predicates::{Tier, Vocabulary};
 use nesy_core::symbol::Symbol;
-use nesy_policy::{Limits, SubtaskStatus, run_in_process};
-use nesy_sim::goal::GoalMonitor;
-use nesy_sim::task::{SubtaskKind, TaskConfig};
+use nesy_policy::{Limits, run_in_process};
+use nesy_sim::scene::SubtaskKind;
+use nesy_sim::tasks::TaskConfig;
+use nesy_sim::tasks::goal::GoalMonitor;
 use nesy_sim::{Embodiment, Sim, observe};
 use nesy_vlm::context::InductionContext;
 use nesy_vlm::oracle::{WorldDomain, induce};
@@ -24,14 +26,14 @@ fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodi
         .unwrap()
         .scene;
     let mut sim = Sim::new(&scene).unwrap();
-    let objects: Vec<Symbol> = nesy_sim::observer::snapshot(&sim)
+    let objects: Vec<Symbol> = nesy_sim::perception::observer::snapshot(&sim)
         .objects
         .iter()
         .map(|o| Symbol::new(&o.name))
         .collect();
     let mut prev = observe(&sim);
     sim.add_hook(Box::new(Keyframes::default()));
-    nesy_sim::expert::run(&mut sim, &scene.goals).unwrap();
+    nesy_sim::tasks::experts::run(&mut sim, &scene).unwrap();
     let world = WorldDomain::builtin().unwrap();
     let task = TaskContext {
         instruction: scene.instruction.clone(),
@@ -89,7 +91,7 @@ fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodi
     GoalMonitor::attach(&mut episode).unwrap();
     let result = run_in_process(&policy.code, Box::new(episode), &Limits::default(), None).unwrap();
     assert!(result.is_ok(), "{:?}\n{}", result.outcome, policy.code);
-    let statuses: Vec<SubtaskStatus> = result
+    let statuses: Vec<SubtaskResult> = result
         .subtasks
         .unwrap_or_default()
         .into_iter()
@@ -97,7 +99,7 @@ fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodi
         .collect();
     assert_eq!(
         statuses,
-        vec![SubtaskStatus::FullSuccess],
+        vec![SubtaskResult::FullSuccess],
         "{kind} obst {obst} on {embodiment}:\n{}",
         policy.code
     );

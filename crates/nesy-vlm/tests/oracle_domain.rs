@@ -9,7 +9,8 @@ use nesy_core::adapt::{InductionRequest, TaskContext, TransitionCheck, check_tra
 use nesy_core::predicates::{Tier, Vocabulary};
 use nesy_core::state::State;
 use nesy_core::symbol::Symbol;
-use nesy_sim::task::{SubtaskConfig, SubtaskKind, TaskConfig};
+use nesy_sim::scene::SubtaskKind;
+use nesy_sim::tasks::{SubtaskConfig, TaskConfig};
 use nesy_sim::{Embodiment, Sim, observe};
 use nesy_vlm::context::InductionContext;
 use nesy_vlm::oracle::{WorldDomain, induce};
@@ -37,14 +38,14 @@ fn expert_run(kind: SubtaskKind, obst: u8, multi: u8, embodiment: Embodiment, va
     };
     let task = cfg.generate().unwrap();
     let mut sim = Sim::new(&task.scene).unwrap();
-    let objects = nesy_sim::observer::snapshot(&sim)
+    let objects = nesy_sim::perception::observer::snapshot(&sim)
         .objects
         .iter()
         .map(|o| Symbol::new(&o.name))
         .collect();
     let init = observe(&sim);
     sim.add_hook(Box::new(Keyframes::default()));
-    nesy_sim::expert::run(&mut sim, &task.scene.goals).unwrap();
+    nesy_sim::tasks::experts::run(&mut sim, &task.scene).unwrap();
     let k = sim.hook::<Keyframes>().unwrap();
     let mut states = vec![init];
     states.extend(k.calls.iter().map(|(_, s)| s.clone()));

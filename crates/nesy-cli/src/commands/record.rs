@@ -7,8 +7,8 @@ use std::time::Instant;
 
 use anyhow::Context;
 use nesy_sim::demo::{RecordOptions, record_scene, write_mcap_file};
-use nesy_sim::render::{VIEW_SIZE, default_threads};
-use nesy_sim::scenario::{self, Side};
+use nesy_sim::perception::render::{VIEW_SIZE, default_threads};
+use nesy_sim::tasks::scenario::{self, Side};
 
 use super::scenarios::{SideArg, load_suite};
 

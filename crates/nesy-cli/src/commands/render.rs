@@ -5,7 +5,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
-use nesy_sim::render::{VIEW_SIZE, default_threads, render_views, write_views};
+use nesy_sim::perception::render::{VIEW_SIZE, default_threads, render_views, write_views};
 use nesy_sim::{Sim, SimConfig};
 
 /// Arguments of `nesy render`.

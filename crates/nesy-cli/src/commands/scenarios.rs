@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use anyhow::Context;
-use nesy_sim::scenario::{self, ConfigFile, CountTable, Scenario, Side};
+use nesy_sim::tasks::scenario::{self, ConfigFile, CountTable, Scenario, Side};
 
 /// Arguments of `nesy scenarios`.
 #[derive(Debug, clap::Args)]

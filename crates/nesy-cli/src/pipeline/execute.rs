@@ -1,11 +1,11 @@
 //! Step 6 (`--execute`): the policy runs in the sandboxed worker against the target scene;
-//! the goal checks' subtask results give SR, GC and PD (spec §7).
+//! the goal checks' subtask results give SR, GC and PD (`docs/benchmark.md` §7).
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
-use nesy_core::metrics::levenshtein;
-use nesy_policy::{EpisodeSpec, ExecutionResult, Limits, SubtaskStatus, WorkerCommand, run_policy};
+use nesy_core::metrics::{EpisodeResult, SubtaskResult, achieved_in_time_order};
+use nesy_policy::{EpisodeSpec, ExecutionResult, Limits, WorkerCommand, run_policy};
 use serde::Serialize;
 
 /// The execution and its scores.
@@ -20,7 +20,7 @@ pub struct ExecutionReport {
 }
 
 impl ExecutionReport {
-    /// True if every subtask succeeded (full or partial, spec §7).
+    /// True if every subtask succeeded (full or partial, `docs/benchmark.md` §7).
     pub fn success(&self) -> bool {
         self.metrics.as_ref().is_some_and(|m| m.sr == 1.0)
     }
@@ -28,7 +28,7 @@ impl ExecutionReport {
     /// True if every subtask reached `full_success`.
     pub fn full_success(&self) -> bool {
         self.metrics.as_ref().is_some_and(|m| {
-            !m.subtasks.is_empty() && m.subtasks.iter().all(|s| s.status == SubtaskStatus::FullSuccess)
+            !m.subtasks.is_empty() && m.subtasks.iter().all(|s| s.status == SubtaskResult::FullSuccess)
         })
     }
 }
@@ -39,10 +39,10 @@ pub struct SubtaskVerdict {
     /// The subtask type.
     pub subtask: String,
     /// Its result.
-    pub status: SubtaskStatus,
+    pub status: SubtaskResult,
 }
 
-/// The episode's scores (spec §7).
+/// The episode's scores (`docs/benchmark.md` §7).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EpisodeMetrics {
     /// The subtask verdicts.
@@ -71,26 +71,23 @@ impl EpisodeMetrics {
                 status: s.status,
             })
             .collect();
-        let ok = verdicts
-            .iter()
-            .filter(|v| v.status != SubtaskStatus::Failure)
-            .count();
-        let n = verdicts.len();
-        // Spec §7: the goal label is the subtask labels in config order; the achieved
-        // sequence merges every subtask's achievements in time order (ties in config order).
-        let label: Vec<String> = subtasks.iter().flat_map(|s| s.label.iter().cloned()).collect();
-        let mut achieved: Vec<(String, u64)> =
-            subtasks.iter().flat_map(|s| s.achieved.iter().cloned()).collect();
-        achieved.sort_by_key(|(_, step)| *step);
-        let achieved: Vec<String> = achieved.into_iter().map(|(name, _)| name).collect();
-        let pd = (!label.is_empty())
-            .then(|| levenshtein(&label, &achieved) as f64 / label.len().max(achieved.len()).max(1) as f64);
+        // The goal label is the subtask labels in config order; the achieved sequence merges
+        // every subtask's achievements in time order.
+        let episode = EpisodeResult {
+            subtasks: verdicts.iter().map(|v| v.status).collect(),
+            label: subtasks.iter().flat_map(|s| s.label.iter().cloned()).collect(),
+            achieved: achieved_in_time_order(
+                subtasks
+                    .iter()
+                    .map(|s| s.achieved.iter().map(|(name, step)| (name.as_str(), *step))),
+            ),
+        };
         Some(EpisodeMetrics {
-            sr: if n > 0 && ok == n { 1.0 } else { 0.0 },
-            gc: if n == 0 { 0.0 } else { ok as f64 / n as f64 },
-            pd,
-            label,
-            achieved,
+            sr: episode.success(),
+            gc: episode.goal_condition(),
+            pd: (!episode.label.is_empty()).then(|| episode.procedure_deviation()),
+            label: episode.label,
+            achieved: episode.achieved,
             subtasks: verdicts,
         })
     }

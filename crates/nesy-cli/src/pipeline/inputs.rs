@@ -11,7 +11,7 @@ use anyhow::Context as _;
 use nesy_core::State;
 use nesy_sim::api::Embodiment;
 use nesy_sim::demo::{CameraName, Demo};
-use nesy_sim::render::{self, View};
+use nesy_sim::perception::render::{self, View};
 use nesy_sim::scene::SceneSpec;
 use nesy_sim::{Sim, observe};
 use nesy_vlm::{Image, KeyframeImages, Views};

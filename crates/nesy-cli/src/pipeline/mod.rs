@@ -30,10 +30,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context as _;
-use nesy_core::adapt::{
-    self, AdaptConfig, Adaptation, Complexity, Demonstration, DomainFactor, Target, TaskContext,
-    iteration_budget,
-};
+use nesy_core::adapt::{self, AdaptConfig, Adaptation, Demonstration, Target, TaskContext};
+use nesy_core::benchmark::{Complexity, Factor, iteration_budget, parse_scenario_id};
 use nesy_core::predicates::{Tier, Vocabulary};
 use nesy_core::symbol::Symbol;
 use nesy_core::{Operator, State};
@@ -125,7 +123,7 @@ pub struct Setting {
     /// Whether embodiment atoms (`(FingerGripper)`, `(VacuumSuction)`) are in the states.
     pub embodiment_in_state: bool,
     /// The domain factor (from the demo's scenario id, else inferred).
-    pub factor: DomainFactor,
+    pub factor: Factor,
     /// The complexity (from the scenario id, else the number of target subtasks).
     pub complexity: Complexity,
     /// The patch-proposal budget used.
@@ -405,15 +403,13 @@ pub fn derive_setting(demo: &DemoInput, target: &TargetInput, options: &AdaptOpt
     let factor = from_id
         .map(|(f, _)| f)
         .unwrap_or(match (source, target_embodiment) {
-            (Embodiment::Finger, Embodiment::Vacuum) => DomainFactor::Gripper,
-            (Embodiment::Vacuum, Embodiment::Finger) => DomainFactor::Vacuum,
-            _ => DomainFactor::Obstruction,
+            (Embodiment::Finger, Embodiment::Vacuum) => Factor::Grip,
+            (Embodiment::Vacuum, Embodiment::Finger) => Factor::Vacu,
+            _ => Factor::Obst,
         });
-    let complexity = from_id.map(|(_, c)| c).unwrap_or(match target.scene.goals.len() {
-        0..=2 => Complexity::Low,
-        3 => Complexity::Medium,
-        _ => Complexity::High,
-    });
+    let complexity = from_id
+        .map(|(_, c)| c)
+        .unwrap_or(Complexity::of_subtask_count(target.scene.goals.len()));
     let (budget, budget_origin) = match options.budget {
         Some(b) => (b, "flag"),
         None => (iteration_budget(factor, complexity), "scenario"),
@@ -427,43 +423,5 @@ pub fn derive_setting(demo: &DemoInput, target: &TargetInput, options: &AdaptOpt
         complexity,
         budget,
         budget_origin,
-    }
-}
-
-/// Reads `<factor>_<complexity>_...` scenario ids (`obst_low_03_s0`, `comb_high_11`).
-pub fn parse_scenario_id(id: &str) -> Option<(DomainFactor, Complexity)> {
-    let mut parts = id.split(['_', '-', '/']);
-    let factor = match parts.next()? {
-        "affo" => DomainFactor::Affordance,
-        "obst" => DomainFactor::Obstruction,
-        "grip" => DomainFactor::Gripper,
-        "vacu" => DomainFactor::Vacuum,
-        "comb" => DomainFactor::Combination,
-        _ => return None,
-    };
-    let complexity = match parts.next()? {
-        "low" => Complexity::Low,
-        "medium" | "med" => Complexity::Medium,
-        "high" => Complexity::High,
-        _ => return None,
-    };
-    Some((factor, complexity))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn scenario_ids_give_factor_and_complexity() {
-        assert_eq!(
-            parse_scenario_id("obst_low_03_s0"),
-            Some((DomainFactor::Obstruction, Complexity::Low))
-        );
-        assert_eq!(
-            parse_scenario_id("comb_high_11"),
-            Some((DomainFactor::Combination, Complexity::High))
-        );
-        assert_eq!(parse_scenario_id("pick_place"), None);
     }
 }

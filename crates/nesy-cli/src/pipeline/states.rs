@@ -1,7 +1,7 @@
 //! Step 2: symbolic states for the demo's keyframes and the target's initial state.
 //!
 //! - `observed`: the ground-truth states the simulator recorded in the demo and observes in
-//!   the target (the authors' setting, spec §10.1).
+//!   the target (the authors' setting, `docs/benchmark.md` §10.1).
 //! - `vlm`: the paper's State Translation (Eq. 2) on the marked views, through
 //!   [`VlmReasoner::translate_state`]. When ground truth exists anyway (simulated demos), the
 //!   translation's precision, recall and F1 against it are reported, as the paper does.

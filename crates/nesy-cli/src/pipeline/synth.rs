@@ -8,9 +8,12 @@
 
 use nesy_core::Operator;
 use nesy_sim::api::Embodiment;
-use nesy_sim::codegen::compile_policy;
+use nesy_sim::codegen::{CodegenError as TemplateError, compile_policy};
 use nesy_sim::scene::SceneSpec;
-use nesy_vlm::{CodeGenerationContext, CodeGenerationRequest, CodegenError, PolicyCompiler, VlmReasoner};
+use nesy_vlm::{
+    CodeGenerationContext, CodeGenerationRequest, CodegenError, PolicyCompileError, PolicyCompiler,
+    VlmReasoner,
+};
 use serde::Serialize;
 
 /// How code is synthesized (`--codegen`).
@@ -148,9 +151,16 @@ fn template(request: &SynthesisRequest<'_>) -> Result<SynthesizedPolicy, SynthEr
 pub struct TemplateCompiler;
 
 impl PolicyCompiler for TemplateCompiler {
-    fn compile(&self, request: &CodeGenerationContext) -> Result<String, String> {
+    fn compile(&self, request: &CodeGenerationContext) -> Result<String, PolicyCompileError> {
         compile_policy(&request.procedure, &request.objects, request.embodiment)
             .map(|c| c.code)
-            .map_err(|e| e.to_string())
+            .map_err(|e| {
+                let detail = e.to_string();
+                match e {
+                    TemplateError::UnknownAction { index, name } => {
+                        PolicyCompileError::UnknownAction { index, name, detail }
+                    }
+                }
+            })
     }
 }

@@ -104,7 +104,7 @@ pub struct ScriptedReasoner {
 impl Reasoner for ScriptedReasoner {
     async fn induce_operator(&mut self, request: &InductionRequest) -> Result<String, ReasonerError> {
         self.inductions.pop_front().ok_or_else(|| {
-            ReasonerError::new(format!(
+            ReasonerError::exhausted(format!(
                 "no recorded induction reply left (step {})",
                 request.step
             ))
@@ -114,7 +114,7 @@ impl Reasoner for ScriptedReasoner {
     async fn propose_patch(&mut self, request: &PatchRequest) -> Result<String, ReasonerError> {
         self.first_patch.get_or_insert_with(Instant::now);
         self.patches.pop_front().ok_or_else(|| {
-            ReasonerError::new(format!(
+            ReasonerError::exhausted(format!(
                 "no recorded patch reply left (iteration {})",
                 request.iteration
             ))

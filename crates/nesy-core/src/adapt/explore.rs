@@ -2,7 +2,7 @@
 
 use super::reasoner::{Feedback, PatchRequest, Problem, Reasoner, ViolationKind};
 use super::{
-    AdaptConfig, AdaptError, Outcome, Target, Trace, TraceEvent, Verdict, ViolationInfo, WorldModel,
+    Ablation, AdaptConfig, AdaptError, Outcome, Target, Trace, TraceEvent, Verdict, ViolationInfo, WorldModel,
 };
 use crate::exec::{
     CompiledProcedure, GroundingCache, Report, UnmetPrecondition, format_unmet, implicit_universe,
@@ -11,7 +11,7 @@ use crate::formula::Formula;
 use crate::operator::Operator;
 use crate::patch::{AppliedPatch, apply_patch};
 use crate::state::State;
-use crate::text::parse_refinement_reply;
+use crate::text::{RefinementReply, parse_refinement_reply};
 use crate::types::Universe;
 
 /// The universe the loop verifies over: every object of the target's initial state, the
@@ -249,29 +249,9 @@ pub async fn explore<R: Reasoner>(
         let violation = identify(&report, &procedure);
         let finished = if single_shot { revised } else { violation.is_none() };
         if finished || iteration >= config.budget {
-            let outcome = if report.is_valid() {
-                Outcome::Adapted {
-                    procedure,
-                    report,
-                    iterations: iteration,
-                }
-            } else {
-                Outcome::Unresolved {
-                    best: best.1,
-                    last: procedure,
-                    last_violation,
-                    iterations: iteration,
-                }
-            };
-            return Ok(ExplorationResult { outcome });
+            return Ok(finish(procedure, report, best.1, last_violation, iteration));
         }
-        let violation = violation.unwrap_or(ViolationInfo {
-            kind: ViolationKind::Unidentified,
-            failing_step: None,
-            action: None,
-            unmet: Vec::new(),
-            state: target.init.clone(),
-        });
+        let violation = violation.unwrap_or_else(|| unidentified(target));
         if last_violation.as_ref().is_some_and(|v| *v != violation) {
             feedback.clear();
         }
@@ -281,54 +261,27 @@ pub async fn explore<R: Reasoner>(
         let reusable = cached_request
             .take()
             .filter(|(v, _)| *v == procedure_version && last_violation.as_ref() == Some(&violation));
-        let request = if let Some((_, mut request)) = reusable {
-            request.iteration = iteration;
-            request.feedback = feedback.clone();
-            request
-        } else if ablation.identification {
-            let split = violation.failing_step.unwrap_or(procedure.len());
-            PatchRequest {
-                iteration,
-                task: target.task.clone(),
-                kind: violation.kind,
-                procedure: procedure.clone(),
-                executed: procedure[..split].to_vec(),
-                erroneous: violation.failing_step.map(|i| procedure[i].clone()),
-                remaining: procedure.get(split + 1..).map(|r| r.to_vec()).unwrap_or_default(),
-                failing_step: violation.failing_step,
-                initial_state: target.init.clone(),
-                error_state: violation.state.clone(),
-                unmet: violation.unmet.clone(),
-                feedback: feedback.clone(),
+        let request = match reusable {
+            Some((_, mut request)) => {
+                request.iteration = iteration;
+                request.feedback = feedback.clone();
+                request
             }
-        } else {
-            PatchRequest {
+            None => patch_request(
+                ablation.identification,
                 iteration,
-                task: target.task.clone(),
-                kind: ViolationKind::Unidentified,
-                procedure: procedure.clone(),
-                executed: Vec::new(),
-                erroneous: None,
-                remaining: procedure.clone(),
-                failing_step: None,
-                initial_state: target.init.clone(),
-                error_state: target.init.clone(),
-                unmet: Vec::new(),
-                feedback: feedback.clone(),
-            }
+                target,
+                &procedure,
+                &violation,
+                &feedback,
+            ),
         };
         let visible = if ablation.identification {
             violation.clone()
         } else {
-            ViolationInfo {
-                kind: ViolationKind::Unidentified,
-                failing_step: None,
-                action: None,
-                unmet: vec![],
-                state: target.init.clone(),
-            }
+            unidentified(target)
         };
-        last_violation = Some(violation.clone());
+        last_violation = Some(violation);
         let reply = reasoner.propose_patch(&request).await?;
         cached_request = Some((procedure_version, request));
         let this_iteration = iteration;
@@ -342,7 +295,7 @@ pub async fn explore<R: Reasoner>(
             } else {
                 0
             });
-        let attempt: Result<(AppliedPatch, Report), Problem> = (|| {
+        let attempt = (|| {
             let r = parsed
                 .as_ref()
                 .map_err(|e| Problem::Unparsable { error: e.clone() })?;
@@ -354,16 +307,7 @@ pub async fn explore<R: Reasoner>(
             let applied = apply_patch(&procedure, &r.patches[0], near)
                 .map_err(|error| Problem::PatchDidNotApply { error })?;
             let new_report = verify(&target.init, &mut universe, &applied.procedure, goal, &mut cache);
-            if ablation.verification {
-                if ablation.identification {
-                    resolves(&visible, &applied, &new_report)?;
-                } else if progress(&new_report) <= progress(&report) {
-                    return Err(Problem::NotResolved {
-                        failing_step: new_report.first_failure,
-                        unmet: identify_unmet(&new_report).unwrap_or_default(),
-                    });
-                }
-            }
+            check_proposal(ablation, &visible, &applied, &new_report, &report)?;
             Ok((applied, new_report))
         })();
         let parsed = parsed.ok();
@@ -390,20 +334,7 @@ pub async fn explore<R: Reasoner>(
                 }
             }
             Err(problem) => {
-                let candidate_procedure = match &problem {
-                    Problem::NotResolved { .. } => parsed
-                        .as_ref()
-                        .and_then(|r| apply_patch(&procedure, &r.patches[0], near).ok())
-                        .map(|a| a.procedure)
-                        .unwrap_or_default(),
-                    _ => Vec::new(),
-                };
-                let fb = Feedback {
-                    attempt: this_iteration,
-                    reply: reply.clone(),
-                    message: describe(&problem, &candidate_procedure),
-                    problem,
-                };
+                let fb = rejection(this_iteration, &reply, parsed.as_ref(), &procedure, near, problem);
                 feedback.push(fb.clone());
                 trace.events.push(TraceEvent::Proposal {
                     iteration: this_iteration,
@@ -414,5 +345,137 @@ pub async fn explore<R: Reasoner>(
                 });
             }
         }
+    }
+}
+
+/// The outcome once the loop stops: adapted if the procedure is consistent and reaches the
+/// goal, else unresolved with the best and the last procedure.
+fn finish(
+    procedure: Vec<Operator>,
+    report: Report,
+    best: Vec<Operator>,
+    last_violation: Option<ViolationInfo>,
+    iterations: usize,
+) -> ExplorationResult {
+    let outcome = if report.is_valid() {
+        Outcome::Adapted {
+            procedure,
+            report,
+            iterations,
+        }
+    } else {
+        Outcome::Unresolved {
+            best,
+            last: procedure,
+            last_violation,
+            iterations,
+        }
+    };
+    ExplorationResult { outcome }
+}
+
+/// What a request shows when identification is off (or found nothing): the procedure and
+/// the initial state, no failing step and no unmet literals.
+fn unidentified(target: &Target) -> ViolationInfo {
+    ViolationInfo {
+        kind: ViolationKind::Unidentified,
+        failing_step: None,
+        action: None,
+        unmet: Vec::new(),
+        state: target.init.clone(),
+    }
+}
+
+/// The patch request for `violation`: split at the failing step with identification, the
+/// whole procedure as "remaining" without it.
+fn patch_request(
+    identification: bool,
+    iteration: usize,
+    target: &Target,
+    procedure: &[Operator],
+    violation: &ViolationInfo,
+    feedback: &[Feedback],
+) -> PatchRequest {
+    if identification {
+        let split = violation.failing_step.unwrap_or(procedure.len());
+        PatchRequest {
+            iteration,
+            task: target.task.clone(),
+            kind: violation.kind,
+            procedure: procedure.to_vec(),
+            executed: procedure[..split].to_vec(),
+            erroneous: violation.failing_step.map(|i| procedure[i].clone()),
+            remaining: procedure.get(split + 1..).map(|r| r.to_vec()).unwrap_or_default(),
+            failing_step: violation.failing_step,
+            initial_state: target.init.clone(),
+            error_state: violation.state.clone(),
+            unmet: violation.unmet.clone(),
+            feedback: feedback.to_vec(),
+        }
+    } else {
+        PatchRequest {
+            iteration,
+            task: target.task.clone(),
+            kind: ViolationKind::Unidentified,
+            procedure: procedure.to_vec(),
+            executed: Vec::new(),
+            erroneous: None,
+            remaining: procedure.to_vec(),
+            failing_step: None,
+            initial_state: target.init.clone(),
+            error_state: target.init.clone(),
+            unmet: Vec::new(),
+            feedback: feedback.to_vec(),
+        }
+    }
+}
+
+/// The verification of an applied proposal (Eq. 8): with identification it must resolve the
+/// violation it was asked about; without, it must make the executor get further. With
+/// verification off every applied proposal passes.
+fn check_proposal(
+    ablation: Ablation,
+    visible: &ViolationInfo,
+    applied: &AppliedPatch,
+    new_report: &Report,
+    report: &Report,
+) -> Result<(), Problem> {
+    if !ablation.verification {
+        return Ok(());
+    }
+    if ablation.identification {
+        return resolves(visible, applied, new_report);
+    }
+    if progress(new_report) <= progress(report) {
+        return Err(Problem::NotResolved {
+            failing_step: new_report.first_failure,
+            unmet: identify_unmet(new_report).unwrap_or_default(),
+        });
+    }
+    Ok(())
+}
+
+/// The feedback for a rejected reply. A proposal that applied but did not resolve the
+/// violation is described with the procedure it would have produced.
+fn rejection(
+    attempt: usize,
+    reply: &str,
+    parsed: Option<&RefinementReply>,
+    procedure: &[Operator],
+    near: usize,
+    problem: Problem,
+) -> Feedback {
+    let candidate_procedure = match &problem {
+        Problem::NotResolved { .. } => parsed
+            .and_then(|r| apply_patch(procedure, &r.patches[0], near).ok())
+            .map(|a| a.procedure)
+            .unwrap_or_default(),
+        _ => Vec::new(),
+    };
+    Feedback {
+        attempt,
+        reply: reply.to_owned(),
+        message: describe(&problem, &candidate_procedure),
+        problem,
     }
 }

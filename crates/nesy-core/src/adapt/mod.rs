@@ -29,7 +29,8 @@ mod world_model;
 
 pub use explore::{ExplorationResult, explore, identify, resolves};
 pub use reasoner::{
-    Feedback, InductionRequest, PatchRequest, Problem, Reasoner, ReasonerError, TaskContext, ViolationKind,
+    Feedback, InductionRequest, PatchRequest, Problem, Reasoner, ReasonerError, ReasonerErrorKind,
+    TaskContext, ViolationKind,
 };
 pub use world_model::{WorldModel, check_transition, construct_world_model};
 
@@ -117,7 +118,8 @@ impl Ablation {
 pub struct AdaptConfig {
     /// Attempts per demonstrated transition during world-model construction.
     pub induction_tries: usize,
-    /// Maximum patch proposals (reasoner calls) during exploration; see [`iteration_budget`].
+    /// Maximum patch proposals (reasoner calls) during exploration; the benchmark's budget is
+    /// [`crate::benchmark::iteration_budget`].
     pub budget: usize,
     /// What "Φ(s_t, a_t) ⊨ s_{t+1}" means.
     pub transition_check: TransitionCheck,
@@ -133,49 +135,6 @@ impl Default for AdaptConfig {
             transition_check: TransitionCheck::Exact,
             ablation: Ablation::FULL,
         }
-    }
-}
-
-/// The benchmark's domain factors (spec §6; config names in parentheses).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum DomainFactor {
-    /// Object affordance (`affo`).
-    Affordance,
-    /// Obstruction (`obst`).
-    Obstruction,
-    /// Finger gripper source, vacuum target (`grip`).
-    Gripper,
-    /// Vacuum source, finger gripper target (`vacu`).
-    Vacuum,
-    /// Combination of factors (`comb`).
-    Combination,
-}
-
-/// Task complexity levels.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Complexity {
-    /// Two subtasks.
-    Low,
-    /// Three subtasks.
-    Medium,
-    /// Four subtasks.
-    High,
-}
-
-/// The exploration budget of spec §7 and the paper's hyper-parameter table: 10, or 15 for
-/// the combination factor, doubled at high complexity (20 / 30).
-pub fn iteration_budget(factor: DomainFactor, complexity: Complexity) -> usize {
-    let base = if factor == DomainFactor::Combination {
-        15
-    } else {
-        10
-    };
-    if complexity == Complexity::High {
-        base * 2
-    } else {
-        base
     }
 }
 

@@ -187,21 +187,66 @@ impl PatchRequest {
     }
 }
 
-/// A reasoner failed to produce a reply at all (transport, quota, refusal): this ends the
-/// run, unlike a bad reply, which becomes feedback.
+/// A reasoner failed to produce a reply at all: this ends the run, unlike a bad reply,
+/// which becomes feedback. The [`ReasonerErrorKind`] tells a caller (the benchmark harness)
+/// whether to retry the unit later or to score it as the method's failure.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error, Serialize, Deserialize)]
-#[error("reasoner failed: {message}")]
+#[error("reasoner failed ({}): {message}", kind.as_str())]
 pub struct ReasonerError {
-    /// What went wrong.
+    /// What kind of failure it was.
+    pub kind: ReasonerErrorKind,
+    /// What went wrong, with the call that failed.
     pub message: String,
 }
 
+/// The kinds of [`ReasonerError`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ReasonerErrorKind {
+    /// The call did not complete: the network, a timeout, a rate limit or a server error.
+    /// Worth retrying later; says nothing about the method.
+    Transport,
+    /// The endpoint refused the request as built (too many images, too long, bad
+    /// parameters): retrying the same request will not help.
+    Refused,
+    /// A reply arrived but cannot be used at all (not a chat response, cut off at the token
+    /// cap, a model refusal).
+    Reply,
+    /// A recorded exchange is missing or unreadable (cassette replay).
+    Replay,
+    /// The request could not be built (a prompt template failed, bad settings).
+    Request,
+    /// A scripted or offline responder has no answer (a test double ran out, an offline
+    /// responder gave up).
+    Exhausted,
+}
+
+impl ReasonerErrorKind {
+    /// `transport`, `refused`, `reply`, `replay`, `request` or `exhausted`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ReasonerErrorKind::Transport => "transport",
+            ReasonerErrorKind::Refused => "refused",
+            ReasonerErrorKind::Reply => "reply",
+            ReasonerErrorKind::Replay => "replay",
+            ReasonerErrorKind::Request => "request",
+            ReasonerErrorKind::Exhausted => "exhausted",
+        }
+    }
+}
+
 impl ReasonerError {
-    /// An error with a message.
-    pub fn new(message: impl Into<String>) -> Self {
+    /// An error of `kind` with a message.
+    pub fn new(kind: ReasonerErrorKind, message: impl Into<String>) -> Self {
         ReasonerError {
+            kind,
             message: message.into(),
         }
+    }
+
+    /// A scripted or offline responder has no answer ([`ReasonerErrorKind::Exhausted`]).
+    pub fn exhausted(message: impl Into<String>) -> Self {
+        ReasonerError::new(ReasonerErrorKind::Exhausted, message)
     }
 }
 

@@ -1,4 +1,4 @@
-//! Action blocks (benchmark spec §9) and procedures (blocks separated by blank lines):
+//! Action blocks (`docs/benchmark.md` §9) and procedures (blocks separated by blank lines):
 //!
 //! ```text
 //! OpenGripperToDropOrangeIntoHingeBody

@@ -4,26 +4,23 @@
 #![allow(dead_code)]
 
 use nesy_core::formula::{AtomPattern, Effect, Formula, Term, TypedVar};
+use nesy_core::rng::SplitMix64;
 use nesy_core::{Atom, Operator, State, Symbol};
 
-/// SplitMix64.
-pub struct SeedRng(pub u64);
+/// The test generators' source of randomness: nesy-core's SplitMix64 with a few helpers.
+pub struct SeedRng(pub SplitMix64);
 
 impl SeedRng {
-    pub fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+    pub fn new(seed: u64) -> SeedRng {
+        SeedRng(SplitMix64::new(seed))
     }
 
     pub fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
+        self.0.below(n)
     }
 
     pub fn chance(&mut self, percent: u64) -> bool {
-        self.next() % 100 < percent
+        (self.0.below(100) as u64) < percent
     }
 
     pub fn word(&mut self, items: &[&'static str]) -> &'static str {

@@ -10,7 +10,7 @@ use pyo3::ffi;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyByteArray, PyBytes, PyDict, PyFloat, PyInt, PyString, PyTuple};
 
-/// Height of the table surface in the world frame (spec §1: `Z_OFFSET = 0.5`). A
+/// Height of the table surface in the world frame (`docs/benchmark.md` §1: `Z_OFFSET = 0.5`). A
 /// two-element position `(x, y)` means a point on the table surface, `(x, y, 0.5)`.
 pub const TABLE_TOP_Z: f64 = 0.5;
 

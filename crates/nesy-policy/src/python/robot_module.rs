@@ -1,4 +1,4 @@
-//! The `robot` Python module: the paper's perception and action API (spec §4), with the
+//! The `robot` Python module: the paper's perception and action API (`docs/benchmark.md` §4), with the
 //! same names, parameters and defaults, calling into the episode's [`RobotApi`].
 //!
 //! Positions and boxes come back as `np.array`s of the vetted `np` subset, as in the

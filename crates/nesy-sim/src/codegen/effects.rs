@@ -13,6 +13,7 @@ use nesy_core::formula::{Effect, Formula};
 use nesy_core::operator::Operator;
 
 use super::{Kind, kind_of};
+use crate::scene::parts;
 
 /// A ground literal: predicate and arguments.
 type Lit = (String, Vec<String>);
@@ -56,9 +57,9 @@ fn positive_pre(pre: &[Formula]) -> Vec<Lit> {
 /// The handles, the part each one moves (the observer may name either) and the schemas'
 /// word for it.
 const HANDLES: [(&str, &str, &str); 3] = [
-    ("hinge_handle", "hinge_lid", "hinge"),
-    ("bottom_drawer_handle", "bottom_drawer", "bottom-drawer"),
-    ("top_drawer_handle", "top_drawer", "top-drawer"),
+    (parts::HINGE_HANDLE, parts::HINGE_LID, "hinge"),
+    (parts::BOTTOM_DRAWER_HANDLE, parts::BOTTOM_DRAWER, "bottom-drawer"),
+    (parts::TOP_DRAWER_HANDLE, parts::TOP_DRAWER, "top-drawer"),
 ];
 
 fn is_holding(pred: &str) -> bool {
@@ -103,12 +104,12 @@ pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(&'
     for (x, opened) in changes {
         if let Some(x) = x {
             let schema = match (x.as_str(), opened) {
-                ("hinge_lid", true) => "open-hinge-lid",
-                ("hinge_lid", false) => "close-hinge-lid",
-                ("bottom_drawer", true) => "open-bottom-drawer",
-                ("bottom_drawer", false) => "close-bottom-drawer",
-                ("top_drawer", true) => "open-top-drawer",
-                ("top_drawer", false) => "close-top-drawer",
+                (parts::HINGE_LID, true) => "open-hinge-lid",
+                (parts::HINGE_LID, false) => "close-hinge-lid",
+                (parts::BOTTOM_DRAWER, true) => "open-bottom-drawer",
+                (parts::BOTTOM_DRAWER, false) => "close-bottom-drawer",
+                (parts::TOP_DRAWER, true) => "open-top-drawer",
+                (parts::TOP_DRAWER, false) => "close-top-drawer",
                 _ => continue,
             };
             return Some((schema, Vec::new()));
@@ -154,8 +155,8 @@ pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(&'
             .find(|(y, _)| *y == x)
             .map(|(_, place)| place)?;
         return match (rest.as_str(), kind_of(&rest)) {
-            ("hinge_body", _) => Some(("drop-into-hinge-body", vec![x])),
-            ("bottom_drawer", _) => Some(("drop-into-bottom-drawer", vec![x])),
+            (parts::HINGE_BODY, _) => Some(("drop-into-hinge-body", vec![x])),
+            (parts::BOTTOM_DRAWER, _) => Some(("drop-into-bottom-drawer", vec![x])),
             (_, Some(Kind::Surface)) => Some(("put-down", vec![x, rest])),
             (_, Some(Kind::Box)) => Some(("release-into", vec![x, rest])),
             _ => None,
@@ -173,8 +174,8 @@ pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(&'
     };
     if let Some((x, place)) = add2("OverOf").into_iter().find(|(x, _)| item(x)) {
         return match place.as_str() {
-            "hinge_body" => Some(("carry-over-hinge-body", vec![x])),
-            "bottom_drawer" => Some(("carry-over-bottom-drawer", vec![x])),
+            parts::HINGE_BODY => Some(("carry-over-hinge-body", vec![x])),
+            parts::BOTTOM_DRAWER => Some(("carry-over-bottom-drawer", vec![x])),
             _ => None,
         };
     }
@@ -184,7 +185,7 @@ pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(&'
     {
         // Chess pieces reach their boxes by a push across the board; anything held is
         // carried in.
-        return if b.ends_with("chess_box") || !held(&x) {
+        return if b == parts::LEFT_CHESS_BOX || b == parts::RIGHT_CHESS_BOX || !held(&x) {
             Some(("sweep-into", vec![x, b]))
         } else {
             Some(("carry-into", vec![x, b]))
@@ -200,9 +201,9 @@ pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(&'
     // the table (the put-down that follows names the surface it comes to rest on).
     if let Some((_, a)) = dels.iter().find(|(p, a)| {
         matches!(p.as_str(), "OnTopOf" | "InsideOf" | "OverOf") && a.len() == 2 && item(&a[0]) && held(&a[0])
-    }) && objects.iter().any(|o| o == "floor")
+    }) && objects.iter().any(|o| o == parts::FLOOR)
     {
-        return Some(("carry-onto", vec![a[0].clone(), "floor".to_owned()]));
+        return Some(("carry-onto", vec![a[0].clone(), parts::FLOOR.to_owned()]));
     }
     // Only quantified clearing effects, no relation of its own: the hand only moves (a
     // retreat, or an approach to a handle, which the grasp that follows makes itself). An

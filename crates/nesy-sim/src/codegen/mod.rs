@@ -22,7 +22,8 @@ use nesy_core::operator::Operator;
 use serde::{Deserialize, Serialize};
 
 use crate::api::Embodiment;
-use crate::api_impl::MAX_FINGER_DEPTH;
+use crate::api::MAX_FINGER_DEPTH;
+use crate::scene::{TABLE_TOP, parts};
 
 /// What an action does, independent of the end effector.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -111,8 +112,13 @@ const SCHEMAS: &[Schema] = &[
     s("drop-into-bottom-drawer", Release, &[I], None),
     s("sweep-into", Push, &[I, B], None),
     s("retreat", Retreat, &[], None),
-    s("move-to-hinge-handle", MoveToHandle, &[], Some("hinge_handle")),
-    s("grasp-hinge-handle", GraspHandle, &[], Some("hinge_handle")),
+    s(
+        "move-to-hinge-handle",
+        MoveToHandle,
+        &[],
+        Some(parts::HINGE_HANDLE),
+    ),
+    s("grasp-hinge-handle", GraspHandle, &[], Some(parts::HINGE_HANDLE)),
     s("open-hinge-lid", OpenLid, &[], None),
     s("close-hinge-lid", CloseLid, &[], None),
     s("release-hinge-handle", ReleaseHandle, &[], None),
@@ -120,31 +126,36 @@ const SCHEMAS: &[Schema] = &[
         "move-to-bottom-drawer-handle",
         MoveToHandle,
         &[],
-        Some("bottom_drawer_handle"),
+        Some(parts::BOTTOM_DRAWER_HANDLE),
     ),
     s(
         "grasp-bottom-drawer-handle",
         GraspHandle,
         &[],
-        Some("bottom_drawer_handle"),
+        Some(parts::BOTTOM_DRAWER_HANDLE),
     ),
-    s("open-bottom-drawer", OpenDrawer, &[], Some("bottom_drawer")),
-    s("close-bottom-drawer", CloseDrawer, &[], Some("bottom_drawer")),
+    s("open-bottom-drawer", OpenDrawer, &[], Some(parts::BOTTOM_DRAWER)),
+    s(
+        "close-bottom-drawer",
+        CloseDrawer,
+        &[],
+        Some(parts::BOTTOM_DRAWER),
+    ),
     s("release-bottom-drawer-handle", ReleaseHandle, &[], None),
     s(
         "move-to-top-drawer-handle",
         MoveToHandle,
         &[],
-        Some("top_drawer_handle"),
+        Some(parts::TOP_DRAWER_HANDLE),
     ),
     s(
         "grasp-top-drawer-handle",
         GraspHandle,
         &[],
-        Some("top_drawer_handle"),
+        Some(parts::TOP_DRAWER_HANDLE),
     ),
-    s("open-top-drawer", OpenDrawer, &[], Some("top_drawer")),
-    s("close-top-drawer", CloseDrawer, &[], Some("top_drawer")),
+    s("open-top-drawer", OpenDrawer, &[], Some(parts::TOP_DRAWER)),
+    s("close-top-drawer", CloseDrawer, &[], Some(parts::TOP_DRAWER)),
     s("release-top-drawer-handle", ReleaseHandle, &[], None),
     s("move-to-align", MoveToObject, &[I], None),
     s("attach", Take, &[I], None),
@@ -162,9 +173,9 @@ const SCHEMAS: &[Schema] = &[
         "suction-move-to-hinge-handle",
         MoveToHandle,
         &[],
-        Some("hinge_handle"),
+        Some(parts::HINGE_HANDLE),
     ),
-    s("attach-hinge-handle", GraspHandle, &[], Some("hinge_handle")),
+    s("attach-hinge-handle", GraspHandle, &[], Some(parts::HINGE_HANDLE)),
     s("suction-open-hinge-lid", OpenLid, &[], None),
     s("suction-close-hinge-lid", CloseLid, &[], None),
     s("detach-hinge-handle", ReleaseHandle, &[], None),
@@ -172,41 +183,51 @@ const SCHEMAS: &[Schema] = &[
         "suction-move-to-bottom-drawer-handle",
         MoveToHandle,
         &[],
-        Some("bottom_drawer_handle"),
+        Some(parts::BOTTOM_DRAWER_HANDLE),
     ),
     s(
         "attach-bottom-drawer-handle",
         GraspHandle,
         &[],
-        Some("bottom_drawer_handle"),
+        Some(parts::BOTTOM_DRAWER_HANDLE),
     ),
     s(
         "suction-open-bottom-drawer",
         OpenDrawer,
         &[],
-        Some("bottom_drawer"),
+        Some(parts::BOTTOM_DRAWER),
     ),
     s(
         "suction-close-bottom-drawer",
         CloseDrawer,
         &[],
-        Some("bottom_drawer"),
+        Some(parts::BOTTOM_DRAWER),
     ),
     s("detach-bottom-drawer-handle", ReleaseHandle, &[], None),
     s(
         "suction-move-to-top-drawer-handle",
         MoveToHandle,
         &[],
-        Some("top_drawer_handle"),
+        Some(parts::TOP_DRAWER_HANDLE),
     ),
     s(
         "attach-top-drawer-handle",
         GraspHandle,
         &[],
-        Some("top_drawer_handle"),
+        Some(parts::TOP_DRAWER_HANDLE),
     ),
-    s("suction-open-top-drawer", OpenDrawer, &[], Some("top_drawer")),
-    s("suction-close-top-drawer", CloseDrawer, &[], Some("top_drawer")),
+    s(
+        "suction-open-top-drawer",
+        OpenDrawer,
+        &[],
+        Some(parts::TOP_DRAWER),
+    ),
+    s(
+        "suction-close-top-drawer",
+        CloseDrawer,
+        &[],
+        Some(parts::TOP_DRAWER),
+    ),
     s("detach-top-drawer-handle", ReleaseHandle, &[], None),
 ];
 
@@ -217,7 +238,11 @@ pub fn schema_names() -> impl Iterator<Item = &'static str> {
 
 // Where objects go and how the lid swings: the scripted experts' constants, shared so the
 // compiled policies place objects exactly where the experts do.
-use crate::expert::{DRAWER_SPOTS, HINGE_SPOTS, LID_CLOSING_ARC, LID_OPENING_ARC, TOY_BOX_CELLS};
+use crate::tasks::layout::{
+    DRAWER_DROP_CLEARANCE, DRAWER_PULL_FRACTION, DRAWER_RETREAT, DRAWER_SPOTS, DROP_CLEARANCE,
+    HINGE_DROP_CLEARANCE, HINGE_SPOTS, LID_CLOSING_ARC, LID_OPENING_ARC, LID_SWING_MAX_X, PUSH_DEPTH_DIVISOR,
+    PUSH_OVERSHOOT, TOY_BOX_CELLS,
+};
 
 /// A Python helper the finger programs use to pick up round fruit: the wrist turn (rad) at
 /// which the open fingers point away from the nearest neighbour that stands above the
@@ -297,12 +322,14 @@ fn camel(text: &str) -> String {
         .collect()
 }
 
+/// The schema argument kind an object can fill, from its name: the world's fixed names are
+/// surfaces, boxes or parts no schema takes as an argument; every other name is a loose item.
 fn kind_of(object: &str) -> Option<Kind> {
     match object {
-        "floor" | "board" => Some(Kind::Surface),
-        "toy_box" => Some(Kind::Box),
-        o if o.ends_with("chess_box") => Some(Kind::Box),
-        o if o.starts_with("hinge_") || o.contains("drawer") || o.contains("gripper") => None,
+        parts::FLOOR | parts::BOARD => Some(Kind::Surface),
+        parts::TOY_BOX | parts::LEFT_CHESS_BOX | parts::RIGHT_CHESS_BOX => Some(Kind::Box),
+        parts::GRIPPER | parts::VACUUM_GRIPPER => None,
+        o if parts::HINGE_BOX_PARTS.contains(&o) || parts::DRAWER_CABINET_PARTS.contains(&o) => None,
         _ => Some(Kind::Item),
     }
 }
@@ -343,7 +370,7 @@ pub fn resolve_action(name: &str, objects: &[String]) -> Option<ResolvedAction> 
     })
 }
 
-/// Recognises an action by its effects and preconditions (see [`effects`]) when its name
+/// Recognises an action by its effects and preconditions (the `effects` module) when its name
 /// names no schema: how operators named freely by a model are compiled.
 pub fn resolve_by_effects(op: &Operator, objects: &[String]) -> Option<ResolvedAction> {
     let (name, args) = effects::schema_by_effects(op, objects)?;
@@ -389,16 +416,20 @@ pub fn compile_policy(
     })
 }
 
-struct Emitter {
+struct Emitter<'a> {
     out: String,
     vacuum: bool,
     /// Drops so far per container (for cells and spots).
     drops: BTreeMap<String, usize>,
     /// The tool points sideways (`pointing` in the program) since the last handle approach.
     pointing: bool,
+    /// The whole procedure (some actions look at their neighbours).
+    actions: &'a [ResolvedAction],
+    /// The objects carried over the hinge body (round fruit).
+    fruits: Vec<&'a str>,
 }
 
-impl Emitter {
+impl Emitter<'_> {
     fn line(&mut self, text: &str) {
         self.out.push_str(text);
         self.out.push('\n');
@@ -440,7 +471,11 @@ impl Emitter {
         if sideways {
             // The suction tool reaches the bottom handle pointing at the cabinet: from above
             // its wrist would sweep cylinders off the cabinet's front edge (as the expert).
-            self.line("pointing = \"right\" if get_obj_pos(\"bottom_drawer_handle\")[1] < get_obj_pos(\"drawer_body\")[1] else \"left\"");
+            self.line(&format!(
+                "pointing = \"right\" if get_obj_pos({:?})[1] < get_obj_pos({:?})[1] else \"left\"",
+                parts::BOTTOM_DRAWER_HANDLE,
+                parts::DRAWER_BODY
+            ));
             self.line(&format!("move_gripper_to({handle:?}, pointing_to=pointing)"));
             self.pointing = true;
         } else if self.vacuum {
@@ -456,16 +491,16 @@ impl Emitter {
     /// straight across keep distinct x; a piece knocked off to one side is brought back in).
     fn over_at_own_x(&mut self, x: &str, bbox: &str, hang: &str) {
         self.line(&format!(
-            "move_to_position([min(max(get_obj_pos({x:?})[0], {bbox}[0][0] + 0.025), {bbox}[1][0] - 0.025), ({bbox}[0][1] + {bbox}[1][1]) / 2, {bbox}[1][2] + {hang} + 0.01])"
+            "move_to_position([min(max(get_obj_pos({x:?})[0], {bbox}[0][0] + 0.025), {bbox}[1][0] - 0.025), ({bbox}[0][1] + {bbox}[1][1]) / 2, {bbox}[1][2] + {hang} + {DROP_CLEARANCE}])"
         ));
     }
 
     fn carry_onto(&mut self, x: &str, surface: &str) {
         let hang = self.hang(&format!("get_obj_size({x:?})[2]"));
-        if surface == "floor" {
+        if surface == parts::FLOOR {
             self.line(&format!("spot = get_empty_floor_xy({x:?})"));
             self.line(&format!(
-                "move_to_position([spot[0], spot[1], 0.5 + {hang} + 0.01])"
+                "move_to_position([spot[0], spot[1], {TABLE_TOP} + {hang} + {DROP_CLEARANCE}])"
             ));
         } else {
             // The piece keeps its own x (the sweep pushes it straight across), but a piece no
@@ -478,11 +513,17 @@ impl Emitter {
 
     fn drawer_directions(&mut self) {
         // Drawers slide out toward the side their handles are on (as the expert decides).
-        self.line("handle_y = get_obj_pos(\"bottom_drawer_handle\")[1]");
-        self.line("cabinet_y = get_obj_pos(\"drawer_body\")[1]");
+        self.line(&format!(
+            "handle_y = get_obj_pos({:?})[1]",
+            parts::BOTTOM_DRAWER_HANDLE
+        ));
+        self.line(&format!("cabinet_y = get_obj_pos({:?})[1]", parts::DRAWER_BODY));
         self.line("open_dir = \"left\" if handle_y < cabinet_y else \"right\"");
         self.line("close_dir = \"right\" if open_dir == \"left\" else \"left\"");
-        self.line("travel = get_obj_size(\"bottom_drawer\")[1] * 0.85");
+        self.line(&format!(
+            "travel = get_obj_size({:?})[1] * {DRAWER_PULL_FRACTION}",
+            parts::BOTTOM_DRAWER
+        ));
     }
 }
 
@@ -490,20 +531,29 @@ impl Emitter {
 /// pulling the bottom drawer open.
 fn opens_bottom_drawer(actions: &[ResolvedAction], i: usize) -> bool {
     let handle = schema(&actions[i].schema).part;
-    handle == Some("bottom_drawer_handle")
+    handle == Some(parts::BOTTOM_DRAWER_HANDLE)
         && actions[i + 1..]
             .iter()
             .take_while(|a| a.motion != GraspHandle || schema(&a.schema).part == handle)
-            .any(|a| a.motion == OpenDrawer && schema(&a.schema).part == Some("bottom_drawer"))
+            .any(|a| a.motion == OpenDrawer && schema(&a.schema).part == Some(parts::BOTTOM_DRAWER))
 }
 
 fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
     let vacuum = embodiment == Embodiment::Vacuum;
+    // The hinge task's fruits (what is carried over the hinge body) are round: the fingers
+    // take them at the turn that keeps clear of their neighbours.
+    let fruits: Vec<&str> = actions
+        .iter()
+        .filter(|a| a.motion == CarryOverHinge)
+        .filter_map(|a| a.args.first().map(String::as_str))
+        .collect();
     let mut e = Emitter {
         out: String::new(),
         vacuum,
         drops: BTreeMap::new(),
         pointing: false,
+        actions,
+        fruits,
     };
     let _ = writeln!(
         e.out,
@@ -512,207 +562,235 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
         embodiment
     );
     e.line("import math");
-    // The hinge task's fruits (what is carried over the hinge body) are round: the fingers
-    // take them at the turn that keeps clear of their neighbours.
-    let fruits: Vec<&str> = actions
-        .iter()
-        .filter(|a| a.motion == CarryOverHinge)
-        .filter_map(|a| a.args.first().map(String::as_str))
-        .collect();
-    if !vacuum && !fruits.is_empty() {
+    if !vacuum && !e.fruits.is_empty() {
         e.out.push_str(CLEAR_ANGLE_HELPER);
     }
     for (i, a) in actions.iter().enumerate() {
         let _ = writeln!(e.out, "\n# {}. {}", i + 1, a.name);
+        e.action(i, a);
+    }
+    e.out
+}
+
+impl Emitter<'_> {
+    /// The calls for action `i` of the procedure.
+    fn action(&mut self, i: usize, a: &ResolvedAction) {
         let arg = |k: usize| a.args.get(k).map(String::as_str).unwrap_or_default();
         let part = schema(&a.schema).part.unwrap_or_default();
         match a.motion {
-            MoveToObject => {
-                let x = arg(0);
-                e.pointing = false;
-                if vacuum {
-                    e.line(&format!("move_gripper_to({x:?})"));
-                } else {
-                    // Deep enough to push the object when a sweep follows, else mid-height.
-                    let pushes = actions
-                        .get(i + 1)
-                        .is_some_and(|n| n.motion == Push && n.args.first().map(String::as_str) == Some(x));
-                    let div = if pushes { "1.3" } else { "2" };
-                    if fruits.contains(&x) && !pushes {
-                        // `move_gripper_to`'s tool point (the top less the depth, capped as
-                        // the API caps it), with the fingers turned clear of the neighbours.
-                        e.line(&format!("fb = get_obj_bbox({x:?})"));
-                        e.line(&format!(
-                            "move_to_position([(fb[0][0] + fb[1][0]) / 2, (fb[0][1] + fb[1][1]) / 2, fb[1][2] - min(get_obj_size({x:?})[2] / 2, {MAX_FINGER_DEPTH})], angle=clear_angle({x:?}))"
-                        ));
-                    } else {
-                        e.line(&format!(
-                            "move_gripper_to({x:?}, depth=get_obj_size({x:?})[2] / {div})"
-                        ));
-                    }
-                }
-            }
+            MoveToObject => self.move_to_object(i, arg(0)),
             Take => {
-                let t = e.take();
-                e.line(t);
+                let t = self.take();
+                self.line(t);
             }
-            Release => {
-                // A put-down says where the object comes to rest; without a carry to that
-                // surface just before it, the carry is part of it.
-                let put_down = a.schema.ends_with("put-down");
-                let carried = i > 0
-                    && actions[i - 1].motion == CarryOnto
-                    && actions[i - 1].args.first() == a.args.first();
-                if put_down && !carried {
-                    e.carry_onto(arg(0), arg(1));
-                }
-                let r = e.release();
-                e.line(r);
-            }
+            Release => self.release_object(i, a),
             CarryOnto => {
                 // The following put-down names the surface the object comes to rest on (the
                 // carry itself may leave it just above either surface).
-                let surface = match actions.get(i + 1) {
+                let surface = match self.actions.get(i + 1) {
                     Some(n) if n.schema.ends_with("put-down") && n.args.first() == a.args.first() => {
                         n.args.get(1).map(String::as_str).unwrap_or(arg(1))
                     }
                     _ => arg(1),
                 };
-                e.carry_onto(arg(0), surface);
+                self.carry_onto(arg(0), surface);
             }
-            CarryInto => {
-                let (x, b) = (arg(0), arg(1));
-                let k = e.next_drop(b);
-                let [dx, dy] = if b == "toy_box" {
-                    TOY_BOX_CELLS[k % TOY_BOX_CELLS.len()]
-                } else {
-                    [0.0, 0.0]
-                };
-                let hang = e.hang(&format!("get_obj_size({x:?})[2]"));
-                e.line(&format!("box = get_obj_bbox({b:?})"));
-                if b.ends_with("chess_box") {
-                    // Every piece into the box's centre would land the second on the first: a
-                    // piece keeps its own x (distinct per piece, as the sweep pushes them straight
-                    // across), kept inside the box.
-                    e.over_at_own_x(x, "box", &hang);
-                } else {
-                    e.line(&format!(
-                        "move_to_position([(box[0][0] + box[1][0]) / 2 + {dx}, (box[0][1] + box[1][1]) / 2 + {dy}, box[1][2] + {hang} + 0.01])"
-                    ));
-                }
-            }
-            CarryOverHinge => {
-                let x = arg(0);
-                let k = e.next_drop("hinge_body");
-                let dy = HINGE_SPOTS[k % HINGE_SPOTS.len()];
-                let hang = e.hang(&format!("get_obj_size({x:?})[2]"));
-                e.line("body = get_obj_bbox(\"hinge_body\")");
-                e.line(&format!(
-                    "move_to_position([(body[0][0] + body[1][0]) / 2, (body[0][1] + body[1][1]) / 2 + {dy}, body[1][2] + {hang} + 0.03])"
-                ));
-            }
-            CarryOverDrawer => {
-                let x = arg(0);
-                let k = e.next_drop("bottom_drawer");
-                let [dx, dy] = DRAWER_SPOTS[k % DRAWER_SPOTS.len()];
-                e.line("outward = -1.0 if get_obj_pos(\"bottom_drawer_handle\")[1] < get_obj_pos(\"drawer_body\")[1] else 1.0");
-                e.line("drawer = get_obj_pos(\"bottom_drawer\")");
-                e.line(&format!(
-                    "move_to_position([drawer[0] + {dx}, drawer[1] + {dy} * outward, drawer[2] + get_obj_size(\"bottom_drawer\")[2] + get_obj_size({x:?})[2] + 0.05])"
-                ));
-            }
-            Push => {
-                let (x, b) = (arg(0), arg(1));
-                // A push starts low around the piece. After a put-down the fingers are still
-                // open around it, but at the carry height and with the piece loose between
-                // them: from there the slide leaves it short of its box. Approach it again,
-                // as the expert does before every push.
-                let approached = i > 0
-                    && actions[i - 1].motion == MoveToObject
-                    && actions[i - 1].args.first().map(String::as_str) == Some(x);
-                if !vacuum && !approached {
-                    e.line(&format!(
-                        "move_gripper_to({x:?}, depth=get_obj_size({x:?})[2] / 1.3)"
-                    ));
-                }
-                e.line(&format!("piece_y = get_obj_pos({x:?})[1]"));
-                e.line(&format!("box_y = get_obj_pos({b:?})[1]"));
-                e.line(
-                    "move_parallel(\"left\" if piece_y > box_y else \"right\", abs(piece_y - box_y) + 0.02)",
-                );
-            }
+            CarryInto => self.carry_into(arg(0), arg(1)),
+            CarryOverHinge => self.carry_over_hinge(arg(0)),
+            CarryOverDrawer => self.carry_over_drawer(arg(0)),
+            Push => self.push(i, arg(0), arg(1)),
             Retreat => {
-                if e.pointing {
-                    e.line("move_parallel(\"up\", 0.05, pointing_to=pointing)");
+                let up = format!("move_parallel(\"up\", {DRAWER_RETREAT}");
+                if self.pointing {
+                    self.line(&format!("{up}, pointing_to=pointing)"));
                 } else {
-                    e.line("move_parallel(\"up\", 0.05)");
+                    self.line(&format!("{up})"));
                 }
             }
             MoveToHandle => {
-                let sideways = vacuum && opens_bottom_drawer(actions, i);
-                e.move_to_handle(part, sideways)
+                let sideways = self.vacuum && opens_bottom_drawer(self.actions, i);
+                self.move_to_handle(part, sideways)
             }
-            GraspHandle => {
-                let moved = i > 0
-                    && actions[i - 1].motion == MoveToHandle
-                    && schema(&actions[i - 1].schema).part == Some(part);
-                if !moved {
-                    let sideways = vacuum && opens_bottom_drawer(actions, i);
-                    e.move_to_handle(part, sideways);
-                }
-                if vacuum {
-                    e.line(&format!("attach_vacuum_handle({part:?})"));
-                } else {
-                    e.line(&format!("grasp_handle({part:?})"));
-                }
-            }
-            OpenLid | CloseLid => {
-                // A demonstration records one action per waypoint of a swing, and a
-                // waypoint that has not moved the lid yet may read either way: a run of lid
-                // actions is one arc, in the direction of the run's last action.
-                let is_swing = |m: Motion| m == OpenLid || m == CloseLid;
-                if actions.get(i + 1).is_some_and(|n| is_swing(n.motion)) {
-                    e.line("# (one swing with the next action)");
-                    continue;
-                }
-                let arc: &[f64] = if a.motion == OpenLid {
-                    &LID_OPENING_ARC
-                } else {
-                    &LID_CLOSING_ARC
-                };
-                e.line("body = get_obj_bbox(\"hinge_body\")");
-                e.line("lid = get_obj_bbox(\"hinge_lid\")");
-                e.line("lid_y = (lid[0][1] + lid[1][1]) / 2");
-                e.line("reach = max(lid[1][0] - lid[0][0], lid[1][2] - lid[0][2])");
-                e.line(&format!("for degrees in {arc:?}:"));
-                e.line("    a = math.radians(degrees)");
-                e.line("    x = min(body[1][0] + reach * math.cos(a), 0.725)");
-                e.line("    move_to_position([x, lid_y, body[1][2] + reach * math.sin(a)], lift_clearance=0.0, angle=math.pi / 2)");
-            }
+            GraspHandle => self.grasp_handle(i, part),
+            OpenLid | CloseLid => self.swing_lid(i, a.motion),
             ReleaseHandle => {
-                if vacuum {
-                    e.line("detach_vacuum_handle()");
+                if self.vacuum {
+                    self.line("detach_vacuum_handle()");
                 } else {
-                    e.line("release_handle()");
+                    self.line("release_handle()");
                 }
             }
             OpenDrawer | CloseDrawer => {
-                e.drawer_directions();
+                self.drawer_directions();
                 let dir = if a.motion == OpenDrawer {
                     "open_dir"
                 } else {
                     "close_dir"
                 };
-                let _ = part;
-                if e.pointing {
-                    e.line(&format!("move_parallel({dir}, travel, pointing_to=pointing)"));
+                if self.pointing {
+                    self.line(&format!("move_parallel({dir}, travel, pointing_to=pointing)"));
                 } else {
-                    e.line(&format!("move_parallel({dir}, travel)"));
+                    self.line(&format!("move_parallel({dir}, travel)"));
                 }
             }
         }
     }
-    e.out
+
+    fn move_to_object(&mut self, i: usize, x: &str) {
+        self.pointing = false;
+        if self.vacuum {
+            self.line(&format!("move_gripper_to({x:?})"));
+            return;
+        }
+        // Deep enough to push the object when a sweep follows, else mid-height.
+        let pushes = self
+            .actions
+            .get(i + 1)
+            .is_some_and(|n| n.motion == Push && n.args.first().map(String::as_str) == Some(x));
+        if self.fruits.contains(&x) && !pushes {
+            // `move_gripper_to`'s tool point (the top less the depth, capped as the API caps
+            // it), with the fingers turned clear of the neighbours.
+            self.line(&format!("fb = get_obj_bbox({x:?})"));
+            self.line(&format!(
+                "move_to_position([(fb[0][0] + fb[1][0]) / 2, (fb[0][1] + fb[1][1]) / 2, fb[1][2] - min(get_obj_size({x:?})[2] / 2, {MAX_FINGER_DEPTH})], angle=clear_angle({x:?}))"
+            ));
+        } else {
+            let div = if pushes {
+                PUSH_DEPTH_DIVISOR.to_string()
+            } else {
+                "2".to_owned()
+            };
+            self.line(&format!(
+                "move_gripper_to({x:?}, depth=get_obj_size({x:?})[2] / {div})"
+            ));
+        }
+    }
+
+    fn release_object(&mut self, i: usize, a: &ResolvedAction) {
+        // A put-down says where the object comes to rest; without a carry to that surface
+        // just before it, the carry is part of it.
+        let put_down = a.schema.ends_with("put-down");
+        let carried = i > 0
+            && self.actions[i - 1].motion == CarryOnto
+            && self.actions[i - 1].args.first() == a.args.first();
+        if put_down && !carried {
+            let (x, surface) = (
+                a.args.first().map(String::as_str).unwrap_or_default(),
+                a.args.get(1).map(String::as_str).unwrap_or_default(),
+            );
+            self.carry_onto(x, surface);
+        }
+        let r = self.release();
+        self.line(r);
+    }
+
+    fn carry_into(&mut self, x: &str, b: &str) {
+        let k = self.next_drop(b);
+        let [dx, dy] = if b == parts::TOY_BOX {
+            TOY_BOX_CELLS[k % TOY_BOX_CELLS.len()]
+        } else {
+            [0.0, 0.0]
+        };
+        let hang = self.hang(&format!("get_obj_size({x:?})[2]"));
+        self.line(&format!("box = get_obj_bbox({b:?})"));
+        if b == parts::LEFT_CHESS_BOX || b == parts::RIGHT_CHESS_BOX {
+            // Every piece into the box's centre would land the second on the first: a piece
+            // keeps its own x (distinct per piece, as the sweep pushes them straight across),
+            // kept inside the box.
+            self.over_at_own_x(x, "box", &hang);
+        } else {
+            self.line(&format!(
+                "move_to_position([(box[0][0] + box[1][0]) / 2 + {dx}, (box[0][1] + box[1][1]) / 2 + {dy}, box[1][2] + {hang} + {DROP_CLEARANCE}])"
+            ));
+        }
+    }
+
+    fn carry_over_hinge(&mut self, x: &str) {
+        let k = self.next_drop(parts::HINGE_BODY);
+        let dy = HINGE_SPOTS[k % HINGE_SPOTS.len()];
+        let hang = self.hang(&format!("get_obj_size({x:?})[2]"));
+        self.line(&format!("body = get_obj_bbox({:?})", parts::HINGE_BODY));
+        self.line(&format!(
+            "move_to_position([(body[0][0] + body[1][0]) / 2, (body[0][1] + body[1][1]) / 2 + {dy}, body[1][2] + {hang} + {HINGE_DROP_CLEARANCE}])"
+        ));
+    }
+
+    fn carry_over_drawer(&mut self, x: &str) {
+        let k = self.next_drop(parts::BOTTOM_DRAWER);
+        let [dx, dy] = DRAWER_SPOTS[k % DRAWER_SPOTS.len()];
+        self.line(&format!(
+            "outward = -1.0 if get_obj_pos({:?})[1] < get_obj_pos({:?})[1] else 1.0",
+            parts::BOTTOM_DRAWER_HANDLE,
+            parts::DRAWER_BODY
+        ));
+        self.line(&format!("drawer = get_obj_pos({:?})", parts::BOTTOM_DRAWER));
+        self.line(&format!(
+            "move_to_position([drawer[0] + {dx}, drawer[1] + {dy} * outward, drawer[2] + get_obj_size({:?})[2] + get_obj_size({x:?})[2] + {DRAWER_DROP_CLEARANCE}])",
+            parts::BOTTOM_DRAWER
+        ));
+    }
+
+    fn push(&mut self, i: usize, x: &str, b: &str) {
+        // A push starts low around the piece. After a put-down the fingers are still open
+        // around it, but at the carry height and with the piece loose between them: from
+        // there the slide leaves it short of its box. Approach it again, as the expert does
+        // before every push.
+        let approached = i > 0
+            && self.actions[i - 1].motion == MoveToObject
+            && self.actions[i - 1].args.first().map(String::as_str) == Some(x);
+        if !self.vacuum && !approached {
+            self.line(&format!(
+                "move_gripper_to({x:?}, depth=get_obj_size({x:?})[2] / {PUSH_DEPTH_DIVISOR})"
+            ));
+        }
+        self.line(&format!("piece_y = get_obj_pos({x:?})[1]"));
+        self.line(&format!("box_y = get_obj_pos({b:?})[1]"));
+        self.line(&format!(
+            "move_parallel(\"left\" if piece_y > box_y else \"right\", abs(piece_y - box_y) + {PUSH_OVERSHOOT})"
+        ));
+    }
+
+    fn grasp_handle(&mut self, i: usize, part: &str) {
+        let moved = i > 0
+            && self.actions[i - 1].motion == MoveToHandle
+            && schema(&self.actions[i - 1].schema).part == Some(part);
+        if !moved {
+            let sideways = self.vacuum && opens_bottom_drawer(self.actions, i);
+            self.move_to_handle(part, sideways);
+        }
+        if self.vacuum {
+            self.line(&format!("attach_vacuum_handle({part:?})"));
+        } else {
+            self.line(&format!("grasp_handle({part:?})"));
+        }
+    }
+
+    fn swing_lid(&mut self, i: usize, motion: Motion) {
+        // A demonstration records one action per waypoint of a swing, and a waypoint that has
+        // not moved the lid yet may read either way: a run of lid actions is one arc, in the
+        // direction of the run's last action.
+        let is_swing = |m: Motion| m == OpenLid || m == CloseLid;
+        if self.actions.get(i + 1).is_some_and(|n| is_swing(n.motion)) {
+            self.line("# (one swing with the next action)");
+            return;
+        }
+        let arc: &[f64] = if motion == OpenLid {
+            &LID_OPENING_ARC
+        } else {
+            &LID_CLOSING_ARC
+        };
+        self.line(&format!("body = get_obj_bbox({:?})", parts::HINGE_BODY));
+        self.line(&format!("lid = get_obj_bbox({:?})", parts::HINGE_LID));
+        self.line("lid_y = (lid[0][1] + lid[1][1]) / 2");
+        self.line("reach = max(lid[1][0] - lid[0][0], lid[1][2] - lid[0][2])");
+        self.line(&format!("for degrees in {arc:?}:"));
+        self.line("    a = math.radians(degrees)");
+        self.line(&format!(
+            "    x = min(body[1][0] + reach * math.cos(a), {})",
+            LID_SWING_MAX_X
+        ));
+        self.line("    move_to_position([x, lid_y, body[1][2] + reach * math.sin(a)], lift_clearance=0.0, angle=math.pi / 2)");
+    }
 }
 
 #[cfg(test)]

@@ -57,7 +57,6 @@ pub struct Manifest {
     /// Object names in the scene.
     pub objects: Vec<String>,
     /// The demonstrating robot's end effector: `finger` or `vacuum`.
-    #[schemars(with = "crate::scene::EmbodimentSchema")]
     pub embodiment: Embodiment,
     /// Benchmark scenario id, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -3,7 +3,7 @@
 //! A [`Demo`] is its metadata (instruction, objects, embodiment, scenario, version, and
 //! optionally the target scene it is meant to be adapted to) plus its keyframes. A keyframe
 //! is the initial state or the state after one completed action call (the authors'
-//! definition, spec §7); it carries the three camera views (plain and labelled PNG), the
+//! definition, `docs/benchmark.md` §7); it carries the three camera views (plain and labelled PNG), the
 //! ground-truth symbolic state when one is known, and the API call that led to it.
 //!
 //! Two storage layouts are read by [`read`]:
@@ -14,7 +14,7 @@
 
 pub mod folder;
 pub mod mcap_format;
-pub mod record;
+mod record;
 
 use std::path::{Path, PathBuf};
 

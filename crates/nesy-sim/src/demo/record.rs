@@ -7,11 +7,11 @@ use std::time::{Duration, Instant};
 
 use super::{CameraImages, CameraName, Demo, DemoMetadata, Keyframe, KeyframeViews, NESY_VERSION};
 use crate::api::{RobotApi, TraceEntry};
-use crate::expert::{self, ExpertError};
-use crate::goal::{EpisodeOutcome, GoalError, GoalMonitor};
-use crate::render::{View, render_views};
+use crate::perception::render::{View, render_views};
 use crate::scene::{SceneError, SceneSpec};
-use crate::sim::{Sim, SimHook};
+use crate::tasks::experts::{self, ExpertError};
+use crate::tasks::goal::{EpisodeOutcome, GoalError, GoalMonitor};
+use crate::world::{Sim, SimHook};
 
 /// How to record.
 #[derive(Clone, Debug, PartialEq)]
@@ -31,8 +31,8 @@ pub struct RecordOptions {
 impl Default for RecordOptions {
     fn default() -> Self {
         RecordOptions {
-            image_size: crate::render::VIEW_SIZE,
-            render_threads: crate::render::default_threads(),
+            image_size: crate::perception::render::VIEW_SIZE,
+            render_threads: crate::perception::render::default_threads(),
             scenario_id: None,
             side: None,
             target_scene: None,
@@ -100,7 +100,7 @@ impl KeyframeHook {
         let started = Instant::now();
         let views = render_views(sim, self.image_size, self.render_threads);
         let views = encode_views(&views);
-        let state = crate::observer::observe(sim);
+        let state = crate::perception::observer::observe(sim);
         let mut captured = self.captured.lock().unwrap_or_else(|e| e.into_inner());
         let index = captured.keyframes.len();
         captured.keyframes.push(Keyframe {
@@ -161,7 +161,7 @@ pub fn record_scene(scene: &SceneSpec, options: &RecordOptions) -> Result<Record
     };
     hook.capture(&sim, None);
     sim.add_hook(Box::new(hook));
-    let expert_error = expert::run(&mut sim, &scene.goals).err();
+    let expert_error = experts::run(&mut sim, scene).err();
     let outcome = monitor.finish(&mut sim);
     // The recorder is done: later calls (the object list below) add no keyframes.
     drop(sim.take_hooks());
@@ -218,7 +218,7 @@ pub fn run_expert(scene: &SceneSpec) -> Result<ExpertRun, RecordError> {
     let mut sim = Sim::new(scene)?;
     let monitor = GoalMonitor::attach(&mut sim)?;
     let start = sim.time();
-    let expert_error = expert::run(&mut sim, &scene.goals).err();
+    let expert_error = experts::run(&mut sim, scene).err();
     let outcome = monitor.finish(&mut sim);
     Ok(ExpertRun {
         outcome,

@@ -44,7 +44,22 @@ use crate::transport::{BoxFuture, Origin, Transport, WireRequest, WireResponse};
 pub trait PolicyCompiler: Send + Sync + fmt::Debug {
     /// The program for the request's procedure, objects and end effector, or why there is
     /// none.
-    fn compile(&self, request: &CodeGenerationContext) -> Result<String, String>;
+    fn compile(&self, request: &CodeGenerationContext) -> Result<String, PolicyCompileError>;
+}
+
+/// Why a [`PolicyCompiler`] produced no program.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum PolicyCompileError {
+    /// An action of the procedure maps to no motion of the robot API.
+    #[error("{detail}")]
+    UnknownAction {
+        /// 1-based position in the procedure.
+        index: usize,
+        /// The action's name.
+        name: String,
+        /// The compiler's explanation.
+        detail: String,
+    },
 }
 
 /// Counts of what the oracle answered, for reports and tests.
@@ -179,7 +194,7 @@ impl OracleTransport {
                 let compiler = self.compiler.as_ref().ok_or_else(|| {
                     fail("the oracle has no policy compiler for code generation; plug in nesy-sim's template compiler".into())
                 })?;
-                let code = compiler.compile(&ctx).map_err(fail)?;
+                let code = compiler.compile(&ctx).map_err(|e| fail(e.to_string()))?;
                 self.bump(|s| s.programs += 1);
                 Ok(format!(
                     "The program below is nesy's template compilation of the {} verified actions for the {}.\n\n```python\n{}```\n",

@@ -6,6 +6,7 @@ use std::str::FromStr;
 
 use nesy_core::formula::{Effect, Formula};
 use nesy_core::operator::Operator;
+use nesy_core::rng::SplitMix64;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -125,7 +126,7 @@ impl fmt::Display for OracleNoise {
 
 /// A small deterministic generator (SplitMix64) seeded per request.
 #[derive(Debug, Clone)]
-pub struct NoiseRng(u64);
+pub struct NoiseRng(SplitMix64);
 
 impl NoiseRng {
     /// A generator for one request: the run's seed and the request body decide it, so a
@@ -137,26 +138,17 @@ impl NoiseRng {
         let digest = h.finalize();
         let mut bytes = [0u8; 8];
         bytes.copy_from_slice(&digest[..8]);
-        NoiseRng(u64::from_le_bytes(bytes))
-    }
-
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        NoiseRng(SplitMix64::new(u64::from_le_bytes(bytes)))
     }
 
     /// True with probability `p`.
     pub fn chance(&mut self, p: f64) -> bool {
-        p > 0.0 && (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64 <= p
+        self.0.chance(p)
     }
 
     /// A uniform index below `n` (n > 0).
     pub fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n.max(1) as u64) as usize
+        self.0.below(n)
     }
 }
 
@@ -249,9 +241,9 @@ mod tests {
         let mut a = NoiseRng::for_request(7, &body);
         let mut b = NoiseRng::for_request(7, &body);
         let mut c = NoiseRng::for_request(8, &body);
-        let xs: Vec<u64> = (0..4).map(|_| a.next_u64()).collect();
-        assert_eq!(xs, (0..4).map(|_| b.next_u64()).collect::<Vec<_>>());
-        assert_ne!(xs, (0..4).map(|_| c.next_u64()).collect::<Vec<_>>());
+        let xs: Vec<usize> = (0..4).map(|_| a.below(1 << 30)).collect();
+        assert_eq!(xs, (0..4).map(|_| b.below(1 << 30)).collect::<Vec<_>>());
+        assert_ne!(xs, (0..4).map(|_| c.below(1 << 30)).collect::<Vec<_>>());
         let hits = (0..10_000).filter(|_| a.chance(0.2)).count();
         assert!((1_700..2_300).contains(&hits), "{hits}");
         assert!(!a.chance(0.0));

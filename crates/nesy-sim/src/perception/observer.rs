@@ -1,0 +1,364 @@
+//! The symbolic state observer (`docs/benchmark.md` §5): geometry to `nesy_core::State`.
+//!
+//! [`observe`] snapshots the simulator into a [`Snapshot`] and [`observe_snapshot`] applies
+//! the predicate rules to it, so the rules can be tested on hand-made geometry. Every
+//! threshold of the rules is one of the named constants below.
+
+use nesy_core::{Atom, State};
+
+use crate::api::Embodiment;
+use crate::scene::parts;
+use crate::world::Sim;
+use crate::world::geometry::Aabb;
+use crate::world::objects::PartRole;
+
+/// A joint reads `Closed` at or below this fraction of its travel.
+pub const CLOSED_PROGRESS: f64 = 0.3;
+/// A joint reads `Open` at or above this fraction of its travel.
+pub const OPEN_PROGRESS: f64 = 0.7;
+/// A joint also reads closed (open) within `LIMIT_NEAR_BASE + LIMIT_NEAR_SCALE × |limit|` of
+/// its lower (upper) limit.
+pub const LIMIT_NEAR_BASE: f64 = 0.1;
+/// See [`LIMIT_NEAR_BASE`].
+pub const LIMIT_NEAR_SCALE: f64 = 0.3;
+/// Least xy overlap (m, on both axes) between an object and what it rests on.
+pub const SUPPORT_MIN_OVERLAP: f64 = 0.002;
+/// How far (m) an object's bottom may sink below a support's top and still rest on it.
+pub const SUPPORT_MAX_SINK: f64 = 0.003;
+/// How far (m) above a support's top an object's bottom may float and still rest on it.
+pub const SUPPORT_MAX_GAP: f64 = 0.01;
+/// How far (m) an object's bottom may reach below a support's bottom (objects resting on a
+/// thin plate, not beside a tall block).
+pub const SUPPORT_BELOW_TOLERANCE: f64 = 0.01;
+/// Supports whose tops are within this height (m) of the highest one all count.
+pub const SUPPORT_TOP_TIE: f64 = 1e-5;
+/// xy margin (m) within which the open top drawer covers the bottom drawer's handle, and a
+/// held object is over something.
+pub const OVER_XY_MARGIN: f64 = 0.005;
+/// The gap (m) between a held object's bottom and what lies below it for `OverOf`.
+pub const OVER_GAP: std::ops::RangeInclusive<f64> = 0.02..=0.30;
+
+/// What the observer needs to know about one object.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectView {
+    /// Name.
+    pub name: String,
+    /// World AABB.
+    pub aabb: Aabb,
+    /// Role in the rules.
+    pub role: PartRole,
+    /// Articulated group (objects of one asset share it; pairs within a group are dropped).
+    pub group: Option<usize>,
+    /// Joint position and limits for `hinge_lid`, `top_drawer`, `bottom_drawer`.
+    pub joint: Option<(f64, f64, f64)>,
+    /// True if it is in the grasp region (between the pads or under the cup).
+    pub in_gripper: bool,
+}
+
+/// Everything the rules look at.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    /// `floor` (the table) first, then the objects in scene order.
+    pub objects: Vec<ObjectView>,
+    /// The robot's end effector.
+    pub embodiment: Embodiment,
+    /// Emit `(FingerGripper)`/`(VacuumSuction)`.
+    pub embodiment_in_state: bool,
+    /// Fingers closed or suction on.
+    pub closed: bool,
+    /// The welded object.
+    pub held: Option<String>,
+    /// The grasped handle.
+    pub grasped_handle: Option<String>,
+}
+
+/// How much (low, high) a container's box grows before `InsideOf` tests it
+/// (`docs/benchmark.md` §5's table).
+fn padding(name: &str) -> ([f64; 3], [f64; 3]) {
+    match name {
+        parts::HINGE_BODY => ([-0.02, -0.02, -0.02], [0.02, 0.02, 0.05]),
+        parts::TOY_BOX => ([-0.02, -0.02, -0.01], [0.02, 0.02, 0.05]),
+        parts::LEFT_CHESS_BOX | parts::RIGHT_CHESS_BOX => ([-0.01, -0.01, -0.01], [0.01, 0.01, 0.05]),
+        _ => ([-0.01, -0.01, -0.01], [0.01, 0.01, 0.02]),
+    }
+}
+
+/// Takes a snapshot of the simulator.
+pub fn snapshot(sim: &Sim) -> Snapshot {
+    let floor = ObjectView {
+        name: parts::FLOOR.into(),
+        aabb: sim.object_aabb(parts::FLOOR).unwrap_or(Aabb::EMPTY),
+        role: PartRole::Fixed,
+        group: None,
+        joint: None,
+        in_gripper: false,
+    };
+    let objects = std::iter::once(floor)
+        .chain(sim.parts().iter().enumerate().map(|(i, p)| {
+            let joint = (p.role == PartRole::Link)
+                .then(|| p.articulation.map(|a| &sim.articulations()[a]))
+                .flatten()
+                .map(|a| (a.q, a.limits.0, a.limits.1));
+            let group = matches!(
+                p.role,
+                PartRole::ArticulatedBody | PartRole::Link | PartRole::Handle
+            )
+            .then_some(p.object);
+            ObjectView {
+                name: p.name.clone(),
+                aabb: sim.part_aabb(i),
+                role: p.role,
+                group,
+                joint,
+                in_gripper: sim.part_in_gripper(i),
+            }
+        }))
+        .collect();
+    Snapshot {
+        objects,
+        embodiment: sim.robot_embodiment(),
+        embodiment_in_state: sim.scene().embodiment_in_state,
+        closed: sim.is_closed(),
+        held: sim.held_object().map(str::to_owned),
+        grasped_handle: sim.grasped_handle().map(str::to_owned),
+    }
+}
+
+/// The symbolic state of the simulator now.
+pub fn observe(sim: &Sim) -> State {
+    observe_snapshot(&snapshot(sim))
+}
+
+/// Open/Closed of a joint: Closed if its progress is at most [`CLOSED_PROGRESS`] or it is
+/// near the lower limit, else Open if its progress is at least [`OPEN_PROGRESS`] or it is
+/// near the upper limit, else neither.
+fn open_closed(q: f64, lo: f64, hi: f64) -> Option<&'static str> {
+    let progress = (q - lo) / (hi - lo);
+    let near = |limit: f64| (q - limit).abs() <= LIMIT_NEAR_BASE + LIMIT_NEAR_SCALE * limit.abs();
+    if progress <= CLOSED_PROGRESS || near(lo) {
+        Some("Closed")
+    } else if progress >= OPEN_PROGRESS || near(hi) {
+        Some("Open")
+    } else {
+        None
+    }
+}
+
+/// Applies the observer's rules to a snapshot.
+pub fn observe_snapshot(s: &Snapshot) -> State {
+    let mut atoms: Vec<Atom> = Vec::new();
+    let finger = s.embodiment == Embodiment::Finger;
+    let (open_p, closed_p, holding_p, surround_p) = if finger {
+        (
+            "GripperOpen",
+            "GripperClosed",
+            "GripperHolding",
+            "GripperSurrounding",
+        )
+    } else {
+        (
+            "VacuumInactive",
+            "VacuumActive",
+            "VacuumAttached",
+            "VacuumAligned",
+        )
+    };
+    atoms.push(Atom::new(if s.closed { closed_p } else { open_p }, &[]));
+    if s.embodiment_in_state {
+        atoms.push(Atom::new(
+            if finger { "FingerGripper" } else { "VacuumSuction" },
+            &[],
+        ));
+    }
+    for o in &s.objects {
+        if let Some((q, lo, hi)) = o.joint
+            && let Some(p) = open_closed(q, lo, hi)
+        {
+            atoms.push(Atom::new(p, &[&o.name]));
+        }
+    }
+    // Holding: the welded object or the grasped handle, while closed.
+    if s.closed {
+        let mut held: Vec<&str> = s
+            .held
+            .iter()
+            .chain(&s.grasped_handle)
+            .map(String::as_str)
+            .collect();
+        held.sort_unstable();
+        if let Some(first) = held.first() {
+            atoms.push(Atom::new(holding_p, &[first]));
+        }
+    } else if s.held.is_none() {
+        let mut around: Vec<&str> = s
+            .objects
+            .iter()
+            .filter(|o| {
+                o.in_gripper
+                    && o.name != parts::FLOOR
+                    && !matches!(o.role, PartRole::Handle | PartRole::ArticulatedBody)
+            })
+            .map(|o| o.name.as_str())
+            .collect();
+        around.sort_unstable();
+        if let Some(first) = around.first() {
+            atoms.push(Atom::new(surround_p, &[first]));
+        }
+    }
+    let same_group = |a: &ObjectView, b: &ObjectView| a.group.is_some() && a.group == b.group;
+    // InsideOf: the smallest container whose padded box holds the object.
+    let mut inside: Vec<Option<usize>> = vec![None; s.objects.len()];
+    for (i, a) in s.objects.iter().enumerate() {
+        let mut best: Option<(f64, usize)> = None;
+        for (j, c) in s.objects.iter().enumerate() {
+            if i == j || same_group(a, c) {
+                continue;
+            }
+            let (lo, hi) = padding(&c.name);
+            if c.aabb.padded(lo, hi).contains_box(&a.aabb) {
+                let v = c.aabb.volume();
+                if best.is_none_or(|(bv, _)| v < bv) {
+                    best = Some((v, j));
+                }
+            }
+        }
+        if let Some((_, j)) = best {
+            inside[i] = Some(j);
+            atoms.push(Atom::new("InsideOf", &[&a.name, &s.objects[j].name]));
+        }
+    }
+    let is_inside_pair = |i: usize, j: usize| inside[i] == Some(j) || inside[j] == Some(i);
+    // OnTopOf: resting on the highest supporting surface(s).
+    let mut on_top = vec![false; s.objects.len()];
+    for (i, a) in s.objects.iter().enumerate() {
+        if inside[i].is_some() {
+            continue;
+        }
+        let supports = |c: &Aabb| {
+            a.aabb.overlap(c, 0) > SUPPORT_MIN_OVERLAP
+                && a.aabb.overlap(c, 1) > SUPPORT_MIN_OVERLAP
+                && (-SUPPORT_MAX_SINK..=SUPPORT_MAX_GAP).contains(&(a.aabb.min[2] - c.max[2]))
+                && a.aabb.min[2] >= c.min[2] - SUPPORT_BELOW_TOLERANCE
+                && a.aabb.max[2] > c.max[2]
+        };
+        let candidates: Vec<(usize, f64)> = s
+            .objects
+            .iter()
+            .enumerate()
+            .filter(|&(j, c)| j != i && !is_inside_pair(i, j) && supports(&c.aabb))
+            .map(|(j, c)| (j, c.aabb.max[2]))
+            .collect();
+        let top = candidates.iter().map(|c| c.1).fold(f64::NEG_INFINITY, f64::max);
+        for (j, h) in candidates {
+            if (h - top).abs() <= SUPPORT_TOP_TIE && !same_group(a, &s.objects[j]) {
+                atoms.push(Atom::new("OnTopOf", &[&a.name, &s.objects[j].name]));
+                on_top[i] = true;
+            }
+        }
+    }
+    // Special rule: an open top drawer lies over the bottom drawer's handle.
+    if let (Some(top), Some(handle)) = (
+        s.objects.iter().find(|o| o.name == parts::TOP_DRAWER),
+        s.objects.iter().find(|o| o.name == parts::BOTTOM_DRAWER_HANDLE),
+    ) && top.aabb.overlaps_xy(&handle.aabb, OVER_XY_MARGIN)
+    {
+        atoms.push(Atom::new(
+            "OnTopOf",
+            &[parts::TOP_DRAWER, parts::BOTTOM_DRAWER_HANDLE],
+        ));
+    }
+    // OverOf: the held object above the nearest thing below it.
+    if let Some(held) = &s.held
+        && let Some(w) = s.objects.iter().position(|o| &o.name == held)
+        && inside[w].is_none()
+        && !on_top[w]
+    {
+        let wa = &s.objects[w].aabb;
+        let nearest = s
+            .objects
+            .iter()
+            .enumerate()
+            .filter(|&(j, o)| j != w && o.role != PartRole::Handle)
+            .map(|(_, o)| o)
+            .filter_map(|o| {
+                let gap = wa.min[2] - o.aabb.max[2];
+                (wa.overlap(&o.aabb, 0) > -OVER_XY_MARGIN
+                    && wa.overlap(&o.aabb, 1) > -OVER_XY_MARGIN
+                    && OVER_GAP.contains(&gap))
+                .then_some((gap, o.name.as_str()))
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((_, o)) = nearest {
+            atoms.push(Atom::new("OverOf", &[held, o]));
+        }
+    }
+    State::from_atoms(atoms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn obj(name: &str, min: [f64; 3], max: [f64; 3], role: PartRole) -> ObjectView {
+        ObjectView {
+            name: name.into(),
+            aabb: Aabb { min, max },
+            role,
+            group: None,
+            joint: None,
+            in_gripper: false,
+        }
+    }
+
+    fn snap(objects: Vec<ObjectView>) -> Snapshot {
+        let floor = obj("floor", [0.0, -1.0, 0.0], [1.0, 1.0, 0.5], PartRole::Fixed);
+        Snapshot {
+            objects: std::iter::once(floor).chain(objects).collect(),
+            embodiment: Embodiment::Finger,
+            embodiment_in_state: false,
+            closed: false,
+            held: None,
+            grasped_handle: None,
+        }
+    }
+
+    #[test]
+    fn joint_thresholds_match_spec() {
+        // Hinge: Closed when q ≤ −0.31, Open when q ≥ 0.3245 (progress 0.7).
+        assert_eq!(open_closed(-0.785, -0.785, 0.8), Some("Closed"));
+        assert_eq!(open_closed(-0.31, -0.785, 0.8), Some("Closed"));
+        assert_eq!(open_closed(0.0, -0.785, 0.8), None);
+        assert_eq!(open_closed(0.32, -0.785, 0.8), None);
+        assert_eq!(open_closed(0.325, -0.785, 0.8), Some("Open"));
+        // Drawer: Closed when q ≤ 0.10.
+        assert_eq!(open_closed(0.10, 0.0, 0.1232), Some("Closed"));
+        assert_eq!(open_closed(0.11, 0.0, 0.1232), Some("Open"));
+    }
+
+    #[test]
+    fn stack_inside_and_smallest_container() {
+        let s = snap(vec![
+            obj("toy_box", [0.4, 0.0, 0.5], [0.54, 0.1, 0.545], PartRole::Fixed),
+            obj(
+                "red_cube",
+                [0.45, 0.03, 0.504],
+                [0.48, 0.06, 0.534],
+                PartRole::Loose,
+            ),
+            obj("blue_cube", [0.2, 0.0, 0.5], [0.23, 0.03, 0.53], PartRole::Loose),
+            obj(
+                "green_cube",
+                [0.2, 0.0, 0.53],
+                [0.23, 0.03, 0.56],
+                PartRole::Loose,
+            ),
+        ]);
+        let state = observe_snapshot(&s);
+        let text = state.to_string();
+        assert!(text.contains("(InsideOf red_cube toy_box)"), "{text}");
+        assert!(text.contains("(OnTopOf green_cube blue_cube)"), "{text}");
+        assert!(!text.contains("(OnTopOf red_cube"), "{text}");
+        assert!(text.contains("(OnTopOf blue_cube floor)"), "{text}");
+        assert!(text.contains("(GripperOpen)"), "{text}");
+    }
+}

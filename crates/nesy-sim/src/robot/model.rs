@@ -1,0 +1,67 @@
+//! The two Panda variants: their URDFs (embedded from `assets/robots/`), tool links, home
+//! configuration and mounting pose.
+
+use nalgebra::{Translation3, UnitQuaternion};
+
+use crate::api::Embodiment;
+use crate::robot::kinematics::{Iso, ModelError, RobotModel};
+
+/// `assets/robots/panda_finger.urdf`.
+pub const FINGER_URDF: &str = include_str!("../../../../assets/robots/panda_finger.urdf");
+/// `assets/robots/panda_vacuum.urdf`.
+pub const VACUUM_URDF: &str = include_str!("../../../../assets/robots/panda_vacuum.urdf");
+
+/// The arm's initial joint configuration (`docs/benchmark.md` §1).
+pub const HOME_ARM: [f64; 7] = [
+    0.0,
+    -std::f64::consts::FRAC_PI_4,
+    0.0,
+    -3.0 * std::f64::consts::FRAC_PI_4,
+    0.0,
+    std::f64::consts::FRAC_PI_2,
+    std::f64::consts::FRAC_PI_4,
+];
+
+/// Initial and maximum finger travel (each finger) of the finger gripper.
+pub const FINGER_OPEN: f64 = 0.04;
+
+/// Where the robot base stands: on the pedestal at (0, 0, 0.5), facing +x.
+pub fn base_pose() -> Iso {
+    Iso::from_parts(Translation3::new(0.0, 0.0, 0.5), UnitQuaternion::identity())
+}
+
+/// URDF, tool link and the link that carries held objects, per embodiment.
+pub fn variant(embodiment: Embodiment) -> (&'static str, &'static str, &'static str) {
+    match embodiment {
+        Embodiment::Finger => (FINGER_URDF, "panda_grasp_point", "panda_hand"),
+        Embodiment::Vacuum => (VACUUM_URDF, "vacuum_tip", "vacuum_tool"),
+    }
+}
+
+/// Loads the kinematic model of a variant.
+pub fn load_model(embodiment: Embodiment) -> Result<RobotModel, ModelError> {
+    let (urdf, tool, _) = variant(embodiment);
+    RobotModel::from_urdf_str(urdf, tool)
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::robot::kinematics::{IkOptions, OrientationGoal, pointing_rotation};
+
+    #[test]
+    fn ik_round_trip_from_home() {
+        let m = load_model(Embodiment::Finger).unwrap();
+        let home = HOME_ARM.to_vec();
+        let target = Vector3::new(0.45, 0.1, 0.05);
+        let goal = OrientationGoal::Full(pointing_rotation(Vector3::new(0.0, 0.0, -1.0), 0.4));
+        let q = m
+            .solve_ik(target, goal, &home, &IkOptions::default())
+            .expect("reachable");
+        assert!(m.within_limits(&q));
+        let p = m.tool_pose(&q);
+        assert!((p.translation.vector - target).norm() < 1e-3);
+    }
+}

@@ -1,0 +1,468 @@
+//! `scene.json`: the versioned description of one episode's world (embodiment, objects,
+//! articulation states, subtask goals, instruction, seed), its JSON Schema, and loading
+//! with errors that name the JSON path and the expected value.
+//!
+//! [`parts`] names the fixed parts and the articulated joints; `goals` holds the subtask
+//! kinds and their goals.
+
+mod goals;
+pub mod parts;
+
+pub use goals::{Placement, SubtaskGoal, SubtaskKind};
+pub use parts::Joint;
+
+use std::collections::{BTreeMap, HashSet};
+use std::path::Path;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::api::Embodiment;
+
+/// The scene format version this build reads and writes.
+pub const SCENE_SCHEMA_VERSION: u32 = 1;
+
+/// Height of the table top in metres: objects resting on the table have their lowest point
+/// here, and the robot's base stands at this height on its pedestal.
+pub const TABLE_TOP: f64 = 0.5;
+
+/// One episode's world.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    /// Format version; must be 1.
+    pub schema_version: u32,
+    /// The robot's end effector.
+    pub embodiment: Embodiment,
+    /// When true the observer emits `(FingerGripper)` or `(VacuumSuction)` (the authors'
+    /// `ee_set`, used when source and target embodiments may differ).
+    #[serde(default)]
+    pub embodiment_in_state: bool,
+    /// The natural-language instruction.
+    #[serde(default)]
+    pub instruction: String,
+    /// Seed the scene was generated from (informational; the simulator is deterministic).
+    #[serde(default)]
+    pub seed: u64,
+    /// Objects, in scene order (perception lists them in this order after `floor`).
+    pub objects: Vec<ObjectSpec>,
+    /// Joint positions of articulated parts by part name (`hinge_lid`, `top_drawer`,
+    /// `bottom_drawer`), in the benchmark's convention: the hinge lid −0.785 closed to
+    /// +0.785 open (limits −0.785..0.8); drawers 0 closed to 0.1232 open. Parts not listed
+    /// start closed.
+    #[serde(default)]
+    pub articulations: BTreeMap<String, f64>,
+    /// What the episode asks for, one entry per subtask, in label order.
+    #[serde(default)]
+    pub goals: Vec<SubtaskGoal>,
+}
+
+/// One object of the scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectSpec {
+    /// Unique name, used by prompts, the API and the observer. Articulated kinds have fixed
+    /// part names and take the name of their base part: `hinge_body` for a hinge box,
+    /// `drawer_body` for a drawer cabinet.
+    pub name: String,
+    /// What it is.
+    pub kind: ObjectKind,
+    /// Where it is.
+    pub pose: PoseSpec,
+    /// Colour; when absent it is taken from the name's first word (`red_cube` is red) or
+    /// the kind's default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<ColourSpec>,
+    /// Overrides the kind's nominal outer size `[x, y, z]` in metres (before yaw).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size: Option<[f64; 3]>,
+}
+
+/// Position and heading of an object.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PoseSpec {
+    /// `[x, y, z]` in metres: x, y of the object's centre and z of its lowest point (0.5 is
+    /// the table top), so objects are placed resting, never interpenetrating.
+    pub position: [f64; 3],
+    /// Rotation about the world z axis in radians.
+    #[serde(default)]
+    pub yaw: f64,
+}
+
+/// Object kinds with their nominal sizes (`docs/benchmark.md` §2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ObjectKind {
+    /// 3 cm cube block.
+    Cube,
+    /// Cylinder block, radius 1.5 cm, height 3 cm.
+    Cylinder,
+    /// Apple, about 5.7 cm across.
+    Apple,
+    /// Orange, about 6.4 cm across.
+    Orange,
+    /// Lemon, about 5.4 cm across.
+    Lemon,
+    /// Chess rook, 5.1 cm tall.
+    Rook,
+    /// Chess knight, 5.9 cm tall.
+    Knight,
+    /// Chess bishop, 6.5 cm tall.
+    Bishop,
+    /// Chess board between the two chess boxes (fixed).
+    ChessBoard,
+    /// Open chess box with thin walls (fixed).
+    ChessBox,
+    /// Open toy box, bottom plus four walls (fixed).
+    ToyBox,
+    /// Box with a lid on a revolute hinge: parts `hinge_body`, `hinge_lid`, `hinge_handle`.
+    HingeBox,
+    /// Cabinet with two prismatic drawers: parts `drawer_body`, `top_drawer`,
+    /// `bottom_drawer`, `top_drawer_handle`, `bottom_drawer_handle`.
+    DrawerCabinet,
+}
+
+impl ObjectKind {
+    /// True for the kinds that move freely (picked, pushed, dropped).
+    pub fn is_loose(self) -> bool {
+        matches!(
+            self,
+            ObjectKind::Cube
+                | ObjectKind::Cylinder
+                | ObjectKind::Apple
+                | ObjectKind::Orange
+                | ObjectKind::Lemon
+                | ObjectKind::Rook
+                | ObjectKind::Knight
+                | ObjectKind::Bishop
+        )
+    }
+
+    /// The fixed name an articulated kind's entry must have.
+    pub fn required_name(self) -> Option<&'static str> {
+        match self {
+            ObjectKind::HingeBox => Some(parts::HINGE_BODY),
+            ObjectKind::DrawerCabinet => Some(parts::DRAWER_BODY),
+            _ => None,
+        }
+    }
+}
+
+/// A colour by name or as linear RGB in 0..1.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum ColourSpec {
+    /// One of the benchmark's colour names.
+    Named(NamedColour),
+    /// `[r, g, b]`, each in 0..1.
+    Rgb([f64; 3]),
+}
+
+/// The benchmark's colour names (`docs/benchmark.md` §2) plus a few for furniture and fruit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+#[allow(missing_docs)]
+pub enum NamedColour {
+    Red,
+    Green,
+    Blue,
+    Yellow,
+    Purple,
+    White,
+    Black,
+    Orange,
+    Brown,
+    Grey,
+}
+
+impl NamedColour {
+    /// RGB values (`docs/benchmark.md` §2's table for the block colours).
+    pub fn rgb(self) -> [f64; 3] {
+        match self {
+            NamedColour::Red => [0.8, 0.2, 0.2],
+            NamedColour::Green => [0.2, 0.8, 0.2],
+            NamedColour::Blue => [0.2, 0.2, 0.8],
+            NamedColour::Yellow => [0.95, 0.85, 0.2],
+            NamedColour::Purple => [0.6, 0.3, 0.8],
+            NamedColour::White => [0.95, 0.95, 0.95],
+            NamedColour::Black => [0.1, 0.1, 0.1],
+            NamedColour::Orange => [0.95, 0.55, 0.1],
+            NamedColour::Brown => [0.55, 0.38, 0.22],
+            NamedColour::Grey => [0.6, 0.6, 0.6],
+        }
+    }
+
+    /// Parses a lower-case colour name.
+    pub fn from_name(name: &str) -> Option<NamedColour> {
+        serde_json::from_value(serde_json::Value::String(name.to_owned())).ok()
+    }
+}
+
+impl ColourSpec {
+    /// RGB values in 0..1.
+    pub fn rgb(self) -> [f64; 3] {
+        match self {
+            ColourSpec::Named(n) => n.rgb(),
+            ColourSpec::Rgb(c) => c,
+        }
+    }
+}
+
+/// Why a scene could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("cannot read scene {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The JSON did not parse or did not match the format.
+    #[error("{origin}: at {path} (line {line}, column {column}): {message}")]
+    Json {
+        /// File name or `<string>`.
+        origin: String,
+        /// JSON path of the offending value, e.g. `objects[2].kind`.
+        path: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What serde expected.
+        message: String,
+    },
+    /// The JSON parsed but a value is not acceptable.
+    #[error("{origin}: at {path}: expected {expected}, found {found}")]
+    Invalid {
+        /// File name or `<string>`.
+        origin: String,
+        /// JSON path of the offending value.
+        path: String,
+        /// What would have been acceptable.
+        expected: String,
+        /// What was there.
+        found: String,
+    },
+}
+
+impl SceneError {
+    /// The JSON path the error points at, if any.
+    pub fn json_path(&self) -> Option<&str> {
+        match self {
+            SceneError::Io { .. } => None,
+            SceneError::Json { path, .. } | SceneError::Invalid { path, .. } => Some(path),
+        }
+    }
+
+    pub(crate) fn invalid(
+        path: impl Into<String>,
+        expected: impl Into<String>,
+        found: impl Into<String>,
+    ) -> Self {
+        SceneError::Invalid {
+            origin: "<scene>".into(),
+            path: path.into(),
+            expected: expected.into(),
+            found: found.into(),
+        }
+    }
+
+    /// The same error attributed to `name` (a file path) instead of `<scene>`.
+    pub fn with_origin(mut self, name: &str) -> Self {
+        match &mut self {
+            SceneError::Json { origin, .. } | SceneError::Invalid { origin, .. } => *origin = name.to_owned(),
+            SceneError::Io { .. } => {}
+        }
+        self
+    }
+}
+
+/// Names of the parts an object entry creates, base part first.
+pub fn part_names(spec: &ObjectSpec) -> Vec<String> {
+    match spec.kind {
+        ObjectKind::HingeBox => parts::HINGE_BOX_PARTS.map(str::to_owned).to_vec(),
+        ObjectKind::DrawerCabinet => parts::DRAWER_CABINET_PARTS.map(str::to_owned).to_vec(),
+        _ => vec![spec.name.clone()],
+    }
+}
+
+impl SceneSpec {
+    /// Parses and validates scene JSON; `origin` names the source in errors.
+    pub fn from_json_str(text: &str, origin: &str) -> Result<SceneSpec, SceneError> {
+        let de = &mut serde_json::Deserializer::from_str(text);
+        let spec: SceneSpec = serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            let message = inner.to_string();
+            // serde_json appends " at line L column C"; the position is reported separately.
+            let message = match message.rfind(" at line ") {
+                Some(i) => message[..i].to_owned(),
+                None => message,
+            };
+            SceneError::Json {
+                origin: origin.to_owned(),
+                path,
+                line: inner.line(),
+                column: inner.column(),
+                message,
+            }
+        })?;
+        spec.validate().map_err(|e| e.with_origin(origin))?;
+        Ok(spec)
+    }
+
+    /// Reads, parses and validates a scene file.
+    pub fn from_file(path: &Path) -> Result<SceneSpec, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        SceneSpec::from_json_str(&text, &path.display().to_string())
+    }
+
+    /// Pretty JSON.
+    pub fn to_json_pretty(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_default()
+    }
+
+    /// All part names in scene order.
+    pub fn part_names(&self) -> Vec<String> {
+        self.objects.iter().flat_map(part_names).collect()
+    }
+
+    /// Checks everything serde cannot: version, finite and positive numbers, unique names,
+    /// fixed part names, articulation names and ranges, goal references. (Interpenetration
+    /// needs geometry and is checked when the world is built.)
+    pub fn validate(&self) -> Result<(), SceneError> {
+        if self.schema_version != SCENE_SCHEMA_VERSION {
+            return Err(SceneError::invalid(
+                "schema_version",
+                format!("{SCENE_SCHEMA_VERSION}"),
+                self.schema_version.to_string(),
+            ));
+        }
+        let reserved = [parts::FLOOR, parts::GRIPPER, parts::VACUUM_GRIPPER];
+        let mut seen: HashSet<String> = reserved.iter().map(|s| s.to_string()).collect();
+        for (i, o) in self.objects.iter().enumerate() {
+            let at = |field: &str| format!("objects[{i}].{field}");
+            if o.name.is_empty() || o.name.chars().any(|c| !(c.is_ascii_alphanumeric() || c == '_')) {
+                return Err(SceneError::invalid(
+                    at("name"),
+                    "a non-empty name of [A-Za-z0-9_]",
+                    format!("{:?}", o.name),
+                ));
+            }
+            if let Some(required) = o.kind.required_name()
+                && o.name != required
+            {
+                return Err(SceneError::invalid(
+                    at("name"),
+                    format!("\"{required}\" (the parts of a {:?} have fixed names)", o.kind),
+                    format!("{:?}", o.name),
+                ));
+            }
+            for part in part_names(o) {
+                if !seen.insert(part.clone()) {
+                    return Err(SceneError::invalid(
+                        at("name"),
+                        "a name not used by another object",
+                        format!("duplicate {part:?}"),
+                    ));
+                }
+            }
+            for (k, v) in o.pose.position.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(SceneError::invalid(
+                        at(&format!("pose.position[{k}]")),
+                        "a finite number",
+                        v.to_string(),
+                    ));
+                }
+            }
+            if !o.pose.yaw.is_finite() {
+                return Err(SceneError::invalid(
+                    at("pose.yaw"),
+                    "a finite number",
+                    o.pose.yaw.to_string(),
+                ));
+            }
+            if let Some(size) = o.size {
+                if matches!(o.kind, ObjectKind::HingeBox | ObjectKind::DrawerCabinet) {
+                    return Err(SceneError::invalid(
+                        at("size"),
+                        "no size override (articulated assets have fixed geometry)",
+                        format!("{size:?}"),
+                    ));
+                }
+                for (k, v) in size.iter().enumerate() {
+                    if !(v.is_finite() && *v > 0.0 && *v <= 2.0) {
+                        return Err(SceneError::invalid(
+                            at(&format!("size[{k}]")),
+                            "a positive size in metres (at most 2)",
+                            v.to_string(),
+                        ));
+                    }
+                }
+            }
+            if let Some(ColourSpec::Rgb(c)) = o.colour {
+                for (k, v) in c.iter().enumerate() {
+                    if !(v.is_finite() && (0.0..=1.0).contains(v)) {
+                        return Err(SceneError::invalid(
+                            at(&format!("colour[{k}]")),
+                            "a value in 0..1",
+                            v.to_string(),
+                        ));
+                    }
+                }
+            }
+        }
+        for (part, q) in &self.articulations {
+            let at = format!("articulations.{part}");
+            let Some((lo, hi)) = Joint::from_name(part).map(Joint::limits) else {
+                return Err(SceneError::invalid(
+                    at,
+                    "one of hinge_lid, top_drawer, bottom_drawer",
+                    format!("{part:?}"),
+                ));
+            };
+            if !seen.contains(part) {
+                return Err(SceneError::invalid(
+                    at,
+                    "a part of an object in the scene",
+                    format!("{part:?}, which no object provides"),
+                ));
+            }
+            if !(q.is_finite() && *q >= lo - 1e-9 && *q <= hi + 1e-9) {
+                return Err(SceneError::invalid(
+                    at,
+                    format!("a joint position in [{lo}, {hi}]"),
+                    q.to_string(),
+                ));
+            }
+        }
+        for (g, goal) in self.goals.iter().enumerate() {
+            for (field, name) in goal.referenced_names() {
+                if !seen.contains(name) || reserved.contains(&name) {
+                    return Err(SceneError::invalid(
+                        format!("goals[{g}].{field}"),
+                        "the name of a scene object",
+                        format!("{name:?}"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The JSON Schema of [`SceneSpec`], pretty-printed (committed at
+/// `assets/schema/scene.schema.json`).
+pub fn json_schema() -> String {
+    let schema = schemars::schema_for!(SceneSpec);
+    let mut text = serde_json::to_string_pretty(&schema).unwrap_or_default();
+    text.push('\n');
+    text
+}

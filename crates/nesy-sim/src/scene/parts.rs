@@ -1,0 +1,116 @@
+//! The names the world gives its fixed parts, and the one-dof joints of the articulated
+//! assets with their limits and rest positions, in the benchmark's joint convention
+//! (`docs/benchmark.md` §2.3–§2.4).
+//!
+//! Articulated kinds have fixed part names (a hinge box is always `hinge_body`, `hinge_lid`
+//! and `hinge_handle`); the API, the observer, the goal checks, the experts and the template
+//! compiler all name them through these constants.
+//!
+//! ```
+//! use nesy_sim::scene::{Joint, parts};
+//!
+//! assert_eq!(Joint::from_name(parts::HINGE_LID), Some(Joint::HingeLid));
+//! assert_eq!(Joint::HingeLid.limits(), (-0.785, 0.8));
+//! assert_eq!(Joint::BottomDrawer.closed(), 0.0);
+//! ```
+
+/// The table, as the API and the observer name it.
+pub const FLOOR: &str = "floor";
+/// The finger hand (with its fingers), as the API and the observer name it.
+pub const GRIPPER: &str = "gripper";
+/// The suction tool, as the API and the observer name it on the vacuum robot.
+pub const VACUUM_GRIPPER: &str = "vacuum_gripper";
+
+/// The hinge box's fixed body (also the name of its scene entry).
+pub const HINGE_BODY: &str = "hinge_body";
+/// The hinge box's lid, on a revolute joint.
+pub const HINGE_LID: &str = "hinge_lid";
+/// The handle on the lid's free edge.
+pub const HINGE_HANDLE: &str = "hinge_handle";
+/// The drawer cabinet's fixed body (also the name of its scene entry).
+pub const DRAWER_BODY: &str = "drawer_body";
+/// The cabinet's top drawer, on a prismatic joint.
+pub const TOP_DRAWER: &str = "top_drawer";
+/// The cabinet's bottom drawer, on a prismatic joint.
+pub const BOTTOM_DRAWER: &str = "bottom_drawer";
+/// The top drawer's handle.
+pub const TOP_DRAWER_HANDLE: &str = "top_drawer_handle";
+/// The bottom drawer's handle.
+pub const BOTTOM_DRAWER_HANDLE: &str = "bottom_drawer_handle";
+/// The chess board of the sweep subtask.
+pub const BOARD: &str = "board";
+/// The toy box of the pick-and-place subtask.
+pub const TOY_BOX: &str = "toy_box";
+/// The chess box for the white pieces (toward −y).
+pub const LEFT_CHESS_BOX: &str = "left_chess_box";
+/// The chess box for the black pieces (toward +y).
+pub const RIGHT_CHESS_BOX: &str = "right_chess_box";
+
+/// The hinge box's parts, base part first.
+pub const HINGE_BOX_PARTS: [&str; 3] = [HINGE_BODY, HINGE_LID, HINGE_HANDLE];
+/// The drawer cabinet's parts, base part first.
+pub const DRAWER_CABINET_PARTS: [&str; 5] = [
+    DRAWER_BODY,
+    BOTTOM_DRAWER,
+    TOP_DRAWER,
+    BOTTOM_DRAWER_HANDLE,
+    TOP_DRAWER_HANDLE,
+];
+
+/// Lid joint position when open (the lid stands vertical).
+pub const LID_OPEN: f64 = 0.785;
+/// Lid joint position when closed (the lid lies flat on the body).
+pub const LID_CLOSED: f64 = -0.785;
+/// Upper limit of the lid joint (a little past vertical).
+pub const LID_MAX: f64 = 0.8;
+/// Full travel of a drawer (the authors' 0.88 × 0.14 scale).
+pub const DRAWER_TRAVEL: f64 = 0.1232;
+/// How far an open drawer is pulled out in the generated scenes (0.12 of the 0.1232
+/// travel).
+pub const DRAWER_OPEN: f64 = 0.12;
+
+/// The one-dof joints of the articulated assets, named by their moving link.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Joint {
+    /// The hinge lid: −0.785 closed (flat) to +0.785 open (vertical), limits −0.785..0.8.
+    HingeLid,
+    /// The top drawer: 0 closed to 0.1232 open.
+    TopDrawer,
+    /// The bottom drawer: 0 closed to 0.1232 open.
+    BottomDrawer,
+}
+
+impl Joint {
+    /// All three.
+    pub const ALL: [Joint; 3] = [Joint::HingeLid, Joint::TopDrawer, Joint::BottomDrawer];
+
+    /// The moving link's part name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Joint::HingeLid => HINGE_LID,
+            Joint::TopDrawer => TOP_DRAWER,
+            Joint::BottomDrawer => BOTTOM_DRAWER,
+        }
+    }
+
+    /// The joint of a moving link's part name.
+    pub fn from_name(name: &str) -> Option<Joint> {
+        Joint::ALL.into_iter().find(|j| j.name() == name)
+    }
+
+    /// Lower and upper limit.
+    pub fn limits(self) -> (f64, f64) {
+        match self {
+            Joint::HingeLid => (LID_CLOSED, LID_MAX),
+            Joint::TopDrawer | Joint::BottomDrawer => (0.0, DRAWER_TRAVEL),
+        }
+    }
+
+    /// The closed position, where a scene that does not list the joint starts.
+    pub fn closed(self) -> f64 {
+        match self {
+            Joint::HingeLid => LID_CLOSED,
+            Joint::TopDrawer | Joint::BottomDrawer => 0.0,
+        }
+    }
+}

@@ -1,0 +1,785 @@
+//! The benchmark's scenario suite (`docs/benchmark.md` §6, paper Table 6): five domain factors × three
+//! complexities, 220 source/target configurations, each evaluated with two seeds = 440
+//! scenarios.
+//!
+//! - Factors: `obst` (source clean → target obstructed), `affo` (source obstructed →
+//!   target clean), `grip` (finger source → vacuum target), `vacu` (vacuum source → finger
+//!   target), `comb` (obstruction changes both ways, and sometimes an embodiment change).
+//! - Complexities: low = 2 subtasks at multi level 0, medium = 3 at multi 1, high = all 4 at
+//!   multi 2.
+//! - Counts per factor: 15/15/10 configurations (low/medium/high), 20/20/20 for `comb`.
+//!
+//! Configurations come from nesy's own seeded streams ([`crate::world::rng::Stream`]); they are
+//! written as 15 JSON files ([`ConfigFile`], one per factor × complexity) by
+//! `nesy scenarios generate`. A scenario is a configuration plus a seed: seed `s` lays each
+//! subtask out with variant `variant + s × SEED_STRIDE` and the composite offsets with
+//! episode `episode_id + s × SEED_STRIDE`, so the two seeds give two different scenes of the
+//! same configuration, and source and target always share layouts.
+
+use std::path::Path;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::api::Embodiment;
+use crate::tasks::{GeneratedTask, SubtaskConfig, SubtaskKind, TaskConfig, TaskError};
+use crate::world::rng::Stream;
+
+/// Version of the configuration file format.
+pub const CONFIG_SCHEMA_VERSION: u32 = 1;
+/// The seeds every configuration is evaluated with.
+pub const SEEDS: [u64; 2] = [0, 1];
+/// Offset between the variants (and episodes) of consecutive seeds.
+pub const SEED_STRIDE: u64 = 1000;
+
+/// A domain factor: what differs between the demo (source) and deployment (target).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Factor {
+    /// Source clean → target obstructed (the target needs extra steps).
+    Obst,
+    /// Source obstructed → target clean (the demo has redundant steps).
+    Affo,
+    /// Finger-gripper source → vacuum target.
+    Grip,
+    /// Vacuum source → finger-gripper target.
+    Vacu,
+    /// Obstruction changes both ways, with or without an embodiment change.
+    Comb,
+}
+
+impl Factor {
+    /// All five, in the order of the paper's table.
+    pub const ALL: [Factor; 5] = [
+        Factor::Obst,
+        Factor::Affo,
+        Factor::Grip,
+        Factor::Vacu,
+        Factor::Comb,
+    ];
+
+    /// `obst`, `affo`, `grip`, `vacu` or `comb`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Factor::Obst => "obst",
+            Factor::Affo => "affo",
+            Factor::Grip => "grip",
+            Factor::Vacu => "vacu",
+            Factor::Comb => "comb",
+        }
+    }
+
+    /// The factor of a name.
+    pub fn from_name(name: &str) -> Option<Factor> {
+        Factor::ALL.into_iter().find(|f| f.as_str() == name)
+    }
+
+    /// The row of the paper's Table 6 this factor is counted in.
+    pub fn table_row(self) -> &'static str {
+        match self {
+            Factor::Obst | Factor::Affo => "Obstruction & Object Affordance",
+            Factor::Grip | Factor::Vacu => "Kinematic Config & Gripper",
+            Factor::Comb => "Combination",
+        }
+    }
+
+    /// Configurations at a complexity (`docs/benchmark.md` §6).
+    pub fn configurations(self, complexity: Complexity) -> usize {
+        match (self, complexity) {
+            (Factor::Comb, _) => 20,
+            (_, Complexity::Low | Complexity::Medium) => 15,
+            (_, Complexity::High) => 10,
+        }
+    }
+}
+
+impl std::fmt::Display for Factor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Task complexity.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Complexity {
+    /// Two subtasks at multi level 0.
+    Low,
+    /// Three subtasks at multi level 1.
+    Medium,
+    /// All four subtasks at multi level 2.
+    High,
+}
+
+impl Complexity {
+    /// All three.
+    pub const ALL: [Complexity; 3] = [Complexity::Low, Complexity::Medium, Complexity::High];
+
+    /// `low`, `medium` or `high`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Complexity::Low => "low",
+            Complexity::Medium => "medium",
+            Complexity::High => "high",
+        }
+    }
+
+    /// The complexity of a name.
+    pub fn from_name(name: &str) -> Option<Complexity> {
+        Complexity::ALL.into_iter().find(|c| c.as_str() == name)
+    }
+
+    /// Number of subtasks.
+    pub fn subtasks(self) -> usize {
+        match self {
+            Complexity::Low => 2,
+            Complexity::Medium => 3,
+            Complexity::High => 4,
+        }
+    }
+
+    /// The multi level of every subtask.
+    pub fn multi_level(self) -> u8 {
+        match self {
+            Complexity::Low => 0,
+            Complexity::Medium => 1,
+            Complexity::High => 2,
+        }
+    }
+}
+
+impl std::fmt::Display for Complexity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// One source/target configuration (the authors' episode).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EpisodeConfig {
+    /// Episode number within its file, from 0.
+    pub episode_id: u64,
+    /// The demo's subtasks, in instruction order.
+    pub source_subtasks: Vec<SubtaskConfig>,
+    /// The deployment's subtasks: the same kinds and variants, other obstruction levels.
+    pub target_subtasks: Vec<SubtaskConfig>,
+    /// The demonstrating robot.
+    pub source_embodiment: Embodiment,
+    /// The deploying robot.
+    pub target_embodiment: Embodiment,
+    /// States name the end effector (`(FingerGripper)` / `(VacuumSuction)`): the authors'
+    /// `ee_set`, on for `grip`, `vacu` and `comb`.
+    pub embodiment_in_state: bool,
+}
+
+/// One configuration file: all episodes of a factor at a complexity.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConfigFile {
+    /// Format version; must be 1.
+    pub schema_version: u32,
+    /// The domain factor.
+    pub factor: Factor,
+    /// The complexity.
+    pub complexity: Complexity,
+    /// Seeds each episode is evaluated with.
+    pub seeds: Vec<u64>,
+    /// The episodes.
+    pub episodes: Vec<EpisodeConfig>,
+}
+
+/// Why a configuration file cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// The file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The JSON does not parse or does not match the format.
+    #[error("{path}: at {field}: {message}")]
+    Json {
+        /// The file.
+        path: String,
+        /// JSON path of the offending value.
+        field: String,
+        /// What serde expected (with line and column).
+        message: String,
+    },
+    /// A value parsed but is not acceptable.
+    #[error("{path}: at {field}: expected {expected}, found {found}")]
+    Invalid {
+        /// The file.
+        path: String,
+        /// JSON path of the offending value.
+        field: String,
+        /// What would have been acceptable.
+        expected: String,
+        /// What was there.
+        found: String,
+    },
+    /// No scenario has this id.
+    #[error(
+        "unknown scenario {id:?}: expected <factor>_<complexity>_<NN>_s<seed>, e.g. obst_low_00_s0 (see `nesy scenarios list --ids`)"
+    )]
+    UnknownScenario {
+        /// The id asked for.
+        id: String,
+    },
+    /// A side's task does not generate.
+    #[error("scenario {id}, {side}: {source}")]
+    Task {
+        /// The scenario.
+        id: String,
+        /// `source` or `target`.
+        side: Side,
+        /// Why.
+        source: TaskError,
+    },
+}
+
+/// Which side of a scenario.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Side {
+    /// The demonstration.
+    Source,
+    /// The deployment.
+    Target,
+}
+
+impl Side {
+    /// `source` or `target`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Side::Source => "source",
+            Side::Target => "target",
+        }
+    }
+}
+
+impl std::fmt::Display for Side {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// The file name of a configuration file: `<factor>_<complexity>.json`.
+pub fn config_file_name(factor: Factor, complexity: Complexity) -> String {
+    format!("{}_{}.json", factor.as_str(), complexity.as_str())
+}
+
+/// Ordered obstruction changes `comb` draws from, per subtask (source → target).
+const COMB_CHANGES: [(u8, u8); 6] = [(0, 1), (0, 2), (1, 0), (2, 0), (1, 2), (2, 1)];
+
+/// `comb` end-effector mixes per complexity (`docs/benchmark.md` §6): episodes with a finger source, with a
+/// vacuum source, and with no embodiment change.
+fn comb_embodiments(complexity: Complexity) -> (usize, usize, usize) {
+    match complexity {
+        Complexity::Low => (4, 3, 13),
+        Complexity::Medium => (4, 4, 12),
+        Complexity::High => (5, 6, 9),
+    }
+}
+
+/// Generates one configuration file.
+pub fn generate_file(factor: Factor, complexity: Complexity) -> ConfigFile {
+    let count = factor.configurations(complexity);
+    let tag = format!("scenarios/{}/{}", factor.as_str(), complexity.as_str());
+    // Which comb episodes change the embodiment, and which way.
+    let mut comb_ee: Vec<Option<Embodiment>> = Vec::new();
+    if factor == Factor::Comb {
+        let (finger, vacuum, none) = comb_embodiments(complexity);
+        comb_ee.extend(std::iter::repeat_n(Some(Embodiment::Finger), finger));
+        comb_ee.extend(std::iter::repeat_n(Some(Embodiment::Vacuum), vacuum));
+        comb_ee.extend(std::iter::repeat_n(None, none));
+        Stream::new(&format!("{tag}/embodiments"), 0).shuffle(&mut comb_ee);
+    }
+    let episodes = (0..count)
+        .map(|i| {
+            let mut rng = Stream::new(&tag, i as u64);
+            let mut kinds = SubtaskKind::ALL.to_vec();
+            rng.shuffle(&mut kinds);
+            kinds.truncate(complexity.subtasks());
+            let multi = complexity.multi_level();
+            let mut pairs: Vec<(u8, u8)> = kinds
+                .iter()
+                .map(|_| match factor {
+                    Factor::Obst => (0, 1 + rng.index(2) as u8),
+                    Factor::Affo => (1 + rng.index(2) as u8, 0),
+                    Factor::Grip | Factor::Vacu => (0, 0),
+                    Factor::Comb => {
+                        if rng.index(3) == 0 {
+                            let same = rng.index(3) as u8;
+                            (same, same)
+                        } else {
+                            COMB_CHANGES[rng.index(COMB_CHANGES.len())]
+                        }
+                    }
+                })
+                .collect();
+            if factor == Factor::Comb && pairs.iter().all(|(s, t)| s == t) {
+                let k = rng.index(pairs.len());
+                pairs[k] = COMB_CHANGES[rng.index(COMB_CHANGES.len())];
+            }
+            let variants: Vec<u64> = kinds
+                .iter()
+                .map(|_| rng.index(SEED_STRIDE as usize) as u64)
+                .collect();
+            let side = |target: bool| -> Vec<SubtaskConfig> {
+                kinds
+                    .iter()
+                    .zip(&pairs)
+                    .zip(&variants)
+                    .map(|((&kind, &(s, t)), &variant)| SubtaskConfig {
+                        kind,
+                        variant,
+                        obst_level: if target { t } else { s },
+                        multi_level: multi,
+                    })
+                    .collect()
+            };
+            let (source_embodiment, target_embodiment) = match factor {
+                Factor::Grip => (Embodiment::Finger, Embodiment::Vacuum),
+                Factor::Vacu => (Embodiment::Vacuum, Embodiment::Finger),
+                Factor::Comb => match comb_ee[i] {
+                    Some(Embodiment::Finger) => (Embodiment::Finger, Embodiment::Vacuum),
+                    Some(Embodiment::Vacuum) => (Embodiment::Vacuum, Embodiment::Finger),
+                    None => (Embodiment::Finger, Embodiment::Finger),
+                },
+                Factor::Obst | Factor::Affo => (Embodiment::Finger, Embodiment::Finger),
+            };
+            EpisodeConfig {
+                episode_id: i as u64,
+                source_subtasks: side(false),
+                target_subtasks: side(true),
+                source_embodiment,
+                target_embodiment,
+                embodiment_in_state: matches!(factor, Factor::Grip | Factor::Vacu | Factor::Comb),
+            }
+        })
+        .collect();
+    ConfigFile {
+        schema_version: CONFIG_SCHEMA_VERSION,
+        factor,
+        complexity,
+        seeds: SEEDS.to_vec(),
+        episodes,
+    }
+}
+
+/// Generates all 15 configuration files, factor-major.
+pub fn generate_suite() -> Vec<ConfigFile> {
+    Factor::ALL
+        .iter()
+        .flat_map(|&f| Complexity::ALL.iter().map(move |&c| generate_file(f, c)))
+        .collect()
+}
+
+/// JSON Schema of a configuration file.
+pub fn config_schema() -> String {
+    let mut text = serde_json::to_string_pretty(&schemars::schema_for!(ConfigFile)).unwrap_or_default();
+    text.push('\n');
+    text
+}
+
+impl ConfigFile {
+    /// Pretty JSON with a trailing newline.
+    pub fn to_json_pretty(&self) -> String {
+        let mut text = serde_json::to_string_pretty(self).unwrap_or_default();
+        text.push('\n');
+        text
+    }
+
+    /// Parses and validates a configuration file; `origin` names it in errors.
+    pub fn from_json_str(text: &str, origin: &str) -> Result<ConfigFile, ScenarioError> {
+        let de = &mut serde_json::Deserializer::from_str(text);
+        let file: ConfigFile = serde_path_to_error::deserialize(de).map_err(|e| ScenarioError::Json {
+            path: origin.to_owned(),
+            field: e.path().to_string(),
+            message: e.into_inner().to_string(),
+        })?;
+        file.validate(origin)?;
+        Ok(file)
+    }
+
+    /// Reads a configuration file.
+    pub fn from_file(path: &Path) -> Result<ConfigFile, ScenarioError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        ConfigFile::from_json_str(&text, &path.display().to_string())
+    }
+
+    /// Checks the version, the subtask lists of every episode, and that source and target
+    /// share kinds and variants.
+    pub fn validate(&self, origin: &str) -> Result<(), ScenarioError> {
+        let invalid = |field: String, expected: &str, found: String| ScenarioError::Invalid {
+            path: origin.to_owned(),
+            field,
+            expected: expected.to_owned(),
+            found,
+        };
+        if self.schema_version != CONFIG_SCHEMA_VERSION {
+            return Err(invalid(
+                "schema_version".into(),
+                "1",
+                self.schema_version.to_string(),
+            ));
+        }
+        if self.seeds.is_empty() {
+            return Err(invalid("seeds".into(), "at least one seed", "[]".into()));
+        }
+        for (e, episode) in self.episodes.iter().enumerate() {
+            for (side, list) in [
+                ("source_subtasks", &episode.source_subtasks),
+                ("target_subtasks", &episode.target_subtasks),
+            ] {
+                let task = TaskConfig {
+                    subtasks: list.clone(),
+                    episode: episode.episode_id,
+                    embodiment: Embodiment::Finger,
+                    embodiment_in_state: false,
+                };
+                task.validate().map_err(|err| {
+                    invalid(
+                        format!("episodes[{e}].{side}"),
+                        "a valid subtask list",
+                        err.to_string(),
+                    )
+                })?;
+            }
+            let key = |s: &SubtaskConfig| (s.kind, s.variant);
+            let mut a: Vec<_> = episode.source_subtasks.iter().map(key).collect();
+            let mut b: Vec<_> = episode.target_subtasks.iter().map(key).collect();
+            a.sort();
+            b.sort();
+            if a != b {
+                return Err(invalid(
+                    format!("episodes[{e}].target_subtasks"),
+                    "the source's subtask kinds and variants",
+                    format!("{b:?} (source {a:?})"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Writes the 15 files into `dir`; returns their paths.
+pub fn write_suite(files: &[ConfigFile], dir: &Path) -> Result<Vec<std::path::PathBuf>, ScenarioError> {
+    std::fs::create_dir_all(dir).map_err(|source| ScenarioError::Io {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    files
+        .iter()
+        .map(|file| {
+            let path = dir.join(config_file_name(file.factor, file.complexity));
+            std::fs::write(&path, file.to_json_pretty()).map_err(|source| ScenarioError::Io {
+                path: path.display().to_string(),
+                source,
+            })?;
+            Ok(path)
+        })
+        .collect()
+}
+
+/// Reads every `<factor>_<complexity>.json` present in `dir` (at least one must exist).
+pub fn read_suite(dir: &Path) -> Result<Vec<ConfigFile>, ScenarioError> {
+    let mut files = Vec::new();
+    for factor in Factor::ALL {
+        for complexity in Complexity::ALL {
+            let path = dir.join(config_file_name(factor, complexity));
+            if !path.exists() {
+                continue;
+            }
+            let file = ConfigFile::from_file(&path)?;
+            if (file.factor, file.complexity) != (factor, complexity) {
+                return Err(ScenarioError::Invalid {
+                    path: path.display().to_string(),
+                    field: "factor/complexity".into(),
+                    expected: format!("{factor}/{complexity} (from the file name)"),
+                    found: format!("{}/{}", file.factor, file.complexity),
+                });
+            }
+            files.push(file);
+        }
+    }
+    if files.is_empty() {
+        return Err(ScenarioError::Io {
+            path: dir.display().to_string(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                "no <factor>_<complexity>.json configuration files (write them with `nesy scenarios generate`)",
+            ),
+        });
+    }
+    Ok(files)
+}
+
+/// One evaluation scenario: a configuration and a seed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    /// `<factor>_<complexity>_<NN>_s<seed>`, e.g. `comb_high_07_s1`.
+    pub id: String,
+    /// The domain factor.
+    pub factor: Factor,
+    /// The complexity.
+    pub complexity: Complexity,
+    /// The configuration.
+    pub episode: EpisodeConfig,
+    /// The seed.
+    pub seed: u64,
+}
+
+/// A scenario's two scenes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScenarioScenes {
+    /// The demonstration scene (with goals and instruction).
+    pub source: GeneratedTask,
+    /// The deployment scene.
+    pub target: GeneratedTask,
+}
+
+impl ScenarioScenes {
+    /// The target's goal label (what an adapted policy must achieve, in order).
+    pub fn goal_label(&self) -> &[String] {
+        &self.target.goal_label
+    }
+}
+
+/// The id of a scenario.
+pub fn scenario_id(factor: Factor, complexity: Complexity, episode_id: u64, seed: u64) -> String {
+    format!(
+        "{}_{}_{episode_id:02}_s{seed}",
+        factor.as_str(),
+        complexity.as_str()
+    )
+}
+
+impl Scenario {
+    /// The task configuration of one side, with this scenario's seed applied.
+    pub fn task(&self, side: Side) -> TaskConfig {
+        let (subtasks, embodiment) = match side {
+            Side::Source => (&self.episode.source_subtasks, self.episode.source_embodiment),
+            Side::Target => (&self.episode.target_subtasks, self.episode.target_embodiment),
+        };
+        TaskConfig {
+            subtasks: subtasks
+                .iter()
+                .map(|s| SubtaskConfig {
+                    variant: s.variant + self.seed * SEED_STRIDE,
+                    ..*s
+                })
+                .collect(),
+            episode: self.episode.episode_id + self.seed * SEED_STRIDE,
+            embodiment,
+            embodiment_in_state: self.episode.embodiment_in_state,
+        }
+    }
+
+    /// Generates one side's scene.
+    pub fn generate(&self, side: Side) -> Result<GeneratedTask, ScenarioError> {
+        self.task(side).generate().map_err(|source| ScenarioError::Task {
+            id: self.id.clone(),
+            side,
+            source,
+        })
+    }
+
+    /// Generates both scenes.
+    pub fn scenes(&self) -> Result<ScenarioScenes, ScenarioError> {
+        Ok(ScenarioScenes {
+            source: self.generate(Side::Source)?,
+            target: self.generate(Side::Target)?,
+        })
+    }
+}
+
+/// Every scenario of the files: configurations × seeds, in file and episode order.
+pub fn scenarios(files: &[ConfigFile]) -> Vec<Scenario> {
+    files
+        .iter()
+        .flat_map(|file| {
+            file.episodes.iter().flat_map(move |episode| {
+                file.seeds.iter().map(move |&seed| Scenario {
+                    id: scenario_id(file.factor, file.complexity, episode.episode_id, seed),
+                    factor: file.factor,
+                    complexity: file.complexity,
+                    episode: episode.clone(),
+                    seed,
+                })
+            })
+        })
+        .collect()
+}
+
+/// Finds a scenario by id.
+pub fn find(files: &[ConfigFile], id: &str) -> Result<Scenario, ScenarioError> {
+    scenarios(files)
+        .into_iter()
+        .find(|s| s.id == id)
+        .ok_or_else(|| ScenarioError::UnknownScenario { id: id.to_owned() })
+}
+
+/// Scenario counts by factor and complexity.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct CountTable {
+    /// `(factor, [low, medium, high])`, in [`Factor::ALL`] order.
+    pub by_factor: Vec<(Factor, [usize; 3])>,
+}
+
+impl CountTable {
+    /// Counts the scenarios.
+    pub fn of(scenarios: &[Scenario]) -> CountTable {
+        let by_factor = Factor::ALL
+            .iter()
+            .map(|&f| {
+                let mut row = [0; 3];
+                for s in scenarios.iter().filter(|s| s.factor == f) {
+                    row[s.complexity as usize] += 1;
+                }
+                (f, row)
+            })
+            .collect();
+        CountTable { by_factor }
+    }
+
+    /// The rows of the paper's Table 6 (factors grouped), with per-complexity counts.
+    pub fn paper_rows(&self) -> Vec<(&'static str, [usize; 3])> {
+        let mut rows: Vec<(&'static str, [usize; 3])> = Vec::new();
+        for &(factor, counts) in &self.by_factor {
+            let name = factor.table_row();
+            match rows.iter_mut().find(|(n, _)| *n == name) {
+                Some((_, row)) => (0..3).for_each(|i| row[i] += counts[i]),
+                None => rows.push((name, counts)),
+            }
+        }
+        rows
+    }
+
+    /// Column totals.
+    pub fn totals(&self) -> [usize; 3] {
+        let mut t = [0; 3];
+        for (_, row) in &self.by_factor {
+            (0..3).for_each(|i| t[i] += row[i]);
+        }
+        t
+    }
+
+    /// The table as text: one row per factor, then the paper's grouping, then totals.
+    pub fn render(&self) -> String {
+        let mut out = String::new();
+        let line = |out: &mut String, name: &str, row: [usize; 3]| {
+            let total: usize = row.iter().sum();
+            out.push_str(&format!(
+                "{name:<34}{:>6}{:>8}{:>6}{:>7}\n",
+                row[0], row[1], row[2], total
+            ));
+        };
+        out.push_str(&format!(
+            "{:<34}{:>6}{:>8}{:>6}{:>7}\n",
+            "factor", "low", "medium", "high", "total"
+        ));
+        for &(f, row) in &self.by_factor {
+            line(&mut out, f.as_str(), row);
+        }
+        out.push('\n');
+        for (name, row) in self.paper_rows() {
+            line(&mut out, name, row);
+        }
+        line(&mut out, "Total scenarios", self.totals());
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn files_are_valid_and_follow_the_factor_rules() {
+        for file in generate_suite() {
+            file.validate("generated").unwrap();
+            assert_eq!(file.episodes.len(), file.factor.configurations(file.complexity));
+            for e in &file.episodes {
+                assert_eq!(e.source_subtasks.len(), file.complexity.subtasks());
+                let levels: Vec<(u8, u8)> = e
+                    .source_subtasks
+                    .iter()
+                    .zip(&e.target_subtasks)
+                    .map(|(s, t)| (s.obst_level, t.obst_level))
+                    .collect();
+                match file.factor {
+                    Factor::Obst => assert!(levels.iter().all(|&(s, t)| s == 0 && t >= 1)),
+                    Factor::Affo => assert!(levels.iter().all(|&(s, t)| s >= 1 && t == 0)),
+                    Factor::Grip | Factor::Vacu => assert!(levels.iter().all(|&l| l == (0, 0))),
+                    Factor::Comb => assert!(levels.iter().any(|(s, t)| s != t), "{levels:?}"),
+                }
+                let swap = (e.source_embodiment, e.target_embodiment);
+                match file.factor {
+                    Factor::Grip => assert_eq!(swap, (Embodiment::Finger, Embodiment::Vacuum)),
+                    Factor::Vacu => assert_eq!(swap, (Embodiment::Vacuum, Embodiment::Finger)),
+                    Factor::Obst | Factor::Affo => assert_eq!(swap, (Embodiment::Finger, Embodiment::Finger)),
+                    Factor::Comb => {}
+                }
+                assert!(
+                    e.source_subtasks
+                        .iter()
+                        .all(|s| s.multi_level == file.complexity.multi_level())
+                );
+            }
+            if file.factor == Factor::Comb {
+                let (finger, vacuum, none) = comb_embodiments(file.complexity);
+                let count = |a, b| {
+                    file.episodes
+                        .iter()
+                        .filter(|e| (e.source_embodiment, e.target_embodiment) == (a, b))
+                        .count()
+                };
+                assert_eq!(count(Embodiment::Finger, Embodiment::Vacuum), finger);
+                assert_eq!(count(Embodiment::Vacuum, Embodiment::Finger), vacuum);
+                assert_eq!(count(Embodiment::Finger, Embodiment::Finger), none);
+            }
+        }
+    }
+
+    #[test]
+    fn json_round_trip_and_errors_name_the_field() {
+        let file = generate_file(Factor::Comb, Complexity::Medium);
+        let back = ConfigFile::from_json_str(&file.to_json_pretty(), "x.json").unwrap();
+        assert_eq!(back, file);
+        let text = file
+            .to_json_pretty()
+            .replacen("\"put_in_hinge\"", "\"put_in_fridge\"", 1);
+        let err = ConfigFile::from_json_str(&text, "x.json")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("x.json") && err.contains("kind"), "{err}");
+        let mut bad = file.clone();
+        bad.episodes[2].target_subtasks[0].variant += 1;
+        let err = ConfigFile::from_json_str(&bad.to_json_pretty(), "x.json")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("episodes[2].target_subtasks"), "{err}");
+    }
+
+    #[test]
+    fn seeds_give_different_scenes_with_shared_layouts() {
+        let files = generate_suite();
+        let a = find(&files, "obst_low_03_s0").unwrap().scenes().unwrap();
+        let b = find(&files, "obst_low_03_s1").unwrap().scenes().unwrap();
+        assert_ne!(a.source.scene.objects, b.source.scene.objects);
+        // Source and target share the objects and their names.
+        let names = |t: &GeneratedTask| t.scene.objects.iter().map(|o| o.name.clone()).collect::<Vec<_>>();
+        assert_eq!(names(&a.source), names(&a.target));
+        assert_eq!(a.goal_label(), a.source.goal_label.as_slice());
+        assert!(find(&files, "obst_low_15_s0").is_err());
+    }
+}

@@ -1,0 +1,65 @@
+//! `get_empty_floor_xy`: a free table spot for putting an object down (`docs/benchmark.md` §4), with the
+//! authors' variable-shadowing bugs fixed (see the crate README).
+
+use crate::scene::parts;
+use crate::world::geometry::Aabb;
+use crate::world::{FLOOR_AABB, Sim};
+
+/// Obstacle padding in xy (m).
+const PAD: f64 = 0.02;
+/// Upper x bound of the search region before articulated assets cut it.
+const REGION_X_MAX: f64 = 0.53;
+/// y bounds of the search region.
+const REGION_Y: (f64, f64) = (-0.15, 0.16);
+
+/// Finds a free xy for `part`: on a grid of step 0.6 × its larger footprint side over the
+/// region x ∈ [0.11 + hx, min(0.53, hinge/drawer body min x) − hx], y ∈ [−0.15 + hy,
+/// 0.16 − hy]; free means its padded footprint meets no other object's padded footprint.
+/// The current spot wins if it is free; otherwise the candidate nearest the object's
+/// current position.
+pub fn empty_floor_xy(sim: &Sim, part: usize) -> Option<[f64; 2]> {
+    let me = sim.part_aabb(part);
+    let size = me.size();
+    let (hx, hy) = (size[0] / 2.0, size[1] / 2.0);
+    let mut x_max = REGION_X_MAX;
+    for name in [parts::HINGE_BODY, parts::DRAWER_BODY] {
+        if let Some(i) = sim.part_index(name) {
+            x_max = x_max.min(sim.part_aabb(i).min[0]);
+        }
+    }
+    let (x_lo, x_hi) = (FLOOR_AABB.min[0] + hx, x_max - hx);
+    let (y_lo, y_hi) = (REGION_Y.0 + hy, REGION_Y.1 - hy);
+    if x_lo > x_hi || y_lo > y_hi {
+        return None;
+    }
+    let held = sim.held_object();
+    let obstacles: Vec<Aabb> = (0..sim.parts().len())
+        .filter(|&i| i != part && Some(sim.parts()[i].name.as_str()) != held)
+        .map(|i| sim.part_aabb(i).padded([-PAD, -PAD, 0.0], [PAD, PAD, 0.0]))
+        .collect();
+    let free = |x: f64, y: f64| {
+        let foot = Aabb {
+            min: [x - hx - PAD, y - hy - PAD, 0.0],
+            max: [x + hx + PAD, y + hy + PAD, 0.0],
+        };
+        obstacles.iter().all(|o| !foot.overlaps_xy(o, 0.0))
+    };
+    let c = me.centre();
+    if (x_lo..=x_hi).contains(&c[0]) && (y_lo..=y_hi).contains(&c[1]) && free(c[0], c[1]) {
+        return Some([c[0], c[1]]);
+    }
+    let step = 0.6 * size[0].max(size[1]).max(0.01);
+    let nx = ((x_hi - x_lo) / step).floor() as usize;
+    let ny = ((y_hi - y_lo) / step).floor() as usize;
+    let mut best: Option<(f64, [f64; 2])> = None;
+    for i in 0..=nx {
+        for j in 0..=ny {
+            let (x, y) = (x_lo + i as f64 * step, y_lo + j as f64 * step);
+            let d = (x - c[0]).powi(2) + (y - c[1]).powi(2);
+            if best.is_none_or(|(bd, _)| d < bd) && free(x, y) {
+                best = Some((d, [x, y]));
+            }
+        }
+    }
+    best.map(|(_, xy)| xy)
+}
