@@ -28,7 +28,6 @@ macro_rules! out {
 }
 
 pub mod commands;
-pub mod pipeline;
 
 /// Turn a demonstration recorded in one setting into a verified robot program for another.
 #[derive(Debug, Parser)]

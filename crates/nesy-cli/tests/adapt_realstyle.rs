@@ -10,7 +10,9 @@ mod common;
 
 use std::sync::Arc;
 
-use nesy_cli::pipeline::{self, AdaptOptions, DemoInput, NoProgress, TargetInput, VlmSetup, VlmSource};
+use nesy_pipeline::{
+    self as pipeline, AdaptOptions, DemoInput, NoProgress, TargetInput, VlmSetup, VlmSource,
+};
 use nesy_policy::WorkerCommand;
 use nesy_vlm::{BackendKind, VlmConfig};
 use serde_json::Value;
@@ -42,7 +44,18 @@ fn record_realstyle_fixture() {
         },
         record: Some(cassette),
     };
-    let run = pipeline::run(demo, target, setup, &options, Arc::new(NoProgress)).unwrap();
+    let client = pipeline::vlm::build_client(&setup).unwrap();
+    let runtime = tokio::runtime::Runtime::new().unwrap();
+    let run = runtime
+        .block_on(pipeline::run(
+            &demo,
+            &target,
+            client,
+            &options,
+            Arc::new(NoProgress),
+        ))
+        .unwrap();
+    pipeline::output::write_all(&run, &target, &run.out_dir).unwrap();
     assert!(run.adapted().is_some(), "{:?}", run.adaptation.outcome);
 }
 

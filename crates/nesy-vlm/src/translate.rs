@@ -105,6 +105,19 @@ pub enum TranslateError {
     },
 }
 
+impl TranslateError {
+    /// The reasoner failure this is: the call's own kind, a defect of the request, or a
+    /// reply that cannot be read.
+    pub fn reasoner_kind(&self) -> nesy_core::adapt::ReasonerErrorKind {
+        use nesy_core::adapt::ReasonerErrorKind as Kind;
+        match self {
+            TranslateError::Vlm(e) => e.reasoner_kind(),
+            TranslateError::Prompt(_) => Kind::Request,
+            TranslateError::Parse { .. } => Kind::Reply,
+        }
+    }
+}
+
 /// Builds the state-translation chat request without sending it.
 pub fn build_request(
     prompts: &Prompts,

@@ -1,6 +1,6 @@
 //! `nesy adapt`: adapt a demonstration to a target scene (NeSyCR) and synthesize, and
-//! optionally execute, a verified code policy. The work is done by [`crate::pipeline`]; this
-//! module parses flags, shows progress and prints the summary.
+//! optionally execute, a verified code policy. The work is done by `nesy_pipeline`; this
+//! module parses flags, owns the async runtime, shows progress and prints the summary.
 
 use std::io::IsTerminal as _;
 use std::path::PathBuf;
@@ -8,15 +8,15 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Duration;
 
+use anyhow::Context as _;
+use nesy_core::adapt::AdaptConfig;
+use nesy_pipeline::output::{induction_counts, proposals, violations};
+use nesy_pipeline::{
+    self as pipeline, AdaptOptions, AdaptRun, CodegenMode, DemoInput, LogProgress, NoProgress, Progress,
+    StateSource, StatesMode, TargetInput, VlmSetup, VlmSource,
+};
 use nesy_policy::Limits;
 use nesy_vlm::ConfigOverrides;
-
-use crate::pipeline::output::{induction_counts, proposals, violations};
-use crate::pipeline::progress::LogProgress;
-use crate::pipeline::{
-    self, AdaptOptions, AdaptRun, CodegenMode, DemoInput, NoProgress, Progress, StateSource, StatesMode,
-    TargetInput, VlmSetup, VlmSource,
-};
 
 /// Arguments of `nesy adapt`.
 #[derive(Debug, clap::Args)]
@@ -87,7 +87,16 @@ pub fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     let demo = DemoInput::load(&args.demo)?;
     progress.stage("building the target scene");
     let target = TargetInput::load(args.target.as_deref(), &demo)?;
-    let run = pipeline::run(demo, target, setup, &options, progress.clone())?;
+    progress.stage("connecting the VLM");
+    let client = pipeline::vlm::build_client(&setup)?;
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .context("starting the async runtime")?;
+    let run = runtime.block_on(pipeline::run(&demo, &target, client, &options, progress.clone()))?;
+    progress.stage("writing the outputs");
+    pipeline::output::write_all(&run, &target, &run.out_dir)?;
     progress.stage("");
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&run)?)?;
@@ -131,7 +140,10 @@ fn options(args: &AdaptArgs) -> anyhow::Result<AdaptOptions> {
         codegen: args.codegen,
         execute: args.execute,
         budget: args.budget,
-        induction_tries: args.induction_tries,
+        adapt: AdaptConfig {
+            induction_tries: args.induction_tries,
+            ..AdaptConfig::default()
+        },
         limits: Limits {
             wall_time_ms: (args.timeout * 1000.0) as u64,
             ..Limits::default()

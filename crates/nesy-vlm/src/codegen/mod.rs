@@ -67,6 +67,19 @@ pub enum CodegenError {
     },
 }
 
+impl CodegenError {
+    /// The reasoner failure this is: the call's own kind, a defect of the request, or a
+    /// reply without a program.
+    pub fn reasoner_kind(&self) -> nesy_core::adapt::ReasonerErrorKind {
+        use nesy_core::adapt::ReasonerErrorKind as Kind;
+        match self {
+            CodegenError::Vlm(e) => e.reasoner_kind(),
+            CodegenError::Prompt(_) => Kind::Request,
+            CodegenError::NoProgram { .. } => Kind::Reply,
+        }
+    }
+}
+
 /// Builds the code-generation chat request (prompt and task context) without sending it.
 pub fn build_request(
     prompts: &Prompts,

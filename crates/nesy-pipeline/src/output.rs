@@ -13,16 +13,16 @@
 //! | `summary.json` | what `--json` prints |
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use anyhow::Context as _;
 use nesy_core::adapt::{Adaptation, Outcome, TraceEvent, Verdict};
 use nesy_core::format_procedure;
 use serde::Serialize;
 use serde_json::json;
 
-use super::inputs::TargetInput;
-use super::{AdaptRun, StateSource};
+use crate::inputs::TargetInput;
+use crate::synth::SynthesizedPolicy;
+use crate::{AdaptRun, PipelineError, StateSource};
 
 /// `world_model.json`.
 pub const WORLD_MODEL_FILE: &str = "world_model.json";
@@ -42,14 +42,31 @@ pub const REPORT_FILE: &str = "report.md";
 pub const SUMMARY_FILE: &str = "summary.json";
 
 /// Writes a file, naming it on failure.
-pub fn write(path: &Path, contents: &str) -> anyhow::Result<()> {
-    std::fs::write(path, contents).with_context(|| format!("writing {}", path.display()))
+pub fn write(path: &Path, contents: &str) -> Result<(), PipelineError> {
+    std::fs::write(path, contents).map_err(|e| PipelineError::write(path, e))
 }
 
-fn write_json(path: &Path, value: &impl Serialize) -> anyhow::Result<()> {
-    let text =
-        serde_json::to_string_pretty(value).with_context(|| format!("serialising {}", path.display()))?;
+/// Writes a value as pretty JSON with a trailing newline.
+pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), PipelineError> {
+    let text = serde_json::to_string_pretty(value)
+        .map_err(|e| PipelineError::write(path, std::io::Error::other(e)))?;
     write(path, &(text + "\n"))
+}
+
+/// Creates the run directory and writes what execution needs before it starts: the target
+/// scene as run and, when there is one, the program. Returns the scene file's path.
+pub fn prepare_dir(
+    dir: &Path,
+    target: &TargetInput,
+    policy: Option<&SynthesizedPolicy>,
+) -> Result<PathBuf, PipelineError> {
+    std::fs::create_dir_all(dir).map_err(|e| PipelineError::write(dir, e))?;
+    let scene_path = dir.join(TARGET_SCENE_FILE);
+    write(&scene_path, &target.scene.to_json_pretty())?;
+    if let Some(p) = policy {
+        write(&dir.join(POLICY_FILE), &p.code)?;
+    }
+    Ok(scene_path)
 }
 
 /// One violation the symbolic executor found while identifying (Eq. 6).
@@ -226,9 +243,8 @@ pub fn procedure_text(run: &AdaptRun) -> String {
 }
 
 /// Writes every output of `run` into `dir`.
-pub fn write_all(run: &AdaptRun, target: &TargetInput, dir: &Path) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("creating the output directory {}", dir.display()))?;
+pub fn write_all(run: &AdaptRun, target: &TargetInput, dir: &Path) -> Result<(), PipelineError> {
+    prepare_dir(dir, target, run.policy.as_ref())?;
     let wm = &run.adaptation.world_model;
     write_json(
         &dir.join(WORLD_MODEL_FILE),
@@ -268,7 +284,7 @@ pub fn write_all(run: &AdaptRun, target: &TargetInput, dir: &Path) -> anyhow::Re
     for view in &target.views {
         for (suffix, image) in [("", &view.image), ("_marked", &view.marked)] {
             let path = dir.join(format!("target_{}{suffix}.png", view.camera));
-            std::fs::write(&path, image.to_png()).with_context(|| format!("writing {}", path.display()))?;
+            std::fs::write(&path, image.to_png()).map_err(|e| PipelineError::write(&path, e))?;
         }
     }
     write(&dir.join(REPORT_FILE), &report_markdown(run, target))?;
@@ -368,8 +384,8 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
     match (&run.policy, &run.codegen_error) {
         (Some(p), _) => {
             let how = match p.mode {
-                super::CodegenMode::Vlm => "the VLM's code generation",
-                super::CodegenMode::Template => "the template compiler",
+                crate::CodegenMode::Vlm => "the VLM's code generation",
+                crate::CodegenMode::Template => "the template compiler",
             };
             let _ = writeln!(
                 md,

@@ -8,19 +8,21 @@
 
 use std::time::{Duration, Instant};
 
-use anyhow::Context as _;
 use nesy_core::predicates::Vocabulary;
 use nesy_core::{Atom, State};
 use nesy_sim::api::Embodiment;
 use nesy_vlm::{StateTranslationRequest, VlmReasoner};
 use serde::Serialize;
 
-use super::Setting;
-use super::inputs::{DemoInput, DemoKeyframes, TargetInput};
-use super::progress::Progress;
+use crate::PipelineError;
+use crate::inputs::{DemoInput, DemoKeyframes, TargetInput};
+use crate::progress::Progress;
+use crate::setting::Setting;
 
 /// Where symbolic states come from (`--states`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "snake_case")]
 pub enum StatesMode {
     /// Ground truth when the demo has it for every keyframe, else the VLM.
     #[default]
@@ -97,7 +99,7 @@ pub async fn symbolic_states(
     mode: StatesMode,
     vocabulary: &Vocabulary,
     progress: &dyn Progress,
-) -> anyhow::Result<SymbolicStates> {
+) -> Result<SymbolicStates, PipelineError> {
     let truth = demo.demo.states();
     let source_atom = setting
         .embodiment_in_state
@@ -114,7 +116,7 @@ pub async fn symbolic_states(
         StatesMode::Auto => truth.is_none(),
     };
     if !use_vlm {
-        let demo_states = truth.with_context(|| {
+        let demo_states = truth.ok_or_else(|| {
             let missing = demo
                 .demo
                 .keyframes
@@ -122,10 +124,12 @@ pub async fn symbolic_states(
                 .find(|k| k.state.is_none())
                 .map(|k| k.index)
                 .unwrap_or_default();
-            format!(
-                "{}: keyframe {missing} has no ground-truth state; use --states vlm for demos without ground truth",
-                demo.path.display()
-            )
+            PipelineError::Demo {
+                path: demo.path.clone(),
+                message: format!(
+                    "keyframe {missing} has no ground-truth state; use --states vlm for demos without ground truth"
+                ),
+            }
         })?;
         progress.detail("ground-truth states");
         return Ok(SymbolicStates {
@@ -137,13 +141,16 @@ pub async fn symbolic_states(
     }
 
     let started = Instant::now();
-    let keyframes = DemoKeyframes::from_demo(&demo.demo)?;
+    let keyframes = DemoKeyframes::from_demo(demo)?;
     let known = State::from_atoms(source_atom);
     let mut requests = Vec::new();
     for k in &demo.demo.keyframes {
         let views = keyframes
             .keyframe_views(k.index)
-            .with_context(|| format!("{}: keyframe {} has no views", demo.path.display(), k.index))?;
+            .ok_or_else(|| PipelineError::Demo {
+                path: demo.path.clone(),
+                message: format!("keyframe {} has no views", k.index),
+            })?;
         requests.push(StateTranslationRequest {
             view_set: format!("demo/keyframe/{}", k.index),
             instruction: demo.demo.metadata.instruction.clone(),
@@ -184,8 +191,14 @@ pub async fn symbolic_states(
     let mut results: Vec<Option<(StateTranslationRequest, nesy_vlm::TranslatedState)>> = vec![None; total];
     let mut done = 0;
     while let Some(joined) = set.join_next().await {
-        let (i, request, result) = joined.context("a state-translation task panicked")?;
-        let translated = result.with_context(|| format!("translating the states of {}", request.view_set))?;
+        let (i, request, result) = joined.map_err(|e| PipelineError::States {
+            message: format!("a state-translation task ended abnormally: {e}"),
+            kind: None,
+        })?;
+        let translated = result.map_err(|e| PipelineError::States {
+            message: format!("translating the states of {}: {e}", request.view_set),
+            kind: Some(e.reasoner_kind()),
+        })?;
         done += 1;
         progress.detail(&format!("state translation {done}/{total}"));
         results[i] = Some((request, translated));
@@ -204,7 +217,10 @@ pub async fn symbolic_states(
         }
         states.push(translated.state.clone());
     }
-    let target_state = states.pop().context("no target translation")?;
+    let target_state = states.pop().ok_or_else(|| PipelineError::States {
+        message: "no translation of the target's state".into(),
+        kind: None,
+    })?;
     let agreement = (actual > 0).then(|| {
         let precision = if predicted == 0 {
             0.0

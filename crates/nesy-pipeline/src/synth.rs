@@ -7,6 +7,7 @@
 //!   nesy-sim's template compiler (beyond the paper).
 
 use nesy_core::Operator;
+use nesy_core::adapt::ReasonerErrorKind;
 use nesy_sim::api::Embodiment;
 use nesy_sim::codegen::{CodegenError as TemplateError, compile_policy};
 use nesy_sim::scene::SceneSpec;
@@ -17,7 +18,8 @@ use nesy_vlm::{
 use serde::Serialize;
 
 /// How code is synthesized (`--codegen`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum CodegenMode {
     /// The VLM's Code Generation prompt.
@@ -73,6 +75,8 @@ pub enum SynthError {
     Call {
         /// What went wrong.
         message: String,
+        /// The kind of reasoner failure.
+        failure: ReasonerErrorKind,
     },
 }
 
@@ -80,7 +84,7 @@ impl std::fmt::Display for SynthError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             SynthError::NoProgram { message } => write!(f, "no program: {message}"),
-            SynthError::Call { message } => write!(f, "code generation failed: {message}"),
+            SynthError::Call { message, .. } => write!(f, "code generation failed: {message}"),
         }
     }
 }
@@ -112,6 +116,7 @@ pub async fn synthesize(
                 Err(e) => {
                     return Err(SynthError::Call {
                         message: e.to_string(),
+                        failure: e.reasoner_kind(),
                     });
                 }
             };

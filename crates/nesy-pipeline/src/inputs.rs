@@ -7,14 +7,15 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use anyhow::Context as _;
 use nesy_core::State;
 use nesy_sim::api::Embodiment;
 use nesy_sim::demo::{CameraName, Demo};
 use nesy_sim::perception::render::{self, View};
-use nesy_sim::scene::SceneSpec;
+use nesy_sim::scene::{SceneSpec, parts};
 use nesy_sim::{Sim, observe};
 use nesy_vlm::{Image, KeyframeImages, Views};
+
+use crate::PipelineError;
 
 /// A demo as the pipeline uses it.
 #[derive(Debug, Clone)]
@@ -29,17 +30,21 @@ pub struct DemoInput {
 
 impl DemoInput {
     /// Reads a demo; errors name the file and what was wrong with it.
-    pub fn load(path: &Path) -> anyhow::Result<DemoInput> {
+    pub fn load(path: &Path) -> Result<DemoInput, PipelineError> {
         let started = Instant::now();
-        // DemoError's message names the file and the field already (and its I/O cause), so it
-        // is shown once rather than as a chain.
-        let demo = nesy_sim::demo::read(path).map_err(|e| anyhow::anyhow!("reading the demo: {e}"))?;
+        // DemoError's message names the file and the field already (and its I/O cause).
+        let demo = nesy_sim::demo::read(path).map_err(|e| PipelineError::Demo {
+            path: path.to_owned(),
+            message: format!("reading the demo: {e}"),
+        })?;
         if demo.keyframes.len() < 2 {
-            anyhow::bail!(
-                "{}: a demo needs at least two keyframes (the initial state and one action), found {}",
-                path.display(),
-                demo.keyframes.len()
-            );
+            return Err(PipelineError::Demo {
+                path: path.to_owned(),
+                message: format!(
+                    "a demo needs at least two keyframes (the initial state and one action), found {}",
+                    demo.keyframes.len()
+                ),
+            });
         }
         Ok(DemoInput {
             path: path.to_owned(),
@@ -66,7 +71,11 @@ impl DemoInput {
 
 /// Object names without the robot's own.
 pub fn scene_objects(names: &[String]) -> Vec<String> {
-    names.iter().filter(|n| !n.contains("gripper")).cloned().collect()
+    names
+        .iter()
+        .filter(|n| ![parts::GRIPPER, parts::VACUUM_GRIPPER].contains(&n.as_str()))
+        .cloned()
+        .collect()
 }
 
 /// The target scene, built, observed and rendered.
@@ -90,26 +99,31 @@ impl TargetInput {
     /// Reads `path` (or, without one, the target scene recorded in the demo), builds it and
     /// observes and renders it. Embodiment atoms go into the state when the target's end
     /// effector differs from the demo's (the authors' `ee_set`).
-    pub fn load(path: Option<&Path>, demo: &DemoInput) -> anyhow::Result<TargetInput> {
-        let (path, scene) = match path {
-            Some(path) => {
-                let scene = SceneSpec::from_file(path)
-                    .with_context(|| format!("reading the target scene {}", path.display()))?;
-                (path.to_owned(), scene)
-            }
-            None => {
-                let scene = demo.demo.metadata.target_scene.clone().with_context(|| {
-                    format!(
-                        "no --target given and the demo {} records no target scene (metadata `target_scene`)",
-                        demo.path.display()
+    pub fn load(path: Option<&Path>, demo: &DemoInput) -> Result<TargetInput, PipelineError> {
+        let (path, scene) =
+            match path {
+                Some(path) => {
+                    let scene = SceneSpec::from_file(path).map_err(|e| PipelineError::Target {
+                        path: path.to_owned(),
+                        message: format!("reading the target scene: {e}"),
+                    })?;
+                    (path.to_owned(), scene)
+                }
+                None => {
+                    let scene = demo.demo.metadata.target_scene.clone().ok_or_else(|| {
+                        PipelineError::Demo {
+                            path: demo.path.clone(),
+                            message:
+                                "no target scene given, and the demo records none (metadata `target_scene`)"
+                                    .into(),
+                        }
+                    })?;
+                    (
+                        PathBuf::from(format!("{}#target_scene", demo.path.display())),
+                        scene,
                     )
-                })?;
-                (
-                    PathBuf::from(format!("{}#target_scene", demo.path.display())),
-                    scene,
-                )
-            }
-        };
+                }
+            };
         Self::from_scene(path, scene, demo.demo.metadata.embodiment)
     }
 
@@ -118,19 +132,26 @@ impl TargetInput {
         path: PathBuf,
         mut scene: SceneSpec,
         source: Embodiment,
-    ) -> anyhow::Result<TargetInput> {
+    ) -> Result<TargetInput, PipelineError> {
         let started = Instant::now();
         if scene.embodiment != source {
             scene.embodiment_in_state = true;
         }
         if scene.goals.is_empty() {
-            anyhow::bail!(
-                "{}: at goals: expected at least one subtask goal (the target must say what success is), found none",
-                path.display()
-            );
+            return Err(PipelineError::Target {
+                path,
+                message: "at goals: expected at least one subtask goal (the target must say what success is), found none".into(),
+            });
         }
-        let sim =
-            Sim::new(&scene).with_context(|| format!("building the target scene {}", path.display()))?;
+        let sim = match Sim::new(&scene) {
+            Ok(sim) => sim,
+            Err(e) => {
+                return Err(PipelineError::Target {
+                    path,
+                    message: format!("building the target scene: {e}"),
+                });
+            }
+        };
         let observed = observe(&sim);
         let objects = scene_objects(&sim.names());
         let views = render::render_views(&sim, render::VIEW_SIZE, render::default_threads());
@@ -154,14 +175,18 @@ impl TargetInput {
     }
 
     /// The marked views as the VLM sees them.
-    pub fn marked_views(&self) -> anyhow::Result<Views> {
-        let find = |name: &str| -> anyhow::Result<Image> {
+    pub fn marked_views(&self) -> Result<Views, PipelineError> {
+        let find = |name: &str| -> Result<Image, PipelineError> {
+            let bad = |message: String| PipelineError::Target {
+                path: self.path.clone(),
+                message,
+            };
             let view = self
                 .views
                 .iter()
                 .find(|v| v.camera == name)
-                .with_context(|| format!("the renderer produced no {name} view"))?;
-            Ok(Image::png(view.marked.to_png())?)
+                .ok_or_else(|| bad(format!("the renderer produced no {name} view")))?;
+            Image::png(view.marked.to_png()).map_err(|e| bad(format!("the {name} view: {e}")))
         };
         Ok(Views {
             top: find("top")?,
@@ -181,12 +206,15 @@ pub struct DemoKeyframes {
 
 impl DemoKeyframes {
     /// Decodes the demo's images; a keyframe whose images are not PNG is an error naming it.
-    pub fn from_demo(demo: &Demo) -> anyhow::Result<DemoKeyframes> {
+    pub fn from_demo(input: &DemoInput) -> Result<DemoKeyframes, PipelineError> {
+        let demo: &Demo = &input.demo;
         let mut views = Vec::with_capacity(demo.keyframes.len());
         for k in &demo.keyframes {
-            let image = |camera: CameraName| -> anyhow::Result<Image> {
-                Image::png(k.views.get(camera).marked_or_raw().to_vec())
-                    .with_context(|| format!("keyframe {}: {} view", k.index, camera.as_str()))
+            let image = |camera: CameraName| -> Result<Image, PipelineError> {
+                Image::png(k.views.get(camera).marked_or_raw().to_vec()).map_err(|e| PipelineError::Demo {
+                    path: input.path.clone(),
+                    message: format!("keyframe {}: {} view: {e}", k.index, camera.as_str()),
+                })
             };
             views.push(Some(Views {
                 top: image(CameraName::Top)?,

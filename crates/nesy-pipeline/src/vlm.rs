@@ -13,8 +13,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use anyhow::Context as _;
 use nesy_vlm::cassette::CassetteFile;
+
+use crate::PipelineError;
 use nesy_vlm::{
     BackendKind, CassetteMode, CassetteOptions, CassetteTransport, ConfigOverrides, OracleNoise,
     OracleTransport, ProcessEnv, Transport, VlmClient, VlmConfig,
@@ -38,6 +39,9 @@ pub enum VlmSource {
     Oracle {
         /// Noise knobs as given on the command line (empty: none).
         noise: String,
+        /// Seed of the noise draws (with the request body; the benchmark harness gives each
+        /// unit its own).
+        seed: u64,
     },
     /// Any transport, with the configuration whose profile builds the bodies.
     Transport {
@@ -54,32 +58,38 @@ impl std::fmt::Debug for VlmSource {
             VlmSource::Configured(_) => f.write_str("Configured"),
             VlmSource::Url(url, _) => write!(f, "Url({url})"),
             VlmSource::Replay(p) => write!(f, "Replay({})", p.display()),
-            VlmSource::Oracle { noise } => write!(f, "Oracle({noise})"),
+            VlmSource::Oracle { noise, seed } => write!(f, "Oracle({noise}, seed {seed})"),
             VlmSource::Transport { transport, .. } => write!(f, "Transport({})", transport.label()),
         }
     }
 }
 
 impl VlmSource {
-    /// Parses `--vlm`: `oracle`, `replay:PATH`, or an `http(s)://` URL.
-    pub fn parse(text: &str, overrides: ConfigOverrides, noise: String) -> anyhow::Result<VlmSource> {
+    /// Parses `--vlm`: `oracle`, `replay:PATH`, or an `http(s)://` URL. The oracle's noise
+    /// draws are seeded with 0 here; the benchmark harness seeds each unit.
+    pub fn parse(text: &str, overrides: ConfigOverrides, noise: String) -> Result<VlmSource, PipelineError> {
         if text == "oracle" {
-            return Ok(VlmSource::Oracle { noise });
+            return Ok(VlmSource::Oracle { noise, seed: 0 });
         }
         if let Some(path) = text.strip_prefix("replay:") {
             if path.is_empty() {
-                anyhow::bail!(
-                    "--vlm replay: needs a cassette path, e.g. --vlm replay:fixtures/cassettes/x.json"
-                );
+                return Err(setup_error(
+                    "--vlm replay: needs a cassette path, e.g. --vlm replay:fixtures/cassettes/x.json",
+                ));
             }
             return Ok(VlmSource::Replay(PathBuf::from(path)));
         }
         if text.starts_with("http://") || text.starts_with("https://") {
             return Ok(VlmSource::Url(text.to_owned(), Box::new(overrides)));
         }
-        anyhow::bail!(
+        Err(setup_error(format!(
             "--vlm {text:?}: expected `oracle`, `replay:CASSETTE` or an http(s):// URL of an OpenAI-compatible server"
-        )
+        )))
+    }
+
+    /// True for the offline reference responder.
+    pub fn is_oracle(&self) -> bool {
+        matches!(self, VlmSource::Oracle { .. })
     }
 }
 
@@ -100,12 +110,12 @@ pub fn oracle_config() -> VlmConfig {
 }
 
 /// The configuration that rebuilds the bodies a cassette recorded: its backend and model.
-pub fn replay_config(path: &Path, file: &CassetteFile) -> anyhow::Result<VlmConfig> {
-    let model = file.meta.model.clone().with_context(|| {
-        format!(
+pub fn replay_config(path: &Path, file: &CassetteFile) -> Result<VlmConfig, PipelineError> {
+    let model = file.meta.model.clone().ok_or_else(|| {
+        setup_error(format!(
             "{}: at meta.model: expected the recorded model name, found none",
             path.display()
-        )
+        ))
     })?;
     let backend_label = file.meta.backend.clone().unwrap_or_default();
     // Labels are `openai`, `http openai`, or the oracle's; the last word names the profile.
@@ -114,46 +124,50 @@ pub fn replay_config(path: &Path, file: &CassetteFile) -> anyhow::Result<VlmConf
         ORACLE_BACKEND
     } else {
         last.parse::<BackendKind>().map_err(|e| {
-            anyhow::anyhow!(
+            setup_error(format!(
                 "{}: at meta.backend: {e}; replay this cassette with NESY_CASSETTE={} NESY_CASSETTE_MODE=none and the settings it was recorded with",
                 path.display(),
                 path.display()
-            )
+            ))
         })?
     };
     Ok(VlmConfig::new(backend, model))
 }
 
 /// Builds the client for `setup`.
-pub fn build_client(setup: &VlmSetup) -> anyhow::Result<VlmClient> {
+pub fn build_client(setup: &VlmSetup) -> Result<VlmClient, PipelineError> {
     let (config, live): (VlmConfig, Option<Arc<dyn Transport>>) = match &setup.source {
         VlmSource::Replay(path) => {
             if setup.record.is_some() {
-                anyhow::bail!("--record cannot be combined with --vlm replay: (a replay makes no new calls)");
+                return Err(setup_error(
+                    "--record cannot be combined with --vlm replay: (a replay makes no new calls)",
+                ));
             }
             if !path.is_file() {
-                anyhow::bail!("{}: cassette not found (from --vlm replay:)", path.display());
+                return Err(setup_error(format!(
+                    "{}: cassette not found (from --vlm replay:)",
+                    path.display()
+                )));
             }
             let file = CassetteFile::load(path)
-                .with_context(|| format!("reading the cassette {}", path.display()))?;
+                .map_err(|e| setup_error(format!("reading the cassette {}: {e}", path.display())))?;
             let config = replay_config(path, &file)?;
             let transport =
                 CassetteTransport::open(path, CassetteMode::None, None, CassetteOptions::default())
-                    .with_context(|| format!("opening the cassette {}", path.display()))?;
+                    .map_err(|e| setup_error(format!("opening the cassette {}: {e}", path.display())))?;
             return Ok(VlmClient::with_transport(&config, Arc::new(transport)));
         }
         VlmSource::Configured(overrides) => {
-            let config =
-                VlmConfig::resolve(overrides, &ProcessEnv).context("resolving the VLM configuration")?;
+            let config = resolve(overrides)?;
             if setup.record.is_none() {
-                return Ok(VlmClient::from_config(&config)?);
+                return VlmClient::from_config(&config).map_err(client_error);
             }
             if config.cassette.is_some() {
-                anyhow::bail!(
-                    "--record cannot be combined with a configured cassette (--cassette / NESY_CASSETTE)"
-                );
+                return Err(setup_error(
+                    "--record cannot be combined with a configured cassette (--cassette / NESY_CASSETTE)",
+                ));
             }
-            let http = VlmClient::http_transport(&config)?;
+            let http = VlmClient::http_transport(&config).map_err(client_error)?;
             (config, Some(Arc::new(http)))
         }
         VlmSource::Url(url, overrides) => {
@@ -162,30 +176,29 @@ pub fn build_client(setup: &VlmSetup) -> anyhow::Result<VlmClient> {
             if overrides.backend.is_none() && std::env::var_os("NESY_VLM_BACKEND").is_none() {
                 overrides.backend = Some(BackendKind::Vllm);
             }
-            let config =
-                VlmConfig::resolve(&overrides, &ProcessEnv).context("resolving the VLM configuration")?;
+            let config = resolve(&overrides)?;
             if setup.record.is_some() && config.cassette.is_some() {
-                anyhow::bail!(
-                    "--record cannot be combined with a configured cassette (--cassette / NESY_CASSETTE)"
-                );
+                return Err(setup_error(
+                    "--record cannot be combined with a configured cassette (--cassette / NESY_CASSETTE)",
+                ));
             }
             if config.cassette.is_some() {
-                return Ok(VlmClient::from_config(&config)?);
+                return VlmClient::from_config(&config).map_err(client_error);
             }
-            let http = VlmClient::http_transport(&config)?;
+            let http = VlmClient::http_transport(&config).map_err(client_error)?;
             (config, Some(Arc::new(http)))
         }
-        VlmSource::Oracle { noise } => {
-            let transport = oracle_transport(noise)?;
+        VlmSource::Oracle { noise, seed } => {
+            let transport = oracle_transport(noise, *seed)?;
             (oracle_config(), Some(transport))
         }
         VlmSource::Transport { config, transport } => ((**config).clone(), Some(transport.clone())),
     };
-    let live = live.context("no transport")?;
+    let live = live.ok_or_else(|| setup_error("no transport"))?;
     let transport: Arc<dyn Transport> = match &setup.record {
         Some(path) => {
             if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-                std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+                std::fs::create_dir_all(dir).map_err(|e| PipelineError::write(dir, e))?;
             }
             Arc::new(
                 CassetteTransport::open(
@@ -199,7 +212,7 @@ pub fn build_client(setup: &VlmSetup) -> anyhow::Result<VlmClient> {
                         ..CassetteOptions::default()
                     },
                 )
-                .with_context(|| format!("opening {} for recording", path.display()))?,
+                .map_err(|e| setup_error(format!("opening {} for recording: {e}", path.display())))?,
             )
         }
         None => live,
@@ -208,18 +221,33 @@ pub fn build_client(setup: &VlmSetup) -> anyhow::Result<VlmClient> {
 }
 
 /// The offline reference responder: nesy-vlm's oracle over the true domain, with the noise
-/// knobs, answering code generation with the template compiler.
-fn oracle_transport(noise: &str) -> anyhow::Result<Arc<dyn Transport>> {
+/// knobs seeded by `seed`, answering code generation with the template compiler.
+pub fn oracle_transport(noise: &str, seed: u64) -> Result<Arc<dyn Transport>, PipelineError> {
     let noise: OracleNoise = if noise.trim().is_empty() {
         OracleNoise::NONE
     } else {
         noise
             .parse()
-            .with_context(|| format!("--oracle-noise {noise:?}"))?
+            .map_err(|e| setup_error(format!("--oracle-noise {noise:?}: {e}")))?
     };
     let oracle = OracleTransport::new()
-        .context("loading the oracle's domain")?
-        .with_noise(noise, 0)
-        .with_compiler(Arc::new(super::synth::TemplateCompiler));
+        .map_err(|e| setup_error(format!("loading the oracle's domain: {e}")))?
+        .with_noise(noise, seed)
+        .with_compiler(Arc::new(crate::synth::TemplateCompiler));
     Ok(Arc::new(oracle))
+}
+
+fn setup_error(message: impl Into<String>) -> PipelineError {
+    PipelineError::VlmSetup {
+        message: message.into(),
+    }
+}
+
+fn client_error(e: nesy_vlm::VlmError) -> PipelineError {
+    setup_error(e.to_string())
+}
+
+fn resolve(overrides: &ConfigOverrides) -> Result<VlmConfig, PipelineError> {
+    VlmConfig::resolve(overrides, &ProcessEnv)
+        .map_err(|e| setup_error(format!("resolving the VLM configuration: {e}")))
 }

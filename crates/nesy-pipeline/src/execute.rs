@@ -1,12 +1,14 @@
-//! Step 6 (`--execute`): the policy runs in the sandboxed worker against the target scene;
-//! the goal checks' subtask results give SR, GC and PD (`docs/benchmark.md` §7).
+//! Execution: the policy runs in the sandboxed worker against the target scene; the goal
+//! checks' subtask results give SR, GC and PD (`docs/benchmark.md` §7), scored by
+//! `nesy_core::metrics`.
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context as _;
 use nesy_core::metrics::{EpisodeResult, SubtaskResult, achieved_in_time_order};
 use nesy_policy::{EpisodeSpec, ExecutionResult, Limits, WorkerCommand, run_policy};
 use serde::Serialize;
+
+use crate::PipelineError;
 
 /// The execution and its scores.
 #[derive(Debug, Clone, Serialize)]
@@ -99,14 +101,16 @@ pub fn execute(
     code: &str,
     scene_path: &Path,
     limits: &Limits,
-) -> anyhow::Result<ExecutionReport> {
+) -> Result<ExecutionReport, PipelineError> {
     let spec = EpisodeSpec::Scene {
         path: std::path::absolute(scene_path).unwrap_or_else(|_| scene_path.to_owned()),
         embodiment: None,
         render_every: 0,
     };
-    let result = run_policy(worker, code, &spec, limits)
-        .with_context(|| format!("running the policy on {}", scene_path.display()))?;
+    let result = run_policy(worker, code, &spec, limits).map_err(|e| PipelineError::Execute {
+        scene: scene_path.to_owned(),
+        message: e.to_string(),
+    })?;
     let metrics = EpisodeMetrics::from_result(&result);
     Ok(ExecutionReport {
         scene_path: scene_path.to_owned(),

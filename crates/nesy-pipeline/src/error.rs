@@ -1,0 +1,96 @@
+//! Why a pipeline stage could not produce its result. Callers branch on the kind: bad input
+//! is the user's to fix, a transport failure is worth retrying later, and the rest are the
+//! episode's own failures.
+
+use std::path::PathBuf;
+
+use nesy_core::adapt::{AdaptError, ReasonerErrorKind};
+
+/// Everything a stage of the pipeline can fail with.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// The demonstration cannot be read or used.
+    #[error("{}: {message}", path.display())]
+    Demo {
+        /// The demo file or folder.
+        path: PathBuf,
+        /// What is wrong, naming the field or keyframe.
+        message: String,
+    },
+    /// The target scene cannot be read, built or checked.
+    #[error("{}: {message}", path.display())]
+    Target {
+        /// The scene file (or `<demo>#target_scene`).
+        path: PathBuf,
+        /// What is wrong, naming the JSON field.
+        message: String,
+    },
+    /// The model client cannot be set up (configuration, cassette, offline responder).
+    #[error("setting up the VLM: {message}")]
+    VlmSetup {
+        /// What is wrong.
+        message: String,
+    },
+    /// Symbolic states could not be produced.
+    #[error("symbolic states: {message}")]
+    States {
+        /// What went wrong, naming the view set.
+        message: String,
+        /// The reasoner failure behind it, when a model call failed.
+        kind: Option<ReasonerErrorKind>,
+    },
+    /// The adaptation loop could not produce an outcome (the reasoner failed, or no reply
+    /// for a transition parsed).
+    #[error("adaptation: {0}")]
+    Adapt(#[from] AdaptError),
+    /// The policy could not be run at all (not: it ran and failed).
+    #[error("running the policy on {}: {message}", scene.display())]
+    Execute {
+        /// The scene the worker was to run.
+        scene: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// An output file could not be written.
+    #[error("writing {}: {source}", path.display())]
+    Write {
+        /// The file or folder.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// Closing the client failed (a strict cassette with unused interactions, a usage report
+    /// that could not be written).
+    #[error("closing the VLM client (cassette): {message}")]
+    Finish {
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl PipelineError {
+    /// True when the user's input is at fault (a demo, a scene, settings), so a command line
+    /// exits with its bad-input code.
+    pub fn is_bad_input(&self) -> bool {
+        matches!(
+            self,
+            PipelineError::Demo { .. } | PipelineError::Target { .. } | PipelineError::VlmSetup { .. }
+        )
+    }
+
+    /// The reasoner failure behind the error, if a model call is what failed.
+    pub fn reasoner_kind(&self) -> Option<ReasonerErrorKind> {
+        match self {
+            PipelineError::States { kind, .. } => *kind,
+            PipelineError::Adapt(AdaptError::Reasoner(e)) => Some(e.kind),
+            _ => None,
+        }
+    }
+
+    pub(crate) fn write(path: impl Into<PathBuf>, source: std::io::Error) -> PipelineError {
+        PipelineError::Write {
+            path: path.into(),
+            source,
+        }
+    }
+}
