@@ -43,6 +43,8 @@ pub struct Cli {
 pub enum Command {
     /// Adapt a demonstration to a target scene and synthesize (and run) a verified code policy.
     Adapt(Box<commands::adapt::AdaptArgs>),
+    /// Run the benchmark over the 440 scenarios: methods, resumable and sharded runs, reports.
+    Bench(commands::bench::BenchArgs),
     /// Inspect, prune or verify VLM cassettes (recorded model calls for offline replay).
     Cassette(commands::cassette::CassetteArgs),
     /// Record a scripted-expert demonstration of a benchmark scenario as MCAP.
@@ -77,6 +79,7 @@ pub fn main() -> ExitCode {
 pub fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
         Command::Adapt(args) => commands::adapt::run(*args),
+        Command::Bench(args) => commands::bench::run(args),
         Command::Cassette(args) => commands::cassette::run(args),
         Command::Record(args) => commands::record::run(args),
         Command::Render(args) => commands::render::run(args),

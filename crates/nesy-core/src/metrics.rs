@@ -50,6 +50,30 @@ impl std::fmt::Display for SubtaskResult {
     }
 }
 
+/// How a subtask is scored when objects it counted as placed are out of place at the end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Scoring {
+    /// nesy's headline: a subtask with a displaced object fails, because the episode's
+    /// final state does not show it achieved.
+    #[default]
+    Strict,
+    /// The authors' metric: an object counts once it was placed (latched), whatever happens
+    /// to it later.
+    Latched,
+}
+
+impl Scoring {
+    /// The verdict of a subtask under this scoring, given whether any of its counted objects
+    /// is out of place at the end.
+    pub fn verdict(self, result: SubtaskResult, displaced: bool) -> SubtaskResult {
+        match self {
+            Scoring::Strict if displaced => SubtaskResult::Fail,
+            _ => result,
+        }
+    }
+}
+
 /// Merges per-subtask achievements, each a `(name, control step)` list in time order, into
 /// the episode's achieved sequence: time order, ties broken by subtask (config) order and
 /// then by the order within the subtask.
@@ -144,22 +168,9 @@ pub struct MeanSe {
 impl MeanSe {
     /// Mean and SE of `values`.
     pub fn of(values: &[f64]) -> Self {
-        let n = values.len();
-        if n == 0 {
-            return MeanSe {
-                mean: f64::NAN,
-                se: f64::NAN,
-                n,
-            };
-        }
-        let mean = values.iter().sum::<f64>() / n as f64;
-        let se = if n < 2 {
-            f64::NAN
-        } else {
-            let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
-            var.sqrt() / (n as f64).sqrt()
-        };
-        MeanSe { mean, se, n }
+        let mut tally = Tally::default();
+        values.iter().for_each(|v| tally.push(*v));
+        tally.mean_se()
     }
 
     /// Scaled to percent (mean × 100 ± SE × 100), as the tables report.
@@ -175,6 +186,71 @@ impl MeanSe {
 impl std::fmt::Display for MeanSe {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{:.2}±{:.2}", self.mean, self.se)
+    }
+}
+
+/// Running sums of a metric over episodes: cells of a table are tallied once, and rows and
+/// the pooled "All" column merge the cells' tallies, so every mean ± SE in a report comes from
+/// the same arithmetic over the same episodes.
+///
+/// ```
+/// use nesy_core::metrics::{MeanSe, Tally};
+///
+/// let (mut a, mut b) = (Tally::default(), Tally::default());
+/// [1.0, 0.0, 1.0].iter().for_each(|v| a.push(*v));
+/// [1.0, 1.0].iter().for_each(|v| b.push(*v));
+/// let pooled = a.merged(&b).mean_se();
+/// assert_eq!(pooled.n, 5);
+/// assert!((pooled.mean - 0.8).abs() < 1e-12);
+/// assert!((pooled.se - MeanSe::of(&[1.0, 0.0, 1.0, 1.0, 1.0]).se).abs() < 1e-12);
+/// ```
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Tally {
+    /// Number of values.
+    pub n: usize,
+    /// Their sum.
+    pub sum: f64,
+    /// The sum of their squares.
+    pub sum_sq: f64,
+}
+
+impl Tally {
+    /// Adds one value.
+    pub fn push(&mut self, value: f64) {
+        self.n += 1;
+        self.sum += value;
+        self.sum_sq += value * value;
+    }
+
+    /// Both tallies' values together.
+    pub fn merged(&self, other: &Tally) -> Tally {
+        Tally {
+            n: self.n + other.n,
+            sum: self.sum + other.sum,
+            sum_sq: self.sum_sq + other.sum_sq,
+        }
+    }
+
+    /// Mean and standard error, SE = sample standard deviation (ddof 1) / √n. With fewer
+    /// than two values the SE is NaN, and the mean of no values is NaN.
+    pub fn mean_se(&self) -> MeanSe {
+        let n = self.n;
+        if n == 0 {
+            return MeanSe {
+                mean: f64::NAN,
+                se: f64::NAN,
+                n,
+            };
+        }
+        let mean = self.sum / n as f64;
+        let se = if n < 2 {
+            f64::NAN
+        } else {
+            // Clamped: rounding can leave a tiny negative for values that are all equal.
+            let var = ((self.sum_sq - self.sum * mean) / (n - 1) as f64).max(0.0);
+            var.sqrt() / (n as f64).sqrt()
+        };
+        MeanSe { mean, se, n }
     }
 }
 

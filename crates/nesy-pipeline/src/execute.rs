@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use nesy_core::metrics::{EpisodeResult, SubtaskResult, achieved_in_time_order};
+use nesy_core::metrics::{EpisodeResult, Scoring, SubtaskResult, achieved_in_time_order};
 use nesy_policy::{EpisodeSpec, ExecutionResult, Limits, WorkerCommand, run_policy};
 use serde::Serialize;
 
@@ -40,19 +40,28 @@ impl ExecutionReport {
 pub struct SubtaskVerdict {
     /// The subtask type.
     pub subtask: String,
-    /// Its result.
+    /// Its result by the authors' latch.
     pub status: SubtaskResult,
+    /// Counted objects out of place at the end (the subtask fails nesy's headline scoring).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub displaced: Vec<String>,
 }
 
-/// The episode's scores (`docs/benchmark.md` §7).
+/// The episode's scores (`docs/benchmark.md` §7). The headline SR and GC fail a subtask whose
+/// counted objects are out of place at the end; `latched_sr` and `latched_gc` are the
+/// authors' scores, which count an object once it was placed.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EpisodeMetrics {
     /// The subtask verdicts.
     pub subtasks: Vec<SubtaskVerdict>,
-    /// 1 if every subtask succeeded (partial counts), else 0.
+    /// 1 if every subtask succeeded (partial counts) and nothing ended displaced, else 0.
     pub sr: f64,
-    /// Fraction of successful subtasks.
+    /// Fraction of successful subtasks (a subtask with a displaced object fails).
     pub gc: f64,
+    /// SR by the authors' latch.
+    pub latched_sr: f64,
+    /// GC by the authors' latch.
+    pub latched_gc: f64,
     /// Normalised Levenshtein distance of the achieved sequence to the goal label, when the
     /// goal checks report the sequences.
     pub pd: Option<f64>,
@@ -71,12 +80,16 @@ impl EpisodeMetrics {
             .map(|s| SubtaskVerdict {
                 subtask: s.subtask.clone(),
                 status: s.status,
+                displaced: s.displaced.clone(),
             })
             .collect();
         // The goal label is the subtask labels in config order; the achieved sequence merges
         // every subtask's achievements in time order.
-        let episode = EpisodeResult {
-            subtasks: verdicts.iter().map(|v| v.status).collect(),
+        let scored = |scoring: Scoring| EpisodeResult {
+            subtasks: verdicts
+                .iter()
+                .map(|v| scoring.verdict(v.status, !v.displaced.is_empty()))
+                .collect(),
             label: subtasks.iter().flat_map(|s| s.label.iter().cloned()).collect(),
             achieved: achieved_in_time_order(
                 subtasks
@@ -84,9 +97,13 @@ impl EpisodeMetrics {
                     .map(|s| s.achieved.iter().map(|(name, step)| (name.as_str(), *step))),
             ),
         };
+        let latched = scored(Scoring::Latched);
+        let episode = scored(Scoring::Strict);
         Some(EpisodeMetrics {
             sr: episode.success(),
             gc: episode.goal_condition(),
+            latched_sr: latched.success(),
+            latched_gc: latched.goal_condition(),
             pd: (!episode.label.is_empty()).then(|| episode.procedure_deviation()),
             label: episode.label,
             achieved: episode.achieved,

@@ -100,30 +100,31 @@ impl TargetInput {
     /// observes and renders it. Embodiment atoms go into the state when the target's end
     /// effector differs from the demo's (the authors' `ee_set`).
     pub fn load(path: Option<&Path>, demo: &DemoInput) -> Result<TargetInput, PipelineError> {
-        let (path, scene) =
-            match path {
-                Some(path) => {
-                    let scene = SceneSpec::from_file(path).map_err(|e| PipelineError::Target {
-                        path: path.to_owned(),
-                        message: format!("reading the target scene: {e}"),
+        let (path, scene) = match path {
+            Some(path) => {
+                let scene = SceneSpec::from_file(path).map_err(|e| PipelineError::Target {
+                    path: path.to_owned(),
+                    message: format!("reading the target scene: {e}"),
+                })?;
+                (path.to_owned(), scene)
+            }
+            None => {
+                let scene = demo
+                    .demo
+                    .metadata
+                    .target_scene
+                    .clone()
+                    .ok_or_else(|| PipelineError::Demo {
+                        path: demo.path.clone(),
+                        message: "no target scene given, and the demo records none (metadata `target_scene`)"
+                            .into(),
                     })?;
-                    (path.to_owned(), scene)
-                }
-                None => {
-                    let scene = demo.demo.metadata.target_scene.clone().ok_or_else(|| {
-                        PipelineError::Demo {
-                            path: demo.path.clone(),
-                            message:
-                                "no target scene given, and the demo records none (metadata `target_scene`)"
-                                    .into(),
-                        }
-                    })?;
-                    (
-                        PathBuf::from(format!("{}#target_scene", demo.path.display())),
-                        scene,
-                    )
-                }
-            };
+                (
+                    PathBuf::from(format!("{}#target_scene", demo.path.display())),
+                    scene,
+                )
+            }
+        };
         Self::from_scene(path, scene, demo.demo.metadata.embodiment)
     }
 

@@ -197,6 +197,9 @@ pub struct SubtaskReport {
     /// (for the procedure deviation, PD, over all subtasks merged in time order).
     #[serde(default)]
     pub achieved: Vec<(String, u64)>,
+    /// Its objects that were counted as placed but are out of place at the end.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub displaced: Vec<String>,
 }
 
 /// How the worker process ended, reported by the parent.

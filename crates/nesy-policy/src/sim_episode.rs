@@ -40,6 +40,7 @@ fn subtask_result(outcome: &SubtaskOutcome) -> SubtaskReport {
             .iter()
             .map(|a| (a.name.clone(), a.step))
             .collect(),
+        displaced: outcome.displaced.clone(),
     }
 }
 

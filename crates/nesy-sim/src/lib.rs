@@ -38,6 +38,10 @@ pub mod scene;
 pub mod tasks;
 pub mod world;
 
+/// The simulator's fingerprint: its version and a hash of its sources and robot models.
+/// Anything recorded with the simulator (demonstrations) is keyed by it.
+pub const FINGERPRINT: &str = env!("NESY_SIM_FINGERPRINT");
+
 pub use api::{ApiCall, ApiError, ApiValue, Direction, Embodiment, RobotApi, TraceEntry};
 pub use perception::observe;
 pub use scene::{SceneError, SceneSpec};

@@ -91,7 +91,7 @@ pub mod response;
 pub mod retry;
 pub mod secret;
 pub mod settings;
-mod timefmt;
+pub mod timefmt;
 pub mod translate;
 pub mod transport;
 

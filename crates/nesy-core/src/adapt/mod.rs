@@ -125,6 +125,19 @@ pub struct AdaptConfig {
     pub transition_check: TransitionCheck,
     /// Ablation switches.
     pub ablation: Ablation,
+    /// Require the derived goal to hold at the end (the full method). Off: the loop stops as
+    /// soon as every precondition holds, as the authors' released code does.
+    #[serde(default = "yes")]
+    pub goal_check: bool,
+    /// Drop induced operators without preconditions from the procedure, as the authors'
+    /// released code does (off in the full method: a transition that needs nothing still
+    /// happened).
+    #[serde(default)]
+    pub drop_unconditioned: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Default for AdaptConfig {
@@ -134,6 +147,8 @@ impl Default for AdaptConfig {
             budget: 10,
             transition_check: TransitionCheck::Exact,
             ablation: Ablation::FULL,
+            goal_check: true,
+            drop_unconditioned: false,
         }
     }
 }

@@ -208,7 +208,14 @@ pub async fn construct_world_model<R: Reasoner>(
             }
         }
     }
-    let goal = derive_goal(&demo.states, &demo.task.vocabulary);
+    if config.drop_unconditioned {
+        procedure.retain(|op| !op.pre.is_empty());
+    }
+    let goal = if config.goal_check {
+        derive_goal(&demo.states, &demo.task.vocabulary)
+    } else {
+        Formula::And(Vec::new())
+    };
     let wm = WorldModel {
         procedure,
         states: demo.states.clone(),

@@ -153,6 +153,36 @@ impl SubtaskGoal {
             .collect()
     }
 
+    /// The goal as ground atoms in the paper's predicates: every object `InsideOf` its
+    /// container, and the lid or drawer `Closed` for the articulated subtasks.
+    pub fn symbolic_goal(&self) -> Vec<nesy_core::Atom> {
+        use nesy_core::Atom;
+        let inside = |o: &str, c: &str| Atom::new("InsideOf", &[o, c]);
+        match self {
+            SubtaskGoal::PickPlace { objects, container } => {
+                objects.iter().map(|o| inside(o, container)).collect()
+            }
+            SubtaskGoal::Sweep { placements } => placements
+                .iter()
+                .map(|p| inside(&p.object, &p.container))
+                .collect(),
+            SubtaskGoal::PutInHinge {
+                objects,
+                container,
+                lid,
+            } => objects
+                .iter()
+                .map(|o| inside(o, container))
+                .chain([Atom::new("Closed", &[lid])])
+                .collect(),
+            SubtaskGoal::PutInPrismatic { objects, drawer } => objects
+                .iter()
+                .map(|o| inside(o, drawer))
+                .chain([Atom::new("Closed", &[drawer])])
+                .collect(),
+        }
+    }
+
     /// Every object name the goal refers to, with the JSON field holding it.
     pub fn referenced_names(&self) -> Vec<(String, &str)> {
         match self {

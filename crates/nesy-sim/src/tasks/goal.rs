@@ -22,7 +22,7 @@
 use std::sync::{Arc, Mutex, MutexGuard};
 
 pub use nesy_core::metrics::SubtaskResult;
-use nesy_core::metrics::{EpisodeResult, achieved_in_time_order};
+use nesy_core::metrics::{EpisodeResult, Scoring, achieved_in_time_order};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -99,6 +99,17 @@ pub struct SubtaskOutcome {
     /// What it achieved, in time order (also for a failed subtask: the objects it did
     /// place).
     pub achieved: Vec<Achievement>,
+    /// Its objects that were counted (latched) but are out of place when the outcome was
+    /// taken, in label order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub displaced: Vec<String>,
+}
+
+impl SubtaskOutcome {
+    /// The verdict under `scoring` (strict: a displaced object fails the subtask).
+    pub fn verdict(&self, scoring: Scoring) -> SubtaskResult {
+        scoring.verdict(self.result, !self.displaced.is_empty())
+    }
 }
 
 /// The outcome of an episode.
@@ -125,18 +136,19 @@ pub struct EpisodeOutcome {
 }
 
 impl EpisodeOutcome {
-    /// The episode as the metrics score it: verdicts, goal label and achieved sequence.
-    pub fn episode_result(&self) -> EpisodeResult {
+    /// The episode as the metrics score it under `scoring`: verdicts, goal label and
+    /// achieved sequence.
+    pub fn episode_result(&self, scoring: Scoring) -> EpisodeResult {
         EpisodeResult {
-            subtasks: self.subtasks.iter().map(|s| s.result).collect(),
+            subtasks: self.subtasks.iter().map(|s| s.verdict(scoring)).collect(),
             label: self.goal_label.clone(),
             achieved: self.achieved_sequence.clone(),
         }
     }
 
-    /// SR (`docs/benchmark.md` §7): every subtask full or partial.
+    /// SR with the authors' latch (`docs/benchmark.md` §7): every subtask full or partial.
     pub fn success(&self) -> bool {
-        self.episode_result().success() == 1.0
+        self.episode_result(Scoring::Latched).success() == 1.0
     }
 
     /// Every subtask `full_success`.
@@ -148,9 +160,10 @@ impl EpisodeOutcome {
                 .all(|s| s.result == SubtaskResult::FullSuccess)
     }
 
-    /// GC (`docs/benchmark.md` §7): the fraction of successful subtasks.
+    /// GC with the authors' latch (`docs/benchmark.md` §7): the fraction of successful
+    /// subtasks.
     pub fn goal_condition(&self) -> f64 {
-        self.episode_result().goal_condition()
+        self.episode_result(Scoring::Latched).goal_condition()
     }
 
     /// Every subtask `full_success` and every counted object still in place at the end: the
@@ -426,6 +439,7 @@ impl GoalChecker {
                     decided_at_step,
                     label: s.goal.label(),
                     achieved: s.achieved(),
+                    displaced: Vec::new(),
                 }
             })
             .collect();
@@ -448,7 +462,14 @@ impl GoalChecker {
     /// [`GoalChecker::outcome`] with [`EpisodeOutcome::displaced`] filled from `view`.
     pub fn outcome_in(&self, view: &dyn GoalView, end_step: u64) -> EpisodeOutcome {
         let mut outcome = self.outcome(end_step);
-        outcome.displaced = self.subtasks.iter().flat_map(|s| s.displaced(view)).collect();
+        for (o, s) in outcome.subtasks.iter_mut().zip(&self.subtasks) {
+            o.displaced = s.displaced(view);
+        }
+        outcome.displaced = outcome
+            .subtasks
+            .iter()
+            .flat_map(|s| s.displaced.clone())
+            .collect();
         outcome
     }
 }

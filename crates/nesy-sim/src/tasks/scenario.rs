@@ -21,6 +21,8 @@ use std::path::Path;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+pub use nesy_core::benchmark::{Complexity, Factor};
+
 use crate::api::Embodiment;
 use crate::tasks::{GeneratedTask, SubtaskConfig, SubtaskKind, TaskConfig, TaskError};
 use crate::world::rng::Stream;
@@ -31,128 +33,6 @@ pub const CONFIG_SCHEMA_VERSION: u32 = 1;
 pub const SEEDS: [u64; 2] = [0, 1];
 /// Offset between the variants (and episodes) of consecutive seeds.
 pub const SEED_STRIDE: u64 = 1000;
-
-/// A domain factor: what differs between the demo (source) and deployment (target).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum Factor {
-    /// Source clean → target obstructed (the target needs extra steps).
-    Obst,
-    /// Source obstructed → target clean (the demo has redundant steps).
-    Affo,
-    /// Finger-gripper source → vacuum target.
-    Grip,
-    /// Vacuum source → finger-gripper target.
-    Vacu,
-    /// Obstruction changes both ways, with or without an embodiment change.
-    Comb,
-}
-
-impl Factor {
-    /// All five, in the order of the paper's table.
-    pub const ALL: [Factor; 5] = [
-        Factor::Obst,
-        Factor::Affo,
-        Factor::Grip,
-        Factor::Vacu,
-        Factor::Comb,
-    ];
-
-    /// `obst`, `affo`, `grip`, `vacu` or `comb`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Factor::Obst => "obst",
-            Factor::Affo => "affo",
-            Factor::Grip => "grip",
-            Factor::Vacu => "vacu",
-            Factor::Comb => "comb",
-        }
-    }
-
-    /// The factor of a name.
-    pub fn from_name(name: &str) -> Option<Factor> {
-        Factor::ALL.into_iter().find(|f| f.as_str() == name)
-    }
-
-    /// The row of the paper's Table 6 this factor is counted in.
-    pub fn table_row(self) -> &'static str {
-        match self {
-            Factor::Obst | Factor::Affo => "Obstruction & Object Affordance",
-            Factor::Grip | Factor::Vacu => "Kinematic Config & Gripper",
-            Factor::Comb => "Combination",
-        }
-    }
-
-    /// Configurations at a complexity (`docs/benchmark.md` §6).
-    pub fn configurations(self, complexity: Complexity) -> usize {
-        match (self, complexity) {
-            (Factor::Comb, _) => 20,
-            (_, Complexity::Low | Complexity::Medium) => 15,
-            (_, Complexity::High) => 10,
-        }
-    }
-}
-
-impl std::fmt::Display for Factor {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-/// Task complexity.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum Complexity {
-    /// Two subtasks at multi level 0.
-    Low,
-    /// Three subtasks at multi level 1.
-    Medium,
-    /// All four subtasks at multi level 2.
-    High,
-}
-
-impl Complexity {
-    /// All three.
-    pub const ALL: [Complexity; 3] = [Complexity::Low, Complexity::Medium, Complexity::High];
-
-    /// `low`, `medium` or `high`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Complexity::Low => "low",
-            Complexity::Medium => "medium",
-            Complexity::High => "high",
-        }
-    }
-
-    /// The complexity of a name.
-    pub fn from_name(name: &str) -> Option<Complexity> {
-        Complexity::ALL.into_iter().find(|c| c.as_str() == name)
-    }
-
-    /// Number of subtasks.
-    pub fn subtasks(self) -> usize {
-        match self {
-            Complexity::Low => 2,
-            Complexity::Medium => 3,
-            Complexity::High => 4,
-        }
-    }
-
-    /// The multi level of every subtask.
-    pub fn multi_level(self) -> u8 {
-        match self {
-            Complexity::Low => 0,
-            Complexity::Medium => 1,
-            Complexity::High => 2,
-        }
-    }
-}
-
-impl std::fmt::Display for Complexity {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
 
 /// One source/target configuration (the authors' episode).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -359,7 +239,7 @@ pub fn generate_file(factor: Factor, complexity: Complexity) -> ConfigFile {
                 target_subtasks: side(true),
                 source_embodiment,
                 target_embodiment,
-                embodiment_in_state: matches!(factor, Factor::Grip | Factor::Vacu | Factor::Comb),
+                embodiment_in_state: factor.names_embodiment(),
             }
         })
         .collect();
@@ -655,7 +535,7 @@ impl CountTable {
     pub fn paper_rows(&self) -> Vec<(&'static str, [usize; 3])> {
         let mut rows: Vec<(&'static str, [usize; 3])> = Vec::new();
         for &(factor, counts) in &self.by_factor {
-            let name = factor.table_row();
+            let name = factor.group().title();
             match rows.iter_mut().find(|(n, _)| *n == name) {
                 Some((_, row)) => (0..3).for_each(|i| row[i] += counts[i]),
                 None => rows.push((name, counts)),

@@ -6,7 +6,7 @@
 //! - [`Sim`] is the world; it implements [`crate::api::RobotApi`] (in `api_impl`).
 //! - `build` builds it from a scene in named steps.
 //! - [`objects`] builds the benchmark's objects from their kinds; [`geometry`] holds the
-//!   boxes and frame conversions; `floor` finds free table spots; [`rng`] is the seeded
+//!   boxes and frame conversions; `floor` finds free table spots; `rng` is the seeded
 //!   randomness that scene generation and motion planning draw from.
 
 mod api_impl;
@@ -14,7 +14,7 @@ mod build;
 pub(crate) mod floor;
 pub mod geometry;
 pub mod objects;
-pub mod rng;
+pub(crate) mod rng;
 
 use std::any::Any;
 

@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 pub use domain::{DomainError, NESY_WORLD_PDDL, WorldDomain, object_type, semantic};
 pub use induce::{InduceError, InducedAction, RecordedCall, api_function, induce};
 pub use noise::{NoiseError, NoiseRng, OracleNoise};
-pub use patch::{OraclePatchError, ProposedPatch, Strategy, propose};
+pub use patch::{OraclePatchError, ProposedPatch, Strategy, plan_to_goal, propose};
 
 use crate::context::{CodeGenerationContext, StateTranslationContext, VlmTask};
 use crate::error::TransportError;

@@ -227,6 +227,31 @@ fn score(
     })
 }
 
+/// A plan over the true domain's schemas of `embodiment` from `state` to `goal`, with the
+/// objects `objects` (and those of the state and goal), its actions named as the reference
+/// responder names them. The replanning control of the benchmark uses it: the planner stage
+/// of a planning method given the true domain and problem.
+pub fn plan_to_goal(
+    world: &WorldDomain,
+    state: &State,
+    goal: &Formula,
+    embodiment: Embodiment,
+    objects: &[Symbol],
+    config: &PlannerConfig,
+) -> Result<Vec<Operator>, String> {
+    let mut names: Vec<Symbol> = objects.to_vec();
+    names.extend(state.objects());
+    let universe = world.universe(names.iter().map(|s| s.as_str()));
+    let schemas = world.schemas_for(embodiment, &universe);
+    let planning = Planning {
+        universe,
+        schemas,
+        target: embodiment,
+        config,
+    };
+    planning.plan(state, goal).map(|(ops, _)| ops)
+}
+
 /// Proposes a patch for a refinement request.
 pub fn propose(
     world: &WorldDomain,

@@ -45,6 +45,13 @@ pub const FINGER_DOCS: &str = include_str!("../../prompts/api/finger.py");
 /// Docstrings of the vacuum functions.
 pub const VACUUM_DOCS: &str = include_str!("../../prompts/api/vacuum.py");
 
+/// The three documentation files with their paths under `prompts/`.
+pub const EMBEDDED: [(&str, &str); 3] = [
+    ("api/perception.py", PERCEPTION_DOCS),
+    ("api/finger.py", FINGER_DOCS),
+    ("api/vacuum.py", VACUUM_DOCS),
+];
+
 /// Every robot API function name (the 19 of the paper's tables).
 pub fn all_functions() -> impl Iterator<Item = &'static str> {
     PERCEPTION_FUNCTIONS

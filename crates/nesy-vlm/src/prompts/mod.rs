@@ -267,6 +267,38 @@ impl Prompts {
         Ok(PROMPTS.get_or_init(|| loaded))
     }
 
+    /// SHA-256 (hex) over every embedded prompt file: templates, few-shot examples and API
+    /// documentation, names and texts. A benchmark run records it, so results from different
+    /// prompts are never mixed.
+    pub fn fingerprint() -> String {
+        use sha2::{Digest, Sha256};
+        let mut h = Sha256::new();
+        let mut add = |name: &str, text: &str| {
+            h.update((name.len() as u64).to_le_bytes());
+            h.update(name.as_bytes());
+            h.update((text.len() as u64).to_le_bytes());
+            h.update(text.as_bytes());
+        };
+        for (name, text) in TEMPLATES {
+            add(name, text);
+        }
+        for files in [
+            examples::INDUCTION_FILES,
+            examples::STATE_FILES,
+            examples::FINGER_CODE_FILES,
+            examples::VACUUM_CODE_FILES,
+            examples::SCENE_FILES,
+        ] {
+            for f in files {
+                add(f.path, f.text);
+            }
+        }
+        for (name, text) in api_docs::EMBEDDED {
+            add(name, text);
+        }
+        h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    }
+
     /// The names of all template files.
     pub fn template_names() -> impl Iterator<Item = &'static str> {
         TEMPLATES.iter().map(|(n, _)| *n)

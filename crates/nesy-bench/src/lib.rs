@@ -1,0 +1,43 @@
+//! # nesy-bench
+//!
+//! The benchmark of the paper: NeSyCR and the other methods over the 440 scenarios, with
+//! SR, GC and PD per domain factor × complexity, shaped like the paper's Table 1.
+//!
+//! - [`methods`]: the [`methods::Method`] interface (episode inputs → a task specification)
+//!   and the methods: `nesycr` (with its ablation switches as settings), `nesycr-released`,
+//!   `code-as-policies`, and the model-free controls `imitation` and `replan`.
+//! - [`harness`]: a run — the manifest first, then every pending unit of a shard, phase A
+//!   (specification and code) and phase B (execution), one JSON line per finished unit;
+//!   running it again resumes.
+//! - [`demos`]: each scenario's demonstration recorded once, keyed by the scenario and the
+//!   simulator's fingerprint.
+//! - [`shard`], [`merge`]: job arrays and their merge; [`slurm`] writes the `sbatch` file.
+//! - [`plan`]: model calls and images per method and cell, before any call.
+//! - [`report`]: `report.md`, `tables/*.csv` and PNG plots.
+//!
+//! Offline, no number is a method's performance: the reference responder bounds NeSyCR
+//! from above, the controls measure the benchmark, and every report says which it is.
+
+pub mod demos;
+pub mod error;
+pub mod harness;
+pub mod manifest;
+pub mod merge;
+pub mod meter;
+pub mod methods;
+pub mod plan;
+pub mod pool;
+pub mod record;
+pub mod report;
+pub mod shard;
+pub mod slurm;
+pub mod store;
+pub mod unit;
+pub mod variant;
+
+pub use error::BenchError;
+pub use harness::{BenchProgress, Quiet, ResponderSetup, RunConfig, RunSummary, StopSignal};
+pub use record::{UnitRecord, UnitStatus};
+pub use shard::Shard;
+pub use unit::Selection;
+pub use variant::Variant;

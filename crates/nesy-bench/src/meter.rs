@@ -1,0 +1,127 @@
+//! A transport wrapper around each unit's model calls: it counts calls and images by purpose,
+//! stops a unit at its call cap, and bounds model calls in flight across every unit of the
+//! run (model calls wait on the endpoint, not on the CPU, so they have their own limit).
+
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex};
+
+use nesy_vlm::VlmError;
+use nesy_vlm::error::TransportError;
+use nesy_vlm::transport::{BoxFuture, Transport, WireRequest, WireResponse};
+use tokio::sync::Semaphore;
+
+/// What a unit's calls came to.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct CallCounts {
+    /// Calls made (attempts included).
+    pub calls: u64,
+    /// Images sent.
+    pub images: u64,
+    /// Calls by purpose.
+    pub by_purpose: BTreeMap<String, u64>,
+    /// True once the cap refused a call.
+    pub cap_reached: bool,
+}
+
+/// Counts and caps one unit's calls.
+#[derive(Debug)]
+pub struct Metered {
+    inner: Arc<dyn Transport>,
+    counts: Arc<Mutex<CallCounts>>,
+    cap: Option<u64>,
+    in_flight: Arc<Semaphore>,
+}
+
+/// The number of image parts in a chat-completions body.
+pub fn image_count(body: &serde_json::Value) -> u64 {
+    body.get("messages")
+        .and_then(|m| m.as_array())
+        .map(|messages| {
+            messages
+                .iter()
+                .filter_map(|m| m.get("content").and_then(|c| c.as_array()))
+                .flatten()
+                .filter(|part| part.get("type").and_then(|t| t.as_str()) == Some("image_url"))
+                .count() as u64
+        })
+        .unwrap_or(0)
+}
+
+impl Metered {
+    /// Wraps `inner`, refusing calls beyond `cap` and waiting on `in_flight` for a slot.
+    pub fn new(inner: Arc<dyn Transport>, cap: Option<u64>, in_flight: Arc<Semaphore>) -> Metered {
+        Metered {
+            inner,
+            counts: Arc::new(Mutex::new(CallCounts::default())),
+            cap,
+            in_flight,
+        }
+    }
+
+    /// The counts so far (shared with the transport).
+    pub fn counts(&self) -> Arc<Mutex<CallCounts>> {
+        self.counts.clone()
+    }
+}
+
+impl Transport for Metered {
+    fn send<'a>(&'a self, request: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
+        Box::pin(async move {
+            {
+                let mut c = self.counts.lock().unwrap_or_else(|e| e.into_inner());
+                if self.cap.is_some_and(|cap| c.calls >= cap) {
+                    c.cap_reached = true;
+                    return Err(TransportError::Failed {
+                        message: format!(
+                            "the unit's cap of {} model call(s) is reached (--max-calls-per-unit)",
+                            self.cap.unwrap_or_default()
+                        ),
+                        retryable: false,
+                    });
+                }
+                c.calls += 1;
+                c.images += image_count(&request.body);
+                *c.by_purpose
+                    .entry(request.purpose.clone().unwrap_or_else(|| "-".into()))
+                    .or_default() += 1;
+            }
+            let _slot = self
+                .in_flight
+                .acquire()
+                .await
+                .map_err(|_| TransportError::Failed {
+                    message: "the run is shutting down".into(),
+                    retryable: false,
+                })?;
+            self.inner.send(request).await
+        })
+    }
+
+    fn label(&self) -> String {
+        self.inner.label()
+    }
+
+    fn finish(&self) -> Result<(), VlmError> {
+        self.inner.finish()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn images_are_counted_in_every_message() {
+        let body = serde_json::json!({"messages": [
+            {"role": "system", "content": "s"},
+            {"role": "user", "content": [
+                {"type": "text", "text": "a"},
+                {"type": "image_url", "image_url": {"url": "data:"}},
+                {"type": "image_url", "image_url": {"url": "data:"}}
+            ]},
+            {"role": "user", "content": [{"type": "image_url", "image_url": {"url": "data:"}}]}
+        ]});
+        assert_eq!(image_count(&body), 3);
+        assert_eq!(image_count(&serde_json::json!({})), 0);
+    }
+}

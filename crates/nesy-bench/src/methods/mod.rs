@@ -1,0 +1,278 @@
+//! The methods the harness compares, behind one interface: episode inputs in, a task
+//! specification out (a symbolic procedure, verified or not, or a natural-language plan).
+//! The harness then turns the specification into code (the shared code-generation tail) and
+//! executes it.
+//!
+//! Each method names its class in the paper's baseline table (natively code, explicit
+//! adaptation, replanning, world model, symbolic tool), whether it is a method or a
+//! model-free control, and what an offline run of it means.
+
+mod code_as_policies;
+mod imitation;
+pub(crate) mod nesycr;
+mod replan;
+
+use std::sync::Arc;
+
+use futures::future::BoxFuture;
+use nesy_core::Operator;
+use nesy_core::adapt::Adaptation;
+use nesy_pipeline::{CodegenMode, DemoInput, DemoKeyframes, Setting, StateSource, TargetInput};
+use nesy_vlm::VlmClient;
+use serde::Serialize;
+
+use crate::error::BenchError;
+use crate::record::UnitStatus;
+use crate::variant::Variant;
+
+pub use code_as_policies::CodeAsPolicies;
+pub use imitation::Imitation;
+pub use nesycr::NeSyCr;
+pub use replan::Replan;
+
+/// Whether a method is one the paper compares or a control the harness adds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// A method of the paper's comparison.
+    Method,
+    /// A control: it measures the benchmark, not a method.
+    Control,
+}
+
+/// The columns of the paper's baseline-comparison table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct Classes {
+    /// Produces code natively.
+    pub natively_code: bool,
+    /// Adapts the demonstration explicitly.
+    pub explicit_adapt: bool,
+    /// Replans in the target.
+    pub replanning: bool,
+    /// Keeps a world model.
+    pub world_model: bool,
+    /// Uses a symbolic tool.
+    pub symbolic_tool: bool,
+}
+
+/// What an offline run (the reference responder, or no model) of a method measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OfflineMeaning {
+    /// The oracle's answers bound the method from above (NeSyCR: local calls with ground
+    /// truth answers, every answer still checked by the symbolic executor).
+    UpperBound,
+    /// The method uses no model; the number is the control's own.
+    ModelFree,
+    /// The method's calls are global ("write the target plan"): a perfect answer is the
+    /// planner's plan, so an offline number would not be the method's. Offline runs are
+    /// refused.
+    NotMeaningful,
+}
+
+/// A method's description.
+#[derive(Debug, Clone, Serialize)]
+pub struct MethodInfo {
+    /// Its name in variant ids (`nesycr`).
+    pub name: &'static str,
+    /// Its name in tables (`NeSyCR`).
+    pub title: &'static str,
+    /// Method or control.
+    pub role: Role,
+    /// Its classes in the paper's comparison table.
+    pub classes: Classes,
+    /// One sentence on what it does.
+    pub summary: &'static str,
+    /// The settings it takes (`key=values`), for `nesy bench methods`.
+    pub settings: &'static [&'static str],
+    /// What an offline run of it measures.
+    pub offline: OfflineMeaning,
+}
+
+/// Everything a method sees of one unit.
+pub struct UnitInputs {
+    /// The source demonstration.
+    pub demo: Arc<DemoInput>,
+    /// The demonstration's decoded views and recorded calls, for the reasoner.
+    pub keyframes: Arc<DemoKeyframes>,
+    /// The target scene, built, observed and rendered.
+    pub target: Arc<TargetInput>,
+    /// The scenario's settings (embodiments, tier, factor, complexity, budget).
+    pub setting: Setting,
+    /// The variant, with its settings.
+    pub variant: Variant,
+    /// The unit's seed.
+    pub seed: u64,
+}
+
+/// A specification the shared tail turns into code.
+#[derive(Debug, Clone)]
+pub enum Specification {
+    /// Symbolic actions.
+    Procedure {
+        /// The actions, in order.
+        procedure: Vec<Operator>,
+        /// True if the symbolic executor verified it from the target's initial state
+        /// (every precondition and the goal).
+        verified: bool,
+    },
+    /// Natural-language steps.
+    Plan {
+        /// The steps, in order.
+        steps: Vec<String>,
+    },
+}
+
+impl Specification {
+    /// `procedure` or `plan`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Specification::Procedure { .. } => "procedure",
+            Specification::Plan { .. } => "plan",
+        }
+    }
+
+    /// Number of steps.
+    pub fn len(&self) -> usize {
+        match self {
+            Specification::Procedure { procedure, .. } => procedure.len(),
+            Specification::Plan { steps } => steps.len(),
+        }
+    }
+
+    /// True without steps.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// What a method produced for a unit.
+#[derive(Debug, Clone)]
+pub struct Specified {
+    /// The specification.
+    pub spec: Specification,
+    /// How its code is made.
+    pub codegen: CodegenMode,
+    /// The adaptation trace, for NeSyCR.
+    pub adaptation: Option<Adaptation>,
+    /// Refinement rounds used and the budget.
+    pub iterations: Option<(usize, usize)>,
+    /// Where the states came from (translation quality for `--states vlm`).
+    pub states: Option<StateSource>,
+    /// Seconds of symbolic work, and the part of it building the world model.
+    pub symbolic_s: (f64, f64),
+    /// Seconds in model calls made by the method itself (not code generation).
+    pub vlm_s: f64,
+    /// Notes for the unit's record (e.g. "compiled the last unverified plan").
+    pub notes: Vec<String>,
+}
+
+/// Why a method produced no specification.
+#[derive(Debug, Clone)]
+pub struct MethodFailure {
+    /// The unit's status.
+    pub status: UnitStatus,
+    /// What happened.
+    pub message: String,
+    /// The adaptation trace, when there is one (an unresolved NeSyCR run).
+    pub adaptation: Option<Box<Adaptation>>,
+    /// Refinement rounds used and the budget.
+    pub iterations: Option<(usize, usize)>,
+}
+
+impl MethodFailure {
+    /// A failure with a status and a message.
+    pub fn new(status: UnitStatus, message: impl Into<String>) -> MethodFailure {
+        MethodFailure {
+            status,
+            message: message.into(),
+            adaptation: None,
+            iterations: None,
+        }
+    }
+
+    /// The status a reasoner failure of `kind` gives the unit.
+    pub fn from_reasoner(kind: nesy_core::adapt::ReasonerErrorKind, message: String) -> MethodFailure {
+        use nesy_core::adapt::ReasonerErrorKind as K;
+        let status = match kind {
+            K::Transport | K::Replay => UnitStatus::TransportError,
+            K::Refused => UnitStatus::RequestRefused,
+            K::Reply | K::Request | K::Exhausted => UnitStatus::MethodError,
+        };
+        MethodFailure::new(status, message)
+    }
+}
+
+/// A method of the benchmark.
+pub trait Method: Send + Sync {
+    /// Its description.
+    fn info(&self) -> MethodInfo;
+
+    /// Checks a variant's settings (called before a run starts, so a typo fails at once).
+    fn validate(&self, variant: &Variant) -> Result<(), BenchError>;
+
+    /// Produces the unit's specification, asking `client` for any model calls (clones of a
+    /// client share its transport and accounting).
+    fn specify<'a>(
+        &'a self,
+        inputs: &'a UnitInputs,
+        client: &'a VlmClient,
+    ) -> BoxFuture<'a, Result<Specified, MethodFailure>>;
+}
+
+/// Every method the harness knows, in table order.
+pub fn registry() -> Vec<Arc<dyn Method>> {
+    vec![
+        Arc::new(NeSyCr::full()),
+        Arc::new(NeSyCr::released()),
+        Arc::new(CodeAsPolicies),
+        Arc::new(Imitation),
+        Arc::new(Replan),
+    ]
+}
+
+/// The method of a name.
+pub fn find(name: &str) -> Result<Arc<dyn Method>, BenchError> {
+    registry()
+        .into_iter()
+        .find(|m| m.info().name == name)
+        .ok_or_else(|| {
+            let known: Vec<&str> = registry().iter().map(|m| m.info().name).collect();
+            BenchError::Usage(format!(
+                "unknown method {name:?}; known: {} (`nesy bench methods` describes them)",
+                known.join(", ")
+            ))
+        })
+}
+
+/// Checks that every setting of `variant` is one of `known` (keys of the form
+/// `key=v1|v2|…` or `key=N`).
+pub(crate) fn check_keys(variant: &Variant, known: &[&str]) -> Result<(), BenchError> {
+    for key in variant.options.keys() {
+        if !known.iter().any(|k| k.split('=').next() == Some(key.as_str())) {
+            return Err(BenchError::Usage(format!(
+                "variant {}: {} takes no setting {key:?}; its settings: {}",
+                variant,
+                variant.method,
+                if known.is_empty() {
+                    "none".to_owned()
+                } else {
+                    known.join(", ")
+                }
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// `on` or `off` of a setting (with a default), or a usage error naming it.
+pub(crate) fn switch(variant: &Variant, key: &str, default: bool) -> Result<bool, BenchError> {
+    match variant.option(key) {
+        None => Ok(default),
+        Some("on") => Ok(true),
+        Some("off") => Ok(false),
+        Some(other) => Err(BenchError::Usage(format!(
+            "variant {variant}: {key}={other:?}; expected on or off"
+        ))),
+    }
+}

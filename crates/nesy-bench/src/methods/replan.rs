@@ -1,0 +1,120 @@
+//! The replanning control: nesy-core's planner over nesy's true domain, from the target's
+//! observed initial state to the target's goal (every object in its container, lids and
+//! drawers closed, the end effector released), compiled by the template compiler. It is the
+//! planner stage of a planning method given a perfect domain and problem: an idealized
+//! control, and a measure of the planner's own capacity.
+
+use futures::FutureExt as _;
+use futures::future::BoxFuture;
+use nesy_core::Atom;
+use nesy_core::formula::Formula;
+use nesy_core::planner::{Heuristic, PlannerConfig, Search};
+use nesy_core::symbol::Symbol;
+use nesy_pipeline::CodegenMode;
+use nesy_sim::api::Embodiment;
+use nesy_vlm::VlmClient;
+use nesy_vlm::oracle::{WorldDomain, plan_to_goal};
+
+use super::{
+    Classes, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified, UnitInputs,
+    check_keys,
+};
+use crate::error::BenchError;
+use crate::record::UnitStatus;
+use crate::variant::Variant;
+
+/// The replanning control.
+#[derive(Debug, Clone, Copy)]
+pub struct Replan;
+
+/// The planner's settings for the control: greedy best-first search on h_FF with a 10 s
+/// wall limit (the authors give Fast Downward 10 s).
+pub fn planner_config() -> PlannerConfig {
+    PlannerConfig {
+        search: Search::Gbfs,
+        heuristic: Heuristic::HFf,
+        time_limit: Some(std::time::Duration::from_secs(10)),
+        ..PlannerConfig::default()
+    }
+}
+
+/// The target's goal as the planner takes it: every scene goal's atoms, and the end effector
+/// open with nothing held.
+pub fn target_goal(inputs: &UnitInputs) -> Formula {
+    let mut atoms: Vec<Formula> = inputs
+        .target
+        .scene
+        .goals
+        .iter()
+        .flat_map(|g| g.symbolic_goal())
+        .map(Formula::atom)
+        .collect();
+    let released = match inputs.target.scene.embodiment {
+        Embodiment::Finger => "GripperOpen",
+        Embodiment::Vacuum => "VacuumInactive",
+    };
+    atoms.push(Formula::atom(Atom::new(released, &[])));
+    Formula::And(atoms)
+}
+
+impl Method for Replan {
+    fn info(&self) -> MethodInfo {
+        MethodInfo {
+            name: "replan",
+            title: "Replanning (control, idealized)",
+            role: Role::Control,
+            classes: Classes {
+                natively_code: false,
+                explicit_adapt: true,
+                replanning: true,
+                world_model: true,
+                symbolic_tool: true,
+            },
+            summary: "nesy-core's planner over the true domain from the target's state to its goal, compiled: the planner stage of a planning method with a perfect domain and problem",
+            settings: &[],
+            offline: OfflineMeaning::ModelFree,
+        }
+    }
+
+    fn validate(&self, variant: &Variant) -> Result<(), BenchError> {
+        check_keys(variant, &[])
+    }
+
+    fn specify<'a>(
+        &'a self,
+        inputs: &'a UnitInputs,
+        _client: &'a VlmClient,
+    ) -> BoxFuture<'a, Result<Specified, MethodFailure>> {
+        async move {
+            let world = WorldDomain::builtin()
+                .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?;
+            let goal = target_goal(inputs);
+            let objects: Vec<Symbol> = inputs.target.objects.iter().map(|o| Symbol::new(o)).collect();
+            let started = std::time::Instant::now();
+            let procedure = plan_to_goal(
+                world,
+                &inputs.target.observed,
+                &goal,
+                inputs.target.scene.embodiment,
+                &objects,
+                &planner_config(),
+            )
+            .map_err(|e| MethodFailure::new(UnitStatus::Unresolved, format!("no plan: {e}")))?;
+            let symbolic = started.elapsed().as_secs_f64();
+            Ok(Specified {
+                spec: Specification::Procedure {
+                    procedure,
+                    verified: true,
+                },
+                codegen: CodegenMode::Template,
+                adaptation: None,
+                iterations: None,
+                states: None,
+                symbolic_s: (symbolic, 0.0),
+                vlm_s: 0.0,
+                notes: Vec::new(),
+            })
+        }
+        .boxed()
+    }
+}

@@ -1,0 +1,240 @@
+//! One JSON line per finished unit: its identity, how it ended, its scores under both
+//! scorings, what it cost and where its artifacts are.
+
+use std::collections::BTreeMap;
+
+use nesy_core::benchmark::{Complexity, Factor};
+use nesy_core::metrics::{EpisodeResult, SubtaskResult};
+use serde::{Deserialize, Serialize};
+
+use crate::unit::UnitKey;
+
+/// How a unit ended. Every unit ends in exactly one status; none is dropped from a table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum UnitStatus {
+    /// Specified, compiled and executed, every subtask successful (strict scoring).
+    Succeeded,
+    /// The method's adaptation ran out of budget without a verified specification.
+    Unresolved,
+    /// A specification, but no program could be obtained from it.
+    CodegenFailed,
+    /// A program ran (or could not run) and did not succeed.
+    ExecutionFailed,
+    /// The method could not produce a specification: a reply it cannot read, a parse or
+    /// planner failure that ends it, a call cap reached.
+    MethodError,
+    /// The scenario's demonstration is unusable (the expert failed, or its final state lacks
+    /// part of the goal); no method runs on it.
+    DemoUnusable,
+    /// The endpoint refused a request as built (too many images, too long): retrying the
+    /// same request cannot help, and it says nothing about the method.
+    RequestRefused,
+    /// A model call did not complete (network, rate limit, server error, a missing
+    /// recording): retried on resume.
+    TransportError,
+    /// The run was stopped while the unit was in flight: retried on resume.
+    Interrupted,
+}
+
+impl UnitStatus {
+    /// Every status, in report order.
+    pub const ALL: [UnitStatus; 9] = [
+        UnitStatus::Succeeded,
+        UnitStatus::Unresolved,
+        UnitStatus::CodegenFailed,
+        UnitStatus::ExecutionFailed,
+        UnitStatus::MethodError,
+        UnitStatus::DemoUnusable,
+        UnitStatus::RequestRefused,
+        UnitStatus::TransportError,
+        UnitStatus::Interrupted,
+    ];
+
+    /// `succeeded`, `unresolved`, …
+    pub fn as_str(self) -> &'static str {
+        match self {
+            UnitStatus::Succeeded => "succeeded",
+            UnitStatus::Unresolved => "unresolved",
+            UnitStatus::CodegenFailed => "codegen_failed",
+            UnitStatus::ExecutionFailed => "execution_failed",
+            UnitStatus::MethodError => "method_error",
+            UnitStatus::DemoUnusable => "demo_unusable",
+            UnitStatus::RequestRefused => "request_refused",
+            UnitStatus::TransportError => "transport_error",
+            UnitStatus::Interrupted => "interrupted",
+        }
+    }
+
+    /// Final statuses are kept on resume; the others (transport errors, interrupted units)
+    /// are run again.
+    pub fn is_final(self) -> bool {
+        !matches!(self, UnitStatus::TransportError | UnitStatus::Interrupted)
+    }
+
+    /// True when the unit is scored as an episode of the method: everything but unusable
+    /// demos (excluded from every method alike) and units that are retried.
+    pub fn is_scored(self) -> bool {
+        self.is_final() && self != UnitStatus::DemoUnusable
+    }
+}
+
+impl std::fmt::Display for UnitStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// One subtask's verdict in a record.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SubtaskScore {
+    /// `pick_place`, …
+    pub subtask: String,
+    /// The authors' verdict (latched).
+    pub result: SubtaskResult,
+    /// Counted objects out of place at the end (the subtask fails the strict scoring).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub displaced: Vec<String>,
+}
+
+/// An episode's scores. A unit that never executed scores SR 0 and GC 0 under both
+/// scorings and has no PD (its label is kept, its achieved sequence is empty).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Scores {
+    /// SR, strict scoring (nesy's headline).
+    pub sr: f64,
+    /// GC, strict scoring.
+    pub gc: f64,
+    /// SR by the authors' latch.
+    pub latched_sr: f64,
+    /// GC by the authors' latch.
+    pub latched_gc: f64,
+    /// PD of the episode (normalised edit distance of the achieved sequence to the label).
+    pub pd: f64,
+    /// The goal label.
+    pub label: Vec<String>,
+    /// What was achieved, in time order.
+    pub achieved: Vec<String>,
+    /// The subtasks.
+    pub subtasks: Vec<SubtaskScore>,
+}
+
+impl Scores {
+    /// The scores of a unit that did not execute: every subtask failed.
+    pub fn not_executed(label: Vec<String>, subtasks: &[String]) -> Scores {
+        let episode = EpisodeResult {
+            subtasks: vec![SubtaskResult::Fail; subtasks.len()],
+            label: label.clone(),
+            achieved: Vec::new(),
+        };
+        Scores {
+            sr: 0.0,
+            gc: 0.0,
+            latched_sr: 0.0,
+            latched_gc: 0.0,
+            pd: episode.procedure_deviation(),
+            label,
+            achieved: Vec::new(),
+            subtasks: subtasks
+                .iter()
+                .map(|s| SubtaskScore {
+                    subtask: s.clone(),
+                    result: SubtaskResult::Fail,
+                    displaced: Vec::new(),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// What a unit's specification was.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpecSummary {
+    /// `procedure` (symbolic actions), `plan` (natural-language steps) or `none`.
+    pub kind: String,
+    /// Steps in it.
+    pub steps: usize,
+    /// Whether the symbolic executor verified it from the target's initial state.
+    pub verified: bool,
+    /// Refinement rounds used (iterative methods).
+    pub iterations: Option<usize>,
+    /// The round budget it had.
+    pub budget: Option<usize>,
+}
+
+/// What a unit spent.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Effort {
+    /// Model calls.
+    pub calls: u64,
+    /// Images sent.
+    pub images: u64,
+    /// Calls by purpose (`induce`, `patch`, `codegen`, `translate`, …).
+    pub calls_by_purpose: BTreeMap<String, u64>,
+    /// Prompt and completion tokens (0 offline).
+    pub tokens: u64,
+    /// Cost in US dollars at the configured price table (0 offline).
+    pub cost_usd: f64,
+    /// Seconds in model calls.
+    pub vlm_s: f64,
+    /// Seconds of symbolic work (verification, identification, patching, planning).
+    pub symbolic_s: f64,
+    /// The part of `symbolic_s` building the world model.
+    pub symbolic_world_model_s: f64,
+    /// Seconds in the template compiler.
+    pub codegen_template_s: f64,
+    /// Seconds in the simulator (target scene and execution).
+    pub sim_s: f64,
+    /// Wall seconds of the whole unit.
+    pub wall_s: f64,
+}
+
+/// State translation against ground truth, when the states came from the model.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Agreement {
+    /// Translated atoms that are true.
+    pub precision: f64,
+    /// True atoms that were translated.
+    pub recall: f64,
+    /// Harmonic mean.
+    pub f1: f64,
+    /// Atom counts behind them: true positives, predicted, actual.
+    pub counts: [u64; 3],
+}
+
+/// One finished unit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct UnitRecord {
+    /// The unit.
+    #[serde(flatten)]
+    pub key: UnitKey,
+    /// The method.
+    pub method: String,
+    /// The scenario's factor.
+    pub factor: Factor,
+    /// The scenario's complexity.
+    pub complexity: Complexity,
+    /// The unit's seed.
+    pub seed: u64,
+    /// Hash of the variant's configuration (a resume refuses records whose hash differs).
+    pub config_hash: String,
+    /// How it ended.
+    pub status: UnitStatus,
+    /// Why, when it did not succeed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// Scores.
+    pub scores: Scores,
+    /// The specification.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spec: Option<SpecSummary>,
+    /// State translation quality, when states came from the model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub states: Option<Agreement>,
+    /// Effort.
+    pub effort: Effort,
+    /// The unit's folder under the run directory.
+    pub artifacts: String,
+    /// When it finished (RFC 3339, UTC).
+    pub finished_at: String,
+}
