@@ -468,10 +468,17 @@ fn unit_dir(shared: &Shared, unit: &Unit) -> PathBuf {
         .join(unit.key.folder(&unit.variant))
 }
 
+/// `ROOT/<scenario>/<variant>[.r<k>].json`. The suffix is appended, not set: a variant id
+/// holds dots (`noise=drop=0.1`) and a repeat ends in `.r<k>`, and `set_extension` would
+/// replace either, so two units would share one recording.
 fn cassette_path(unit: &Unit, root: &Path) -> PathBuf {
-    let mut p = root.join(unit.key.folder(&unit.variant));
-    p.set_extension("json");
-    p
+    recording_path(&unit.key, &unit.variant, root)
+}
+
+fn recording_path(key: &crate::unit::UnitKey, variant: &Variant, root: &Path) -> PathBuf {
+    let mut p = root.join(key.folder(variant)).into_os_string();
+    p.push(".json");
+    PathBuf::from(p)
 }
 
 /// The target scene's goal label and subtask names, for units that never executed.
@@ -1071,4 +1078,37 @@ pub fn complexity_of(id: &str) -> Option<Complexity> {
 pub fn file_digest(path: &Path) -> Option<String> {
     use sha2::Digest as _;
     std::fs::read(path).ok().map(|b| hex(&sha2::Sha256::digest(&b)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::unit::UnitKey;
+
+    #[test]
+    fn every_unit_has_its_own_recording() {
+        let root = Path::new("/c");
+        let path = |variant: &str, repeat: u32| {
+            let v = Variant::parse(variant).unwrap();
+            let key = UnitKey {
+                scenario: "obst_low_00_s0".to_owned(),
+                variant: v.id(),
+                repeat,
+            };
+            recording_path(&key, &v, root)
+        };
+        let paths = [
+            path("nesycr", 0),
+            path("nesycr", 1),
+            path("nesycr", 2),
+            path("nesycr+noise=drop=0.1", 0),
+            path("nesycr+noise=drop=0.2", 0),
+        ];
+        for (i, a) in paths.iter().enumerate() {
+            assert_eq!(a.extension().and_then(|e| e.to_str()), Some("json"), "{a:?}");
+            for b in &paths[i + 1..] {
+                assert_ne!(a, b);
+            }
+        }
+    }
 }

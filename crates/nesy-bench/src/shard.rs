@@ -73,3 +73,47 @@ impl fmt::Display for Shard {
         write!(f, "{}/{}", self.index, self.count)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeSet;
+
+    use super::*;
+    use crate::variant::Variant;
+
+    #[test]
+    fn shards_partition_the_units_evenly_and_spread_the_high_ones() {
+        let files = nesy_sim::tasks::scenario::generate_suite();
+        let scenarios = nesy_sim::tasks::scenario::scenarios(&files);
+        let variants = [Variant::plain("nesycr"), Variant::plain("imitation")];
+        let units = crate::unit::units(&variants, &scenarios, 1, 0);
+        let count = 7;
+        let mut seen = BTreeSet::new();
+        for index in 0..count {
+            let mine = Shard { index, count }.select(&units);
+            // Round-robin over one permutation: sizes differ by at most one.
+            assert!(mine.len().abs_diff(units.len() / count) <= 1, "{}", mine.len());
+            let high = mine
+                .iter()
+                .filter(|u| u.complexity() == nesy_core::benchmark::Complexity::High)
+                .count() as f64;
+            // 240 of the 880 units are high-complexity; each shard gets roughly its share.
+            let share = high / mine.len() as f64;
+            assert!((share - 240.0 / 880.0).abs() < 0.1, "shard {index}: {share}");
+            for u in mine {
+                assert!(seen.insert(u.key.name()), "{} in two shards", u.key.name());
+            }
+        }
+        assert_eq!(seen.len(), units.len(), "every unit in some shard");
+        assert_eq!(Shard::WHOLE.select(&units).len(), units.len());
+    }
+
+    #[test]
+    fn shard_specs_are_checked() {
+        assert_eq!("3/4".parse::<Shard>().unwrap(), Shard { index: 3, count: 4 });
+        for bad in ["4/4", "1", "a/2", "0/0", "-1/3"] {
+            let e = bad.parse::<Shard>().unwrap_err().to_string();
+            assert!(e.contains("expected i/n"), "{bad}: {e}");
+        }
+    }
+}

@@ -28,23 +28,28 @@ pub struct ResultsWriter {
 }
 
 impl ResultsWriter {
-    /// Opens (creating it if needed) the file for appending. A file whose last line was torn
-    /// gets a newline first, so the next record starts on a line of its own.
+    /// Opens (creating it if needed) the file for appending. A torn last line (a process
+    /// killed mid-write) is cut off first: its unit never counted as done and is redone, and
+    /// the next record starts on a line of its own.
     pub fn open(path: &Path) -> Result<ResultsWriter, BenchError> {
         if let Some(dir) = path.parent() {
             std::fs::create_dir_all(dir).map_err(|e| BenchError::io(dir, e))?;
         }
-        let torn = match std::fs::read(path) {
-            Ok(bytes) => !bytes.is_empty() && !bytes.ends_with(b"\n"),
-            Err(_) => false,
+        let complete = match std::fs::read(path) {
+            Ok(bytes) if !bytes.is_empty() && !bytes.ends_with(b"\n") => {
+                Some(bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1))
+            }
+            _ => None,
         };
-        let mut file = OpenOptions::new()
+        let file = OpenOptions::new()
             .create(true)
             .append(true)
             .open(path)
             .map_err(|e| BenchError::io(path, e))?;
-        if torn {
-            file.write_all(b"\n").map_err(|e| BenchError::io(path, e))?;
+        if let Some(len) = complete {
+            file.set_len(len as u64)
+                .and_then(|()| file.sync_data())
+                .map_err(|e| BenchError::io(path, e))?;
         }
         Ok(ResultsWriter {
             path: path.to_owned(),
@@ -128,4 +133,90 @@ pub fn latest_by_unit(records: Vec<UnitRecord>) -> BTreeMap<String, Vec<UnitReco
         }
     }
     by
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use nesy_core::benchmark::{Complexity, Factor};
+
+    use super::*;
+    use crate::record::{Effort, Scores, UnitStatus};
+    use crate::unit::UnitKey;
+
+    pub(crate) fn record(scenario: &str, variant: &str, status: UnitStatus, sr: f64) -> UnitRecord {
+        UnitRecord {
+            key: UnitKey {
+                scenario: scenario.into(),
+                variant: variant.into(),
+                repeat: 0,
+            },
+            method: variant.into(),
+            factor: Factor::Obst,
+            complexity: Complexity::Low,
+            seed: 1,
+            config_hash: "h".into(),
+            status,
+            error: None,
+            scores: Scores {
+                sr,
+                gc: sr,
+                latched_sr: sr,
+                latched_gc: sr,
+                pd: 1.0 - sr,
+                label: vec!["a".into()],
+                achieved: Vec::new(),
+                subtasks: Vec::new(),
+            },
+            spec: None,
+            states: None,
+            effort: Effort::default(),
+            artifacts: String::new(),
+            finished_at: String::new(),
+        }
+    }
+
+    #[test]
+    fn a_torn_last_line_is_skipped_and_the_next_record_starts_clean() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("results/shard-0-of-1.jsonl");
+        let mut w = ResultsWriter::open(&path).unwrap();
+        w.append(&record("s1", "m", UnitStatus::Succeeded, 1.0)).unwrap();
+        drop(w);
+        // A kill in the middle of the second write.
+        let mut bytes = std::fs::read(&path).unwrap();
+        bytes.extend_from_slice(b"{\"scenario\":\"s2\",\"vari");
+        std::fs::write(&path, bytes).unwrap();
+        assert_eq!(read_file(&path).unwrap().len(), 1);
+        let mut w = ResultsWriter::open(&path).unwrap();
+        w.append(&record("s3", "m", UnitStatus::Unresolved, 0.0)).unwrap();
+        let records = read_file(&path).unwrap();
+        assert_eq!(records.len(), 2, "the torn line is cut off, the new one is read");
+        assert_eq!(records[1].key.scenario, "s3");
+        // A malformed line that is not the last one is an error naming the line.
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(&path, format!("not json\n{text}")).unwrap();
+        let e = read_file(&path).unwrap_err().to_string();
+        assert!(e.contains("line 1"), "{e}");
+    }
+
+    #[test]
+    fn retryable_records_are_superseded_and_final_ones_kept() {
+        let by = latest_by_unit(vec![
+            record("s1", "m", UnitStatus::TransportError, 0.0),
+            record("s1", "m", UnitStatus::Succeeded, 1.0),
+            record("s2", "m", UnitStatus::Interrupted, 0.0),
+            record("s3", "m", UnitStatus::Succeeded, 1.0),
+            record("s3", "m", UnitStatus::Succeeded, 1.0),
+        ]);
+        assert_eq!(by["s1/m/r0"].len(), 1);
+        assert_eq!(by["s1/m/r0"][0].status, UnitStatus::Succeeded);
+        assert_eq!(by["s2/m/r0"][0].status, UnitStatus::Interrupted);
+        assert_eq!(
+            by["s3/m/r0"].len(),
+            2,
+            "a duplicate final record is kept for merge to report"
+        );
+        assert!(UnitStatus::TransportError.is_final().eq(&false) && !UnitStatus::Interrupted.is_final());
+        assert!(UnitStatus::MethodError.is_scored() && !UnitStatus::DemoUnusable.is_scored());
+    }
 }

@@ -1,5 +1,5 @@
 //! A variant is a method with its settings, written `method` or `method+key=value+…` on the
-//! command line (`nesycr+ablation=no-verification`, `nesycr+noise=state-drop=0.1`). Units
+//! command line (`nesycr+verification=off`, `nesycr+noise=drop=0.1;flip=0.05`). Units
 //! of one variant share a configuration hash; a resumed run refuses records of a variant
 //! whose settings changed.
 
@@ -47,7 +47,7 @@ impl Variant {
                 .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
         {
             return Err(BenchError::Usage(format!(
-                "variant {text:?}: expected a method name like `nesycr` or `nesycr+ablation=no-verification`"
+                "variant {text:?}: expected a method name like `nesycr` or `nesycr+verification=off`"
             )));
         }
         let mut options = BTreeMap::new();
@@ -146,15 +146,12 @@ mod tests {
 
     #[test]
     fn ids_are_canonical() {
-        let v = Variant::parse("nesycr+on-unresolved=compile-last+ablation=no-verification").unwrap();
+        let v = Variant::parse("nesycr+verification=off+on-unresolved=compile-last").unwrap();
         assert_eq!(v.method, "nesycr");
-        assert_eq!(
-            v.id(),
-            "nesycr+ablation=no-verification+on-unresolved=compile-last"
-        );
+        assert_eq!(v.id(), "nesycr+on-unresolved=compile-last+verification=off");
         assert_eq!(Variant::parse(&v.id()).unwrap(), v);
-        let noisy = Variant::parse("nesycr+noise=state-drop=0.1;state-inject=0.1").unwrap();
-        assert_eq!(noisy.option("noise"), Some("state-drop=0.1;state-inject=0.1"));
+        let noisy = Variant::parse("nesycr+noise=drop=0.1;flip=0.05").unwrap();
+        assert_eq!(noisy.option("noise"), Some("drop=0.1;flip=0.05"));
         assert!(Variant::parse("").is_err());
         assert!(Variant::parse("nesycr+bad").is_err());
         assert!(Variant::parse("nesycr+a=1+a=2").is_err());

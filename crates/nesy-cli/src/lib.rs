@@ -53,7 +53,7 @@ pub enum Command {
     Render(commands::render::RenderArgs),
     /// Run a code policy against a scene in the sandboxed Python worker.
     Run(commands::run::RunArgs),
-    /// Generate, list, show and sweep the benchmark's 440 scenarios.
+    /// Generate, list, show and sweep the benchmark's 440 scenarios; write one's planning problem.
     Scenarios(commands::scenarios::ScenariosArgs),
     /// Verify a plan against a PDDL domain and problem, like VAL.
     Verify(commands::verify::VerifyArgs),

@@ -57,6 +57,40 @@ fn bench(c: &mut Criterion) {
         b.iter(|| black_box(plan(&domain.actions, &u, &problem.init, &problem.goal, &cfg).unwrap()))
     });
     group.finish();
+
+    // A high-complexity scene of the benchmark over nesy's world domain, with and without
+    // preferred operators (the peer: one open list).
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let world = nesy_core::pddl::parse_domain(
+        &std::fs::read_to_string(root.join("assets/pddl/nesy-world.pddl")).unwrap(),
+    )
+    .unwrap();
+    let scene = nesy_core::pddl::parse_problem(
+        &std::fs::read_to_string(root.join("fixtures/planning/obst_high_01_s1.pddl")).unwrap(),
+        &world,
+    )
+    .unwrap();
+    let u = world.universe(&scene).unwrap();
+    let mut group = c.benchmark_group("plan_nesy_world_obst_high_01_s1");
+    group.sample_size(10);
+    for (name, preferred_operators) in [("gbfs_hff_preferred", true), ("gbfs_hff_single_queue", false)] {
+        let cfg = PlannerConfig {
+            preferred_operators,
+            time_limit: None,
+            max_expansions: 2_000_000,
+            ..PlannerConfig::default()
+        };
+        let found = plan(&world.actions, &u, &scene.init, &scene.goal, &cfg).unwrap();
+        eprintln!(
+            "obst_high_01_s1 ({name}): plan of {} steps, {} states expanded",
+            found.steps.len(),
+            found.expanded
+        );
+        group.bench_function(name, |b| {
+            b.iter(|| black_box(plan(&world.actions, &u, &scene.init, &scene.goal, &cfg).unwrap()))
+        });
+    }
+    group.finish();
 }
 
 criterion_group!(benches, bench);

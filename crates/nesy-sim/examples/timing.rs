@@ -59,6 +59,25 @@ fn main() {
         cpu * 1e3,
         sim_seconds / cpu
     );
+    // A whole high-complexity expert episode (all four subtasks, 15 loose objects).
+    let files = nesy_sim::tasks::scenario::generate_suite();
+    let high = nesy_sim::tasks::scenario::find(&files, "comb_high_00_s0")
+        .expect("scenario")
+        .generate(nesy_sim::tasks::scenario::Side::Source)
+        .expect("scene")
+        .scene;
+    let mut episode_seconds = 0.0;
+    let (wall, cpu) = time(3, || {
+        let episode = nesy_sim::tasks::experts::run_scene(&high).expect("episode");
+        episode_seconds = episode.sim_time;
+    });
+    println!(
+        "expert episode comb_high_00_s0 (source): {episode_seconds:.1} s simulated; wall {:.0} ms (RTF {:.0}x), cpu {:.0} ms (RTF {:.0}x)",
+        wall * 1e3,
+        episode_seconds / wall,
+        cpu * 1e3,
+        episode_seconds / cpu
+    );
     let composite = Sim::new(&scene("composite_all_finger")).expect("scene");
     let (wall, cpu) = time(10, || render_views(&composite, VIEW_SIZE, 1));
     println!(

@@ -108,6 +108,10 @@ impl VlmError {
         use nesy_core::adapt::ReasonerErrorKind as Kind;
         match self {
             Self::Config(_) | Self::InvalidRequest(_) => Kind::Request,
+            Self::Transport {
+                error: TransportError::Declined(_),
+                ..
+            } => Kind::Exhausted,
             Self::Transport { .. } => Kind::Transport,
             // Timeouts, rate limits and server errors are the endpoint's state; a quota that
             // ran out or a key that is refused will not fix itself, but they say nothing
@@ -277,6 +281,10 @@ pub enum TransportError {
     /// A cassette could not answer or record (never retried).
     #[error(transparent)]
     Cassette(#[from] CassetteError),
+    /// An offline responder has no answer to give (the reference responder's planner found
+    /// no patch within its limits): asking again would get the same non-answer.
+    #[error("{0}")]
+    Declined(String),
     /// Any other failure; `retryable` tells the retry layer whether to try again.
     #[error("{message}")]
     Failed {
@@ -293,7 +301,7 @@ impl TransportError {
     pub fn is_retryable(&self) -> bool {
         match self {
             Self::Timeout { .. } | Self::Connect(_) | Self::Body(_) => true,
-            Self::Cassette(_) => false,
+            Self::Cassette(_) | Self::Declined(_) => false,
             Self::Failed { retryable, .. } => *retryable,
         }
     }

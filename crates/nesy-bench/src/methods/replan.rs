@@ -6,12 +6,10 @@
 
 use futures::FutureExt as _;
 use futures::future::BoxFuture;
-use nesy_core::Atom;
 use nesy_core::formula::Formula;
 use nesy_core::planner::{Heuristic, PlannerConfig, Search};
 use nesy_core::symbol::Symbol;
 use nesy_pipeline::CodegenMode;
-use nesy_sim::api::Embodiment;
 use nesy_vlm::VlmClient;
 use nesy_vlm::oracle::{WorldDomain, plan_to_goal};
 
@@ -39,22 +37,17 @@ pub fn planner_config() -> PlannerConfig {
 }
 
 /// The target's goal as the planner takes it: every scene goal's atoms, and the end effector
-/// open with nothing held.
+/// open with nothing held ([`nesy_sim::scene::SceneSpec::symbolic_goal`]).
 pub fn target_goal(inputs: &UnitInputs) -> Formula {
-    let mut atoms: Vec<Formula> = inputs
-        .target
-        .scene
-        .goals
-        .iter()
-        .flat_map(|g| g.symbolic_goal())
-        .map(Formula::atom)
-        .collect();
-    let released = match inputs.target.scene.embodiment {
-        Embodiment::Finger => "GripperOpen",
-        Embodiment::Vacuum => "VacuumInactive",
-    };
-    atoms.push(Formula::atom(Atom::new(released, &[])));
-    Formula::And(atoms)
+    Formula::And(
+        inputs
+            .target
+            .scene
+            .symbolic_goal()
+            .into_iter()
+            .map(Formula::atom)
+            .collect(),
+    )
 }
 
 impl Method for Replan {

@@ -1051,6 +1051,30 @@ mod tests {
     }
 
     #[test]
+    fn failures_count_as_zero_and_unusable_demos_are_excluded() {
+        use crate::store::tests::record;
+        let records = [
+            record("a", "m", UnitStatus::Succeeded, 1.0),
+            record("b", "m", UnitStatus::MethodError, 0.0),
+            record("c", "m", UnitStatus::ExecutionFailed, 0.0),
+            record("d", "m", UnitStatus::DemoUnusable, 0.0),
+        ];
+        let refs: Vec<&UnitRecord> = records.iter().collect();
+        let t = Tables::build(&["m".to_owned()], &refs);
+        let all = &t.all["m"];
+        assert_eq!(all.n(), 3, "the unusable demo is not scored");
+        assert!((all.sr.mean_se().mean - 1.0 / 3.0).abs() < 1e-12);
+        assert_eq!(all.pd_success.n, 1, "PD by default over successful units only");
+        assert_eq!(all.pd_all.n, 3);
+        assert_eq!(all.statuses[&UnitStatus::DemoUnusable], 1);
+        assert_eq!(
+            all.statuses.values().sum::<usize>(),
+            4,
+            "every unit is accounted for"
+        );
+    }
+
+    #[test]
     fn se_uses_ddof_one() {
         let mut t = Tally::default();
         for v in [1.0, 0.0, 1.0, 0.0] {

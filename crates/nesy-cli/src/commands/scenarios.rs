@@ -45,6 +45,22 @@ pub enum ScenariosAction {
         #[arg(long)]
         suite: Option<PathBuf>,
     },
+    /// Write one side of a scenario as a PDDL problem over nesy's true domain
+    /// (`assets/pddl/nesy-world.pddl`): the objects, the observed initial state and the goal,
+    /// for `nesy verify` or any PDDL planner.
+    Pddl {
+        /// Scenario id, e.g. `comb_high_11_s1`.
+        id: String,
+        /// Which side.
+        #[arg(long, value_enum, default_value = "target")]
+        side: SideArg,
+        /// Write the problem here instead of printing it.
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+        /// Read the configurations from this directory instead of generating them.
+        #[arg(long)]
+        suite: Option<PathBuf>,
+    },
     /// Run the scripted expert on the source and target scene of every scenario and report
     /// the success rate, with nothing displaced and by the authors' latch, and each failure
     /// (exit 1 if any scene fails or ends with a displaced object).
@@ -141,6 +157,19 @@ pub fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
             let files = load_suite(suite.as_deref())?;
             let scenario = scenario::find(&files, &id)?;
             outln!("{}", scenario.generate(side.into())?.scene.to_json_pretty())?;
+            Ok(ExitCode::SUCCESS)
+        }
+        ScenariosAction::Pddl { id, side, out, suite } => {
+            let files = load_suite(suite.as_deref())?;
+            let scenario = scenario::find(&files, &id)?;
+            let text = pddl_problem(&scenario, side.into())?;
+            match out {
+                Some(path) => {
+                    std::fs::write(&path, &text).with_context(|| format!("writing {}", path.display()))?;
+                    eprintln!("{}", path.display());
+                }
+                None => out!("{text}")?,
+            }
             Ok(ExitCode::SUCCESS)
         }
         ScenariosAction::Sweep {
@@ -407,4 +436,32 @@ fn run_one(s: &Scenario, side: Side) -> SceneResult {
             wall_seconds: started.elapsed().as_secs_f64(),
         },
     }
+}
+
+/// One side of a scenario as a PDDL problem: the scene built and observed, its objects typed
+/// for the true domain, its goal with the end effector released.
+fn pddl_problem(scenario: &Scenario, side: Side) -> anyhow::Result<String> {
+    use nesy_core::formula::Formula;
+    let generated = scenario.generate(side)?;
+    let scene = generated.scene;
+    let sim = nesy_sim::Sim::new(&scene).with_context(|| format!("building {} ({side:?})", scenario.id))?;
+    let mut init = nesy_sim::perception::observer::observe(&sim);
+    // The domain's schemas are split by end effector on this atom.
+    init.insert(nesy_core::Atom::new(
+        match scene.embodiment {
+            nesy_sim::api::Embodiment::Finger => "FingerGripper",
+            nesy_sim::api::Embodiment::Vacuum => "VacuumSuction",
+        },
+        &[],
+    ));
+    let goal = Formula::And(scene.symbolic_goal().into_iter().map(Formula::atom).collect());
+    let world = nesy_vlm::oracle::WorldDomain::builtin()?;
+    let names = sim.names();
+    let name = format!(
+        "{}-{}",
+        scenario.id,
+        if side == Side::Source { "source" } else { "target" }
+    );
+    let problem = world.problem(&name, names.iter().map(String::as_str), init, goal);
+    Ok(problem.to_string())
 }

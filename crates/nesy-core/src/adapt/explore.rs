@@ -1,6 +1,6 @@
 //! Counterfactual identification (Eq. 6) and exploration with verified patches (Eq. 7–8).
 
-use super::reasoner::{Feedback, PatchRequest, Problem, Reasoner, ViolationKind};
+use super::reasoner::{Feedback, PatchRequest, Problem, Reasoner, ReasonerErrorKind, ViolationKind};
 use super::{
     Ablation, AdaptConfig, AdaptError, Outcome, Target, Trace, TraceEvent, Verdict, ViolationInfo, WorldModel,
 };
@@ -282,7 +282,21 @@ pub async fn explore<R: Reasoner>(
             unidentified(target)
         };
         last_violation = Some(violation);
-        let reply = reasoner.propose_patch(&request).await?;
+        let reply = match reasoner.propose_patch(&request).await {
+            Ok(reply) => reply,
+            // The reasoner has no proposal at all (an offline responder's planner found none):
+            // asking again would get the same answer, so the loop stops, unresolved.
+            Err(e) if e.kind == ReasonerErrorKind::Exhausted => {
+                trace.events.push(TraceEvent::GaveUp {
+                    iteration,
+                    message: e.message,
+                });
+                // The loop only asks while there is a violation, so the report is not valid
+                // here and `finish` returns the unresolved outcome.
+                return Ok(finish(procedure, report, best.1, last_violation, iteration));
+            }
+            Err(e) => return Err(e.into()),
+        };
         cached_request = Some((procedure_version, request));
         let this_iteration = iteration;
         iteration += 1;

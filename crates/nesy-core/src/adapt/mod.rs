@@ -229,6 +229,13 @@ pub enum TraceEvent {
         /// The executor's full report.
         report: Report,
     },
+    /// The reasoner had no proposal at all and said so; the loop stopped, unresolved.
+    GaveUp {
+        /// 0-based loop iteration.
+        iteration: usize,
+        /// What the reasoner said.
+        message: String,
+    },
     /// A patch proposal and its verdict.
     Proposal {
         /// 0-based loop iteration.

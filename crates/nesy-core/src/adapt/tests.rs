@@ -418,6 +418,35 @@ fn removal_then_goal_violation_then_budget() {
 }
 
 #[test]
+fn a_reasoner_without_any_proposal_stops_the_loop_unresolved() {
+    // No patch scripted: the reasoner says it has none (exhausted) at the first request.
+    let mut r = Scripted {
+        induction: good_inductions(),
+        ..Default::default()
+    };
+    let adaptation = pollster::block_on(run(&mut r, &demo(), &target(), &AdaptConfig::default())).unwrap();
+    assert_eq!(r.patch_requests.len(), 1, "the same question is not asked again");
+    let Outcome::Unresolved {
+        iterations,
+        last_violation,
+        ..
+    } = &adaptation.outcome
+    else {
+        panic!("{:?}", adaptation.outcome)
+    };
+    assert_eq!(*iterations, 0);
+    assert!(last_violation.is_some());
+    assert!(
+        adaptation.trace.events.iter().any(|e| matches!(
+            e,
+            TraceEvent::GaveUp { iteration: 0, message } if message.contains("script exhausted")
+        )),
+        "{:?}",
+        adaptation.trace.events
+    );
+}
+
+#[test]
 fn ablations_change_what_is_checked_and_shown() {
     // w/o Eq. 8: the wiggle patch (which does not fix the lid) is accepted.
     let wiggle = refinement(

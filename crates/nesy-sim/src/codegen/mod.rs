@@ -24,6 +24,7 @@ use serde::{Deserialize, Serialize};
 use crate::api::Embodiment;
 use crate::api::MAX_FINGER_DEPTH;
 use crate::scene::{TABLE_TOP, parts};
+use crate::world::FLOOR_AABB;
 
 /// What an action does, independent of the end effector.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -250,6 +251,25 @@ use crate::tasks::layout::{
 /// neighbour. Fruits are yaw-free, but `move_gripper_to` turns the fingers to the fruit's
 /// own yaw; with fruits in a row 8 cm apart that lands a finger on the next fruit and knocks
 /// it away before its own pick.
+/// How far inside the reachable table area ([`FLOOR_AABB`]) compiled targets are kept (m).
+const REACH_MARGIN: f64 = 0.005;
+
+/// The policy's clamp of computed targets into the reachable table area: the API refuses a
+/// target outside it, and a spot computed beside a container near the edge (a drop cell, a
+/// drawer spot, a lid waypoint) would otherwise end the run.
+fn within_reach_helper() -> String {
+    let [x0, y0, _] = FLOOR_AABB.min;
+    let [x1, y1, _] = FLOOR_AABB.max;
+    let m = REACH_MARGIN;
+    format!(
+        "\ndef within_reach(p):\n    # Targets stay inside the reachable table area, next to where they were computed.\n    return [min(max(p[0], {:.3}), {:.3}), min(max(p[1], {:.3}), {:.3}), p[2]]\n",
+        x0 + m,
+        x1 - m,
+        y0 + m,
+        y1 - m
+    )
+}
+
 const CLEAR_ANGLE_HELPER: &str = r#"
 def clear_angle(name):
     centre = get_obj_pos(name)
@@ -491,7 +511,7 @@ impl Emitter<'_> {
     /// straight across keep distinct x; a piece knocked off to one side is brought back in).
     fn over_at_own_x(&mut self, x: &str, bbox: &str, hang: &str) {
         self.line(&format!(
-            "move_to_position([min(max(get_obj_pos({x:?})[0], {bbox}[0][0] + 0.025), {bbox}[1][0] - 0.025), ({bbox}[0][1] + {bbox}[1][1]) / 2, {bbox}[1][2] + {hang} + {DROP_CLEARANCE}])"
+            "move_to_position(within_reach([min(max(get_obj_pos({x:?})[0], {bbox}[0][0] + 0.025), {bbox}[1][0] - 0.025), ({bbox}[0][1] + {bbox}[1][1]) / 2, {bbox}[1][2] + {hang} + {DROP_CLEARANCE}]))"
         ));
     }
 
@@ -500,7 +520,7 @@ impl Emitter<'_> {
         if surface == parts::FLOOR {
             self.line(&format!("spot = get_empty_floor_xy({x:?})"));
             self.line(&format!(
-                "move_to_position([spot[0], spot[1], {TABLE_TOP} + {hang} + {DROP_CLEARANCE}])"
+                "move_to_position(within_reach([spot[0], spot[1], {TABLE_TOP} + {hang} + {DROP_CLEARANCE}]))"
             ));
         } else {
             // The piece keeps its own x (the sweep pushes it straight across), but a piece no
@@ -562,6 +582,7 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
         embodiment
     );
     e.line("import math");
+    e.out.push_str(&within_reach_helper());
     if !vacuum && !e.fruits.is_empty() {
         e.out.push_str(CLEAR_ANGLE_HELPER);
     }
@@ -652,7 +673,7 @@ impl Emitter<'_> {
             // it), with the fingers turned clear of the neighbours.
             self.line(&format!("fb = get_obj_bbox({x:?})"));
             self.line(&format!(
-                "move_to_position([(fb[0][0] + fb[1][0]) / 2, (fb[0][1] + fb[1][1]) / 2, fb[1][2] - min(get_obj_size({x:?})[2] / 2, {MAX_FINGER_DEPTH})], angle=clear_angle({x:?}))"
+                "move_to_position(within_reach([(fb[0][0] + fb[1][0]) / 2, (fb[0][1] + fb[1][1]) / 2, fb[1][2] - min(get_obj_size({x:?})[2] / 2, {MAX_FINGER_DEPTH})]), angle=clear_angle({x:?}))"
             ));
         } else {
             let div = if pushes {
@@ -700,7 +721,7 @@ impl Emitter<'_> {
             self.over_at_own_x(x, "box", &hang);
         } else {
             self.line(&format!(
-                "move_to_position([(box[0][0] + box[1][0]) / 2 + {dx}, (box[0][1] + box[1][1]) / 2 + {dy}, box[1][2] + {hang} + {DROP_CLEARANCE}])"
+                "move_to_position(within_reach([(box[0][0] + box[1][0]) / 2 + {dx}, (box[0][1] + box[1][1]) / 2 + {dy}, box[1][2] + {hang} + {DROP_CLEARANCE}]))"
             ));
         }
     }
@@ -711,7 +732,7 @@ impl Emitter<'_> {
         let hang = self.hang(&format!("get_obj_size({x:?})[2]"));
         self.line(&format!("body = get_obj_bbox({:?})", parts::HINGE_BODY));
         self.line(&format!(
-            "move_to_position([(body[0][0] + body[1][0]) / 2, (body[0][1] + body[1][1]) / 2 + {dy}, body[1][2] + {hang} + {HINGE_DROP_CLEARANCE}])"
+            "move_to_position(within_reach([(body[0][0] + body[1][0]) / 2, (body[0][1] + body[1][1]) / 2 + {dy}, body[1][2] + {hang} + {HINGE_DROP_CLEARANCE}]))"
         ));
     }
 
@@ -725,7 +746,7 @@ impl Emitter<'_> {
         ));
         self.line(&format!("drawer = get_obj_pos({:?})", parts::BOTTOM_DRAWER));
         self.line(&format!(
-            "move_to_position([drawer[0] + {dx}, drawer[1] + {dy} * outward, drawer[2] + get_obj_size({:?})[2] + get_obj_size({x:?})[2] + {DRAWER_DROP_CLEARANCE}])",
+            "move_to_position(within_reach([drawer[0] + {dx}, drawer[1] + {dy} * outward, drawer[2] + get_obj_size({:?})[2] + get_obj_size({x:?})[2] + {DRAWER_DROP_CLEARANCE}]))",
             parts::BOTTOM_DRAWER
         ));
     }
@@ -789,7 +810,7 @@ impl Emitter<'_> {
             "    x = min(body[1][0] + reach * math.cos(a), {})",
             LID_SWING_MAX_X
         ));
-        self.line("    move_to_position([x, lid_y, body[1][2] + reach * math.sin(a)], lift_clearance=0.0, angle=math.pi / 2)");
+        self.line("    move_to_position(within_reach([x, lid_y, body[1][2] + reach * math.sin(a)]), lift_clearance=0.0, angle=math.pi / 2)");
     }
 }
 
@@ -906,7 +927,7 @@ mod tests {
             // 0.265) keeps its own x only inside the board's extent.
             assert!(
                 code.contains(
-                    "move_to_position([min(max(get_obj_pos(\"white_bishop\")[0], surface[0][0] + 0.025), surface[1][0] - 0.025), (surface[0][1] + surface[1][1]) / 2"
+                    "move_to_position(within_reach([min(max(get_obj_pos(\"white_bishop\")[0], surface[0][0] + 0.025), surface[1][0] - 0.025), (surface[0][1] + surface[1][1]) / 2"
                 ),
                 "{code}"
             );
@@ -1039,5 +1060,69 @@ mod tests {
         let err =
             compile_policy(&[Operator::new("Dance", vec![], vec![])], &o, Embodiment::Finger).unwrap_err();
         assert!(err.to_string().contains("action 1 (Dance)"), "{err}");
+    }
+
+    #[test]
+    fn every_computed_target_is_kept_within_reach() {
+        let o = names(&[
+            "floor",
+            "toy_box",
+            "red_cube",
+            "apple",
+            "green_cylinder",
+            "board",
+            "white_rook",
+            "left_chess_box",
+            "hinge_body",
+            "hinge_lid",
+            "hinge_handle",
+            "drawer_body",
+            "bottom_drawer",
+            "bottom_drawer_handle",
+        ]);
+        let procedure = ops(&[
+            "MoveToSurroundRedCube",
+            "GraspRedCube",
+            "CarryIntoRedCubeToyBox",
+            "ReleaseIntoRedCubeToyBox",
+            "MoveToSurroundWhiteRook",
+            "GraspWhiteRook",
+            "CarryOntoWhiteRookBoard",
+            "PutDownWhiteRookBoard",
+            "GraspHingeHandle",
+            "OpenHingeLid",
+            "ReleaseHingeHandle",
+            "MoveToSurroundApple",
+            "GraspApple",
+            "CarryOverHingeBodyApple",
+            "DropIntoHingeBodyApple",
+            "GraspBottomDrawerHandle",
+            "OpenBottomDrawer",
+            "ReleaseBottomDrawerHandle",
+            "MoveToSurroundGreenCylinder",
+            "GraspGreenCylinder",
+            "CarryOverBottomDrawerGreenCylinder",
+            "DropIntoBottomDrawerGreenCylinder",
+            "MoveToSurroundRedCube",
+            "GraspRedCube",
+            "PutDownRedCubeFloor",
+        ]);
+        for embodiment in [Embodiment::Finger, Embodiment::Vacuum] {
+            let code = compile_policy(&procedure, &o, embodiment).unwrap().code;
+            let calls = code.matches("move_to_position(").count();
+            assert!(calls >= 6, "{code}");
+            assert_eq!(
+                code.matches("move_to_position(within_reach(").count(),
+                calls,
+                "every target the compiler computes is clamped:\n{code}"
+            );
+            // The clamp is the API's own workspace, shrunk by the margin.
+            let bound = format!(
+                "min(max(p[0], {:.3}), {:.3})",
+                FLOOR_AABB.min[0] + REACH_MARGIN,
+                FLOOR_AABB.max[0] - REACH_MARGIN
+            );
+            assert!(code.contains(&bound), "{code}");
+        }
     }
 }

@@ -35,6 +35,10 @@ const MIN_SEGMENT: f64 = 0.25;
 pub const PARALLEL_MIN_DURATION: f64 = 0.8;
 /// Spacing of IK samples along a straight segment (m).
 const SAMPLE_SPACING: f64 = 0.015;
+/// Largest joint change (rad) between consecutive samples of a followed line.
+const MAX_SAMPLE_JUMP: f64 = 0.3;
+/// How many times finer a jumping sample step is tried before the line is given up.
+const MAX_SUBDIVISION: usize = 8;
 /// Control steps the world runs after a motion so objects come to rest.
 pub const MOTION_SETTLE_STEPS: u32 = 20;
 /// Gap (m) a transit keeps between the arm (and what it carries) and every loose object.
@@ -116,8 +120,8 @@ impl Sim {
 
     /// Plans joint paths through the tool waypoints (each reached by IK, nothing moved).
     /// Each segment is a straight tool-space line sampled every 1.5 cm and solved by IK
-    /// warm-started along the line; where that fails the segment falls back to straight
-    /// joint interpolation between its verified endpoints.
+    /// warm-started along the line; where that fails, the followed part of the line is kept
+    /// and the rest is a straight joint interpolation to an IK solution of the waypoint.
     ///
     /// The segment ending at waypoint `transit` (if any) is a free move between two
     /// clearance points. Its swept arm, fingers and carried object are checked against every
@@ -162,8 +166,9 @@ impl Sim {
         Ok(segments)
     }
 
-    /// One straight tool segment from `(q_from, pose_from)` to `wp`, or joint interpolation
-    /// to an IK solution of `wp` where the line cannot be followed.
+    /// One straight tool segment from `(q_from, pose_from)` to `wp`; where the line cannot be
+    /// followed to the end, its followed prefix then joint interpolation to an IK solution
+    /// of `wp`.
     fn segment(
         &self,
         q_from: &[f64],
@@ -182,24 +187,44 @@ impl Sim {
         let start = pose_from.translation.vector;
         let length = (wp.position - start).norm();
         let n = (length / SAMPLE_SPACING).ceil() as usize;
+        let at = |s: f64| ToolGoal {
+            position: start + (wp.position - start) * s,
+            rotation: pose_from.rotation.slerp(&wp.rotation, s),
+        };
         let mut path = vec![q_from.to_vec()];
-        let mut ok = true;
         let mut seed = q_from.to_vec();
-        for i in 1..n {
-            let s = i as f64 / n as f64;
-            let goal = ToolGoal {
-                position: start + (wp.position - start) * s,
-                rotation: pose_from.rotation.slerp(&wp.rotation, s),
-            };
-            match self.ik(&goal, &seed, &quick) {
-                Some(q) if max_delta(&q, &seed) < 0.3 => {
-                    seed = q.clone();
-                    path.push(q);
+        'line: for i in 1..n {
+            // A sample whose joints jump (near a wrist singularity the joints move fast for a
+            // short stretch of the line) is approached in finer steps before the line is
+            // given up.
+            let (s0, s1) = ((i - 1) as f64 / n as f64, i as f64 / n as f64);
+            let mut steps = 1;
+            loop {
+                let mut trial = seed.clone();
+                let mut samples = Vec::with_capacity(steps);
+                let mut jumped = false;
+                for k in 1..=steps {
+                    let s = s0 + (s1 - s0) * k as f64 / steps as f64;
+                    match self.ik(&at(s), &trial, &quick) {
+                        Some(q) if max_delta(&q, &trial) < MAX_SAMPLE_JUMP => {
+                            trial = q.clone();
+                            samples.push(q);
+                        }
+                        _ => {
+                            jumped = true;
+                            break;
+                        }
+                    }
                 }
-                _ => {
-                    ok = false;
+                if !jumped {
+                    seed = trial;
+                    path.extend(samples);
                     break;
                 }
+                if steps >= MAX_SUBDIVISION {
+                    break 'line;
+                }
+                steps *= 2;
             }
         }
         // The waypoint itself, seeded from the end of the line so the branch carries on.
@@ -210,9 +235,11 @@ impl Sim {
                 target: [wp.position.x, wp.position.y, wp.position.z],
                 pointing_to: pointing,
             })?;
-        if !ok || max_delta(&seed, &q_to) > 0.3 {
-            path = vec![q_from.to_vec()];
-        }
+        // Where the line cannot be followed to the end, the part that could be followed is
+        // kept and only the rest is joint interpolation (the last step of the path): starting
+        // the interpolation at the segment's start swung the hand through what it had just
+        // let go of (a pushed chess piece, dragged back out of its box by the dipping
+        // fingers).
         path.push(q_to);
         Ok(path)
     }
@@ -381,26 +408,46 @@ impl Sim {
 
     /// The approach distance for a move to `goal` along `dir` (unit, the pointing): the
     /// longest of `clearance` and its fractions in [`APPROACH_FRACTIONS`] at which the arm
-    /// reaches the approach point `goal − dir·c` without touching a loose object (the
-    /// objects touching the arm now are not counted). An object next to the target (a fruit
-    /// on a lid beside a drawer handle) can leave no room for the full distance. `clearance`
-    /// when none is clear.
+    /// reaches the approach point `goal − dir·c`, and moves straight from it to the goal,
+    /// without touching an object or a piece of furniture (those touching the arm now or at
+    /// the goal are not counted). An object next to the target (a fruit on a lid beside a
+    /// drawer handle, the hinge box beside the cabinet) can leave no room for the full
+    /// distance. `clearance` when none is clear.
     pub(crate) fn clear_approach(&self, goal: &ToolGoal, dir: nalgebra::Vector3<f64>, clearance: f64) -> f64 {
+        let options = IkOptions::default();
+        let goal_q = self.ik(goal, &self.q, &options);
+        // Loose objects and furniture alike: the arm passes through fixed walls without
+        // contact forces, and a handle approach started inside the hinge box beside the
+        // cabinet swept the fruit in it out. What the arm touches now or at the goal (the
+        // cabinet whose handle it takes, the board under a piece) cannot be kept clear.
         let obstacles: Vec<Obstacle<'_>> = self
-            .transit_obstacles()
+            .unheld_obstacles(|_| true)
             .into_iter()
             .filter(|o| self.configuration_is_clear(&self.q, std::slice::from_ref(o)))
+            .filter(|o| {
+                goal_q
+                    .as_ref()
+                    .is_none_or(|q| self.configuration_is_clear(q, std::slice::from_ref(o)))
+            })
             .collect();
         if obstacles.is_empty() {
             return clearance;
         }
-        let quick = IkOptions::default();
         for fraction in APPROACH_FRACTIONS {
             let approach = ToolGoal {
                 position: goal.position - dir * clearance * fraction,
                 rotation: goal.rotation,
             };
-            let q = self.ik(&approach, &self.q, &quick);
+            let q = self.ik(&approach, &self.q, &options);
+            // The arm at the approach point and along the straight approach to the goal.
+            let clear = q.as_ref().is_some_and(|q| {
+                let from =
+                    Iso::from_parts(nalgebra::Translation3::from(approach.position), approach.rotation);
+                self.configuration_is_clear(q, &obstacles)
+                    && self
+                        .segment(q, &from, goal, Direction::Down)
+                        .is_ok_and(|path| self.path_is_clear(&path, &obstacles))
+            });
             if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
                 let hits: Vec<&str> = obstacles
                     .iter()
@@ -410,11 +457,12 @@ impl Sim {
                     })
                     .map(|o| self.parts[o.part].name.as_str())
                     .collect();
-                eprintln!("approach {fraction}: ik {} hits {hits:?}", q.is_some());
+                eprintln!(
+                    "approach {fraction}: ik {} clear {clear} hits at the approach point {hits:?}",
+                    q.is_some()
+                );
             }
-            if let Some(q) = q
-                && self.configuration_is_clear(&q, &obstacles)
-            {
+            if clear {
                 return clearance * fraction;
             }
         }

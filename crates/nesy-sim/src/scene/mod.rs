@@ -323,6 +323,21 @@ impl SceneSpec {
         SceneSpec::from_json_str(&text, &path.display().to_string())
     }
 
+    /// The scene's goal as ground atoms in the paper's predicates: every subtask's atoms
+    /// ([`SubtaskGoal::symbolic_goal`]) and the end effector released at the end
+    /// (`GripperOpen` or `VacuumInactive`), as the goal checks require.
+    pub fn symbolic_goal(&self) -> Vec<nesy_core::Atom> {
+        let released = match self.embodiment {
+            Embodiment::Finger => "GripperOpen",
+            Embodiment::Vacuum => "VacuumInactive",
+        };
+        self.goals
+            .iter()
+            .flat_map(SubtaskGoal::symbolic_goal)
+            .chain([nesy_core::Atom::new(released, &[])])
+            .collect()
+    }
+
     /// Pretty JSON.
     pub fn to_json_pretty(&self) -> String {
         serde_json::to_string_pretty(self).unwrap_or_default()

@@ -1,7 +1,7 @@
 //! [`RobotApi`] for [`Sim`]: the paper's perception and action calls with `docs/benchmark.md` §4's
 //! defaults, embodiment and feasibility rules, the action budget and the trace.
 
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 
 use super::floor::empty_floor_xy;
 use super::geometry::{Aabb, array_to_na, yaw_of};
@@ -19,10 +19,13 @@ use crate::scene::{ObjectKind, TABLE_TOP};
 const PUSH_BACK_OFF: f64 = 0.015;
 /// Control steps for the fingers to open or close (0.04 m at 0.2 m/s takes 20).
 const GRIPPER_STEPS: u32 = 25;
-/// Distances (m) from the object's centre, along the closing axis, that the open fingers
-/// pass through on the way down (the pads sit at the [`FINGER_OPEN`] travel, about 1 cm
-/// thick).
-const FINGER_SWEEP: [f64; 3] = [FINGER_OPEN - 0.01, FINGER_OPEN, FINGER_OPEN + 0.012];
+/// Distances (m) from a finger's travel, along the closing axis, that the pad passes through
+/// on the way down (the pad is about 1 cm thick, and its inner face sits at the travel).
+const FINGER_SWEEP: [f64; 3] = [-0.01, 0.0, 0.012];
+/// Gap (m) per side between an object and the pads the fingers open to on the way down to it.
+/// A hand opened to its full 8 cm for a 3 cm cube landed a pad on a fruit 6 cm away; a real
+/// gripper is commanded to the width it needs.
+const PRESHAPE_CLEARANCE: f64 = 0.012;
 /// Half the width (m) of a finger pad across the closing axis.
 const FINGER_HALF_WIDTH: f64 = 0.01;
 /// Height (m) of the palm's underside above the tool point.
@@ -30,6 +33,11 @@ const PALM_ABOVE_TOOL: f64 = 0.034;
 /// Half the palm's length (m) along the closing axis, and half its width across it.
 const PALM_HALF_LENGTH: f64 = 0.1;
 const PALM_HALF_WIDTH: f64 = 0.025;
+/// Gap (m) the palm keeps above the neighbours under it when the hand comes down.
+const PALM_CLEARANCE: f64 = 0.004;
+/// How far (m) below an object's top the pads' centre reaches at least, however high the
+/// palm must stay.
+const MIN_PAD_OVERLAP: f64 = 0.006;
 /// Gap (m) a finger wants beside a neighbour's box.
 const FINGER_MARGIN: f64 = 0.005;
 /// A neighbour counts as beside the object when its top is this much (m) above the object's
@@ -317,7 +325,7 @@ impl Sim {
         let axis = dir.iter().position(|v| v.abs() > 0.5).unwrap_or(2);
         let half = aabb.size()[axis] / 2.0;
         let centre = aabb.centre();
-        let target: [f64; 3] = std::array::from_fn(|i| centre[i] + (depth - half) * dir[i]);
+        let mut target: [f64; 3] = std::array::from_fn(|i| centre[i] + (depth - half) * dir[i]);
         let yaw = match self.scene.embodiment {
             Embodiment::Vacuum => 0.0,
             Embodiment::Finger => {
@@ -334,6 +342,27 @@ impl Sim {
                 self.uncrowded_spin(part, pointing, object_yaw + p.grasp_yaw, step, target[2])
             }
         };
+        // A hand coming down stops where its palm would meet a taller neighbour, as a real
+        // one stops on contact (its palm came down on a fruit beside a cube and flung it off
+        // the table), as long as the pads still reach a little below the object's top.
+        if self.scene.embodiment == Embodiment::Finger && pointing == Direction::Down && !is_handle {
+            let rotation = Sim::pointing(pointing, yaw);
+            if let Some(top) = self.palm_ceiling(part, &rotation) {
+                let palm_clear = top + PALM_CLEARANCE - PALM_ABOVE_TOOL;
+                target[2] = target[2].max(palm_clear.min(aabb.max[2] - MIN_PAD_OVERLAP));
+            }
+        }
+        // The empty open hand narrows to the object on its way (the fingers move while the arm
+        // does); `open_gripper` opens it fully again.
+        if self.scene.embodiment == Embodiment::Finger
+            && !is_handle
+            && !self.closed
+            && self.held.is_none()
+            && self.handle_grasp.is_none()
+        {
+            let rotation = Sim::pointing(pointing, yaw);
+            self.gripper_target = self.preshape_travel(part, &rotation);
+        }
         self.do_move_to_position(target, pointing, crate::api::DEFAULT_LIFT_CLEARANCE, yaw)
     }
 
@@ -366,6 +395,7 @@ impl Sim {
             let rotation = Sim::pointing(pointing, spin);
             let along = rotation * Vector3::y();
             let across = rotation * Vector3::x();
+            let travel = self.preshape_travel(part, &rotation);
             // The tallest neighbour that `reaches` the hand's sample point at `s` along the
             // closing axis and `t` across it.
             let touched = |s: f64, t: f64, reaches: &dyn Fn(&Aabb) -> bool| {
@@ -387,7 +417,7 @@ impl Sim {
             let under_palm = |n: &Aabb| n.max[2] > palm_z;
             let fingers = FINGER_SWEEP
                 .iter()
-                .flat_map(|&s| [s, -s])
+                .flat_map(|&d| [travel + d, -(travel + d)])
                 .flat_map(|s| [-FINGER_HALF_WIDTH, 0.0, FINGER_HALF_WIDTH].map(|t| (s, t)))
                 .map(|(s, t)| touched(s, t, &beside))
                 .fold(0.0, f64::max);
@@ -410,6 +440,35 @@ impl Sim {
             .iter()
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map_or(nearest, |&(spin, _)| spin)
+    }
+
+    /// The highest top of the loose objects (other than `part` and a held one) under the
+    /// palm of a hand above `part` with tool orientation `rotation`, if any.
+    fn palm_ceiling(&self, part: usize, rotation: &UnitQuaternion<f64>) -> Option<f64> {
+        let centre = self.part_aabb(part).centre();
+        let along = rotation * Vector3::y();
+        let across = rotation * Vector3::x();
+        let held = self.held.map(|h| h.part);
+        let samples: Vec<[f64; 2]> = (-4..=4)
+            .map(|k| PALM_HALF_LENGTH * f64::from(k) / 4.0)
+            .flat_map(|s| [-PALM_HALF_WIDTH, 0.0, PALM_HALF_WIDTH].map(|t| (s, t)))
+            .map(|(s, t)| {
+                [
+                    centre[0] + along.x * s + across.x * t,
+                    centre[1] + along.y * s + across.y * t,
+                ]
+            })
+            .collect();
+        (0..self.parts.len())
+            .filter(|&i| i != part && Some(i) != held && self.parts[i].role == PartRole::Loose)
+            .map(|i| self.part_aabb(i))
+            .filter(|n| {
+                samples.iter().any(|at| {
+                    (0..2).all(|k| at[k] > n.min[k] - FINGER_MARGIN && at[k] < n.max[k] + FINGER_MARGIN)
+                })
+            })
+            .map(|n| n.max[2])
+            .reduce(f64::max)
     }
 
     fn do_move_parallel(&mut self, dir: Direction, offset: f64) -> Result<(), ApiError> {
@@ -447,14 +506,30 @@ impl Sim {
 
     /// Width of a part across the fingers (along the hand's y axis).
     fn width_across_fingers(&self, part: usize) -> f64 {
-        let hand_inv = self.carrier_pose().inverse();
+        self.width_along(part, &self.carrier_pose().rotation)
+    }
+
+    /// Width of a part along the y axis of a frame turned by `rotation` (the closing axis of
+    /// a hand with that orientation).
+    fn width_along(&self, part: usize, rotation: &rapier3d::prelude::Rotation) -> f64 {
+        let frame_inv =
+            rapier3d::prelude::Pose::from_parts(rapier3d::prelude::Vector::ZERO, *rotation).inverse();
         let aabb = self.parts[part].colliders.iter().fold(Aabb::EMPTY, |acc, &c| {
             let collider = &self.world.colliders[c];
             acc.union(&Aabb::from_parry(
-                &collider.shape().compute_aabb(&(hand_inv * *collider.position())),
+                &collider.shape().compute_aabb(&(frame_inv * *collider.position())),
             ))
         });
         aabb.size()[1]
+    }
+
+    /// The finger travel the open hand takes on its way down to `part` with tool orientation
+    /// `rotation`: the part's half-width across the pads plus [`PRESHAPE_CLEARANCE`], at most
+    /// fully open.
+    fn preshape_travel(&self, part: usize, rotation: &UnitQuaternion<f64>) -> f64 {
+        let r = rotation.coords;
+        let rotation = rapier3d::prelude::Rotation::from_xyzw(r.x as f32, r.y as f32, r.z as f32, r.w as f32);
+        (self.width_along(part, &rotation) / 2.0 + PRESHAPE_CLEARANCE).min(FINGER_OPEN)
     }
 
     fn close_fingers(&mut self) {

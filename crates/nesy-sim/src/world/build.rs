@@ -19,6 +19,10 @@ use crate::scene::{Joint, ObjectSpec, SceneError, SceneSpec, TABLE_TOP};
 /// Continuous collision detection on every dynamic object: a cube dropped into a box or a
 /// piece pushed at the end of a fast segment must not tunnel through a 3–4 mm wall.
 const DYNAMIC_CCD: bool = true;
+/// Rapier's contact prediction distance (m, with the default length unit of 1 m). Below
+/// about 5 mm a fruit resting on its rounded edge rocked without end: the contact vanished
+/// at each swing's far end and came back with energy, so the fruit never came to rest.
+const PREDICTION_DISTANCE: f32 = 0.005;
 /// Deepest overlap (m) between two objects, or an object and the table, that a scene may
 /// start with.
 const MAX_START_OVERLAP: f64 = 0.0015;
@@ -66,6 +70,17 @@ impl WorldBuilder {
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::new(0.0, 0.0, -9.81);
         world.integration_parameters.dt = (CONTROL_DT / SUBSTEPS as f64) as f32;
+        // Rapier's contact recycling keeps a pair's contact points while the pair has moved
+        // less than 5 cm since its last full update. Against the arm that is wrong by whole
+        // objects: a finger pad that had pushed a rook kept its contact through the 15 mm
+        // back-off and lifted the rook by it as the hand rose. Every pair is updated every
+        // step instead.
+        world.integration_parameters.contact_recycling = false;
+        // Contacts are predicted 5 mm ahead instead of Rapier's 2 cm (tuned for metre-sized
+        // bodies): with every pair updated every step, a 2 cm margin made the narrow phase
+        // the largest cost among these centimetre-sized objects. Dropped objects move less
+        // than 3 mm per substep and dynamic bodies use CCD, so nothing tunnels.
+        world.integration_parameters.normalized_prediction_distance = PREDICTION_DISTANCE;
         WorldBuilder {
             world,
             looks: Vec::new(),
@@ -187,7 +202,7 @@ impl WorldBuilder {
                     .unwrap_or([0.0; 2]);
                 let builder = ColliderBuilder::new(shape.shape.clone())
                     .position(shape.local)
-                    .density(objects::DENSITY)
+                    .density(shape.density)
                     .friction(friction)
                     .friction_combine_rule(rule)
                     .sensor(!build.solid);

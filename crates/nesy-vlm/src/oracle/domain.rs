@@ -6,8 +6,9 @@ use std::sync::OnceLock;
 use nesy_core::ParseError;
 use nesy_core::formula::{AtomPattern, Effect, Formula};
 use nesy_core::operator::Operator;
-use nesy_core::pddl::{Domain, parse_domain};
+use nesy_core::pddl::{Domain, Problem, parse_domain};
 use nesy_core::predicates::builtin_predicates;
+use nesy_core::state::State;
 use nesy_core::symbol::Symbol;
 use nesy_core::types::{TypeError, Universe};
 
@@ -124,6 +125,36 @@ impl WorldDomain {
             let _ = u.add(Symbol::new(o), Symbol::new(ty));
         }
         u
+    }
+}
+
+impl WorldDomain {
+    /// A PDDL problem over this domain: the scene's objects (those the domain declares as
+    /// constants left out, the robot's own entry too) typed by [`object_type`], an initial
+    /// state and a goal. Written out, it is a problem file any PDDL planner can take together
+    /// with [`NESY_WORLD_PDDL`].
+    pub fn problem<'a>(
+        &self,
+        name: &str,
+        objects: impl IntoIterator<Item = &'a str>,
+        init: State,
+        goal: Formula,
+    ) -> Problem {
+        let mut seen = std::collections::BTreeSet::new();
+        let objects = objects
+            .into_iter()
+            .filter(|o| *o != "gripper" && *o != "vacuum_gripper")
+            .filter(|o| !self.domain.constants.iter().any(|(c, _)| c.as_str() == *o))
+            .filter(|o| seen.insert(*o))
+            .map(|o| (Symbol::new(o), Symbol::new(object_type(o))))
+            .collect();
+        Problem {
+            name: Symbol::new(name),
+            domain: self.domain.name,
+            objects,
+            init,
+            goal,
+        }
     }
 }
 

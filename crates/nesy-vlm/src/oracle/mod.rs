@@ -165,11 +165,10 @@ impl OracleTransport {
                 let mut proposed = match propose(self.world, &ctx, &self.planner) {
                     Ok(p) => p,
                     Err(e) => {
-                        // An honest non-answer: the loop records it as unparsable feedback.
+                        // An honest non-answer, said in a typed way: the same request would get
+                        // the same answer, so the loop stops instead of asking again.
                         self.bump(|s| s.patches += 1);
-                        return Ok(format!(
-                            "* Refinement rationale:\n- The reference responder found no patch: {e}\n"
-                        ));
+                        return Err(TransportError::Declined(format!("oracle: no patch: {e}")));
                     }
                 };
                 let corrupted = rng.chance(self.noise.bad_patch);

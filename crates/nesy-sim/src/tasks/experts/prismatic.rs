@@ -24,9 +24,44 @@ fn clear_handle_approach<R: RobotApi + ?Sized>(
     handle: &str,
     pointing: Direction,
 ) -> Result<(), ExpertError> {
+    let corridor = approach_corridor(hand, handle, pointing)?;
+    let names = hand.robot.get_obj_names();
+    // An object inside a container lies below its walls, and the approach is chosen so the
+    // arm does not pass through a container ([`furniture_in_the_way`]): it stays (a fruit in
+    // the closed hinge box was taken back out to clear the way).
+    let mut containers = Vec::new();
+    for name in &names {
+        if CONTAINERS.contains(&name.as_str()) {
+            containers.push(hand.bbox(name)?);
+        }
+    }
+    for name in names {
+        if !hand.is_loose(&name) {
+            continue;
+        }
+        let b = hand.bbox(&name)?;
+        let inside = (0..3).all(|i| b[0][i] < corridor[1][i] && corridor[0][i] < b[1][i]);
+        let shielded = containers.iter().any(|c| {
+            let m = centre(&b);
+            (0..2).all(|i| c[0][i] < m[i] && m[i] < c[1][i]) && b[1][2] <= c[1][2] + 0.005
+        });
+        if inside && !shielded {
+            hand.move_aside(&name)?;
+        }
+    }
+    Ok(())
+}
+
+/// The space the arm passes through to grasp `handle` pointing along `pointing` (see
+/// [`clear_handle_approach`]).
+fn approach_corridor<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    handle: &str,
+    pointing: Direction,
+) -> Result<Bbox, ExpertError> {
     let h = hand.bbox(handle)?;
     let c = centre(&h);
-    let corridor: Bbox = match pointing {
+    Ok(match pointing {
         Direction::Down => [
             [c[0] - WRIST_CLEARANCE, c[1] - WRIST_CLEARANCE, h[1][2] + 0.02],
             [c[0] + WRIST_CLEARANCE, c[1] + WRIST_CLEARANCE, h[1][2] + 0.4],
@@ -38,19 +73,38 @@ fn clear_handle_approach<R: RobotApi + ?Sized>(
                 [c[0] + WRIST_CLEARANCE, c[1].max(c[1] + back), c[2] + 0.3],
             ]
         }
-    };
+    })
+}
+
+/// Whether grasping `handle` pointing along `pointing` would put the arm through a container
+/// standing in the way (the hinge box beside the cabinet's front: the suction tool's wrist,
+/// 21.5 cm behind its tip, would be inside it at the grasp).
+fn furniture_in_the_way<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    handle: &str,
+    pointing: Direction,
+) -> Result<bool, ExpertError> {
+    let corridor = approach_corridor(hand, handle, pointing)?;
     for name in hand.robot.get_obj_names() {
-        if !hand.is_loose(&name) {
-            continue;
-        }
-        let b = hand.bbox(&name)?;
-        let inside = (0..3).all(|i| b[0][i] < corridor[1][i] && corridor[0][i] < b[1][i]);
-        if inside {
-            hand.move_aside(&name)?;
+        if CONTAINERS.contains(&name.as_str()) && !name.contains("drawer") {
+            let b = hand.bbox(&name)?;
+            if (0..3).all(|i| b[0][i] < corridor[1][i] && corridor[0][i] < b[1][i]) {
+                return Ok(true);
+            }
         }
     }
-    Ok(())
+    Ok(false)
 }
+
+/// The containers whose walls shield what lies inside them from a passing arm.
+const CONTAINERS: [&str; 6] = [
+    parts::HINGE_BODY,
+    parts::TOY_BOX,
+    parts::TOP_DRAWER,
+    parts::BOTTOM_DRAWER,
+    parts::LEFT_CHESS_BOX,
+    parts::RIGHT_CHESS_BOX,
+];
 
 /// Cylinders into the bottom drawer: an open top drawer (which covers the bottom handle) is
 /// closed, a closed bottom drawer opened, the cylinders dropped in, the drawer closed.
@@ -85,16 +139,27 @@ pub(super) fn run<R: RobotApi + ?Sized>(
     // The open top drawer is closed with the tool pointing at the cabinet: from above, the
     // finger hand, wide along the bar, swept cylinders off the cabinet top on the way in.
     if is_open(&hand.bbox(parts::TOP_DRAWER)?) {
-        clear_handle_approach(hand, parts::TOP_DRAWER_HANDLE, sideways)?;
-        hand.grab_handle_pointing(parts::TOP_DRAWER_HANDLE, sideways)?;
-        hand.slide_pointing(close_dir, travel, sideways)?;
+        let pointing = if furniture_in_the_way(hand, parts::TOP_DRAWER_HANDLE, sideways)? {
+            Direction::Down
+        } else {
+            sideways
+        };
+        clear_handle_approach(hand, parts::TOP_DRAWER_HANDLE, pointing)?;
+        hand.grab_handle_pointing(parts::TOP_DRAWER_HANDLE, pointing)?;
+        hand.slide_pointing(close_dir, travel, pointing)?;
         hand.let_go_handle()?;
     }
     // The bottom handle: the fingers from above, as in the authors' demo; the suction tool
     // pointing at the cabinet, because from above its wrist (6 cm above the tip and wider
     // than the 2.5 cm between the handle and the cabinet face) pushed cylinders standing at
     // the cabinet's front edge down through its top.
-    let pointing = if hand.vacuum { sideways } else { Direction::Down };
+    // Where a container stands in the sideways corridor, the suction tool comes from above
+    // too, after the corridor above the handle is cleared.
+    let pointing = if hand.vacuum && !furniture_in_the_way(hand, parts::BOTTOM_DRAWER_HANDLE, sideways)? {
+        sideways
+    } else {
+        Direction::Down
+    };
     if !is_open(&hand.bbox(drawer)?) {
         clear_handle_approach(hand, parts::BOTTOM_DRAWER_HANDLE, pointing)?;
         hand.grab_handle_pointing(parts::BOTTOM_DRAWER_HANDLE, pointing)?;

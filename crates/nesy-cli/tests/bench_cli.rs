@@ -1,0 +1,217 @@
+//! `nesy bench` end to end through the binary, on a handful of low-complexity scenarios: a run
+//! killed with SIGKILL resumes and redoes only its unfinished units, four shards merge into
+//! the same tables as the unsharded run, a missing shard is named, and a changed
+//! configuration is refused in the same run directory.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const SCENARIOS: &str = "obst_low_00_s0,affo_low_01_s1,grip_low_02_s0";
+const METHODS: &str = "nesycr,imitation,replan";
+
+fn run_args(run: &Path, demos: &Path, extra: &[&str]) -> Vec<String> {
+    let mut args: Vec<String> = [
+        "bench",
+        "run",
+        &run.display().to_string(),
+        "--methods",
+        METHODS,
+        "--scenarios",
+        SCENARIOS,
+        "--vlm",
+        "oracle",
+        "--demos",
+        &demos.display().to_string(),
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args
+}
+
+fn lines(path: &Path) -> usize {
+    std::fs::read_dir(path.join("results"))
+        .map(|d| {
+            d.flatten()
+                .map(|e| {
+                    std::fs::read_to_string(e.path())
+                        .unwrap_or_default()
+                        .lines()
+                        .filter(|l| !l.trim().is_empty())
+                        .count()
+                })
+                .sum()
+        })
+        .unwrap_or(0)
+}
+
+fn table(run: &Path, name: &str) -> String {
+    std::fs::read_to_string(run.join("tables").join(name))
+        .unwrap_or_else(|e| panic!("{}: {e}", run.display()))
+}
+
+#[test]
+fn killed_runs_resume_shards_merge_and_configurations_do_not_mix() {
+    let scratch = common::scratch();
+    let demos = scratch.path().join("demos");
+
+    // The reference: one uninterrupted run (it records the demos for everyone).
+    let whole = scratch.path().join("whole");
+    let out = common::nesy(&run_args(&whole, &demos, &[]));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(lines(&whole), 9, "one record per unit");
+    let reference = table(&whole, "table1.csv");
+    let report = std::fs::read_to_string(whole.join("report.md")).unwrap();
+    assert!(report.contains("OFFLINE"), "{report}");
+    for plot in ["sr_gc_pd.png", "domain_gap.png", "complexity.png"] {
+        let bytes = std::fs::read(whole.join("plots").join(plot)).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG", "{plot}");
+    }
+
+    // Running it again does nothing: every unit is final.
+    let again = common::nesy(&run_args(&whole, &demos, &["--json"]));
+    assert!(again.status.success());
+    assert_eq!(lines(&whole), 9, "nothing is redone");
+
+    // Killed with SIGKILL after its first units: the rerun does only the rest.
+    let killed = scratch.path().join("killed");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_nesy"))
+        .args(run_args(&killed, &demos, &["--jobs", "1"]))
+        .current_dir(common::workspace())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(300);
+    while lines(&killed) < 2 && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.kill().unwrap();
+    let _ = child.wait();
+    let before = lines(&killed);
+    assert!((2..9).contains(&before), "killed after {before} record(s)");
+    let resumed = common::nesy(&run_args(&killed, &demos, &["--json"]));
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&resumed.stdout);
+    let summary: serde_json::Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
+    assert_eq!(summary["summary"]["skipped"], before as u64, "{summary}");
+    assert_eq!(summary["summary"]["ran"], (9 - before) as u64, "{summary}");
+    assert_eq!(lines(&killed), 9);
+    assert_eq!(
+        table(&killed, "table1.csv"),
+        reference,
+        "a resumed run gives the same tables"
+    );
+
+    // Four shards, then a merge: the same tables, byte for byte.
+    let sharded = scratch.path().join("sharded");
+    for i in 0..4 {
+        let shard = format!("{i}/4");
+        let out = common::nesy(&run_args(&sharded, &demos, &["--shard", &shard]));
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        if i == 2 {
+            // Three of four shards: the merge names what is missing.
+            let merge = common::nesy(&["bench".into(), "merge".into(), sharded.display().to_string()]);
+            assert_eq!(merge.status.code(), Some(1));
+            let err = String::from_utf8_lossy(&merge.stderr);
+            assert!(err.contains("missing: "), "{err}");
+            assert!(err.contains("no final record"), "{err}");
+        }
+    }
+    let merge = common::nesy(&["bench".into(), "merge".into(), sharded.display().to_string()]);
+    assert!(
+        merge.status.success(),
+        "{}",
+        String::from_utf8_lossy(&merge.stderr)
+    );
+    assert_eq!(
+        table(&sharded, "table1.csv"),
+        reference,
+        "merged shards give the unsharded tables"
+    );
+    assert_eq!(table(&sharded, "status.csv"), table(&whole, "status.csv"));
+
+    // Another configuration in the same directory is refused, naming what differs.
+    let other = common::nesy(&[
+        "bench".into(),
+        "run".into(),
+        whole.display().to_string(),
+        "--methods".into(),
+        "nesycr+verification=off".into(),
+        "--scenarios".into(),
+        SCENARIOS.into(),
+        "--vlm".into(),
+        "oracle".into(),
+        "--demos".into(),
+        demos.display().to_string(),
+    ]);
+    assert_eq!(other.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(
+        err.contains("another configuration") && err.contains("variants"),
+        "{err}"
+    );
+
+    // Status summarises a run.
+    let status = common::nesy(&["bench".into(), "status".into(), whole.display().to_string()]);
+    assert!(String::from_utf8_lossy(&status.stdout).contains("9 of 9 unit(s) final"));
+}
+
+#[test]
+fn methods_plan_and_bad_input() {
+    let methods = common::nesy(&["bench".into(), "methods".into(), "--json".into()]);
+    let list: serde_json::Value = serde_json::from_slice(&methods.stdout).unwrap();
+    let names: Vec<&str> = list
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["name"].as_str().unwrap())
+        .collect();
+    for m in [
+        "nesycr",
+        "nesycr-released",
+        "code-as-policies",
+        "imitation",
+        "replan",
+    ] {
+        assert!(names.contains(&m), "{names:?}");
+    }
+    let bad = common::nesy(&[
+        "bench".into(),
+        "plan".into(),
+        "--methods".into(),
+        "nesycr+verification=maybe".into(),
+        "--vlm".into(),
+        "oracle".into(),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("expected on or off"));
+    let typo = common::nesy(&[
+        "bench".into(),
+        "plan".into(),
+        "--scenarios".into(),
+        "obst_lwo".into(),
+        "--vlm".into(),
+        "oracle".into(),
+    ]);
+    assert_eq!(typo.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&typo.stderr).contains("no scenario id starts with"));
+    let offline = common::nesy(&[
+        "bench".into(),
+        "plan".into(),
+        "--methods".into(),
+        "code-as-policies".into(),
+        "--vlm".into(),
+        "oracle".into(),
+    ]);
+    assert_eq!(offline.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&offline.stderr).contains("cannot answer them honestly"));
+}
