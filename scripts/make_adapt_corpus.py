@@ -3,9 +3,9 @@
 
 usage: scripts/make_adapt_corpus.py RUN_DIR... [--out tests/adapt_corpus]
 
-RUN_DIR is a scenario directory as scripts/adapt_oracle_runs.py leaves it: `demo/demo.mcap`
-and `adapt/{summary.json,world_model.json,adaptation.json,target_scene.json}` (summary.json
-may also sit in RUN_DIR itself). Each corpus file holds what nesy-core's `adapt::run` received
+RUN_DIR is a scenario directory holding `demo/demo.mcap` (as `nesy record --out RUN_DIR/demo`
+writes it) and `adapt/{summary.json,world_model.json,adaptation.json,target_scene.json}` (as
+`nesy adapt --out RUN_DIR/adapt` writes them; summary.json may also sit in RUN_DIR itself). Each corpus file holds what nesy-core's `adapt::run` received
 (demonstrated states, target state, objects, instruction, tier, budget) and every reply the
 reasoner gave, in call order, so a scripted reasoner can replay the run without the model.
 Standard library only.
