@@ -33,6 +33,24 @@ impl Embodiment {
             Embodiment::Vacuum => "vacuum suction tool",
         }
     }
+
+    /// The nullary predicate that names it in a symbolic state: `FingerGripper` or
+    /// `VacuumSuction` (the world domain's schemas are split by end effector on it).
+    pub fn state_predicate(self) -> &'static str {
+        match self {
+            Embodiment::Finger => "FingerGripper",
+            Embodiment::Vacuum => "VacuumSuction",
+        }
+    }
+
+    /// The nullary predicate that holds when it is released, as every goal ends:
+    /// `GripperOpen` or `VacuumInactive`.
+    pub fn released_predicate(self) -> &'static str {
+        match self {
+            Embodiment::Finger => "GripperOpen",
+            Embodiment::Vacuum => "VacuumInactive",
+        }
+    }
 }
 
 impl fmt::Display for Embodiment {

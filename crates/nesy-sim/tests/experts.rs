@@ -17,6 +17,11 @@ fn assert_full_success(config: &TaskConfig) {
     if let Some(why) = episode.failure() {
         panic!("{config:?}: {why}");
     }
+    assert!(
+        episode.outcome.displaced.is_empty(),
+        "{config:?}: displaced {:?}",
+        episode.outcome.displaced
+    );
     assert_eq!(episode.outcome.goal_label, task.goal_label);
     // Full success in label order: each subtask's achievements are its label.
     for s in &episode.outcome.subtasks {

@@ -2,7 +2,8 @@
 //! with a placed object out of place again (so its demonstration lacked part of its goal, or
 //! its target run failed under the strict check), and each test asserts the expert now ends
 //! in full success with nothing displaced. One more builds its own crowded scene for the
-//! pre-shaped grasp.
+//! pre-shaped grasp. (The earlier regression scenes are held to the same check where they
+//! live: `grip_high_00_s0` in `demo_goal.rs`, the benchmark scenes in `experts.rs`.)
 
 use nesy_sim::api::RobotApi;
 use nesy_sim::scene::SceneSpec;
@@ -57,13 +58,6 @@ fn clearing_the_way_to_a_handle_leaves_the_fruit_in_the_closed_hinge_box() {
 #[test]
 fn a_fruit_on_its_rounded_edge_comes_to_rest() {
     clean("vacu_medium_00_s0", Side::Source);
-}
-
-/// The strict check on the chess and fruit scenes of the earlier regression tests.
-#[test]
-fn earlier_regression_scenes_end_with_nothing_displaced() {
-    clean("grip_high_00_s0", Side::Source);
-    clean("comb_high_06_s1", Side::Target);
 }
 
 /// A cube with a cube 6 cm away on each of its four sides: every grasp spin points the

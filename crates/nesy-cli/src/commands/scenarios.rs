@@ -447,13 +447,7 @@ fn pddl_problem(scenario: &Scenario, side: Side) -> anyhow::Result<String> {
     let sim = nesy_sim::Sim::new(&scene).with_context(|| format!("building {} ({side:?})", scenario.id))?;
     let mut init = nesy_sim::perception::observer::observe(&sim);
     // The domain's schemas are split by end effector on this atom.
-    init.insert(nesy_core::Atom::new(
-        match scene.embodiment {
-            nesy_sim::api::Embodiment::Finger => "FingerGripper",
-            nesy_sim::api::Embodiment::Vacuum => "VacuumSuction",
-        },
-        &[],
-    ));
+    init.insert(nesy_core::Atom::new(scene.embodiment.state_predicate(), &[]));
     let goal = Formula::And(scene.symbolic_goal().into_iter().map(Formula::atom).collect());
     let world = nesy_vlm::oracle::WorldDomain::builtin()?;
     let names = sim.names();

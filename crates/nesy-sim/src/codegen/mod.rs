@@ -245,12 +245,6 @@ use crate::tasks::layout::{
     PUSH_OVERSHOOT, TOY_BOX_CELLS,
 };
 
-/// A Python helper the finger programs use to pick up round fruit: the wrist turn (rad) at
-/// which the open fingers point away from the nearest neighbour that stands above the
-/// fruit's bottom. At turn 0 the fingers open along y, so the turn is the direction to the
-/// neighbour. Fruits are yaw-free, but `move_gripper_to` turns the fingers to the fruit's
-/// own yaw; with fruits in a row 8 cm apart that lands a finger on the next fruit and knocks
-/// it away before its own pick.
 /// How far inside the reachable table area ([`FLOOR_AABB`]) compiled targets are kept (m).
 const REACH_MARGIN: f64 = 0.005;
 
@@ -270,6 +264,18 @@ fn within_reach_helper() -> String {
     )
 }
 
+/// A `move_to_position` to the computed `target` (a Python list expression), clamped by
+/// `within_reach`, with any further keyword arguments in `options` (`, angle=...`).
+fn reachable_move(target: &str, options: &str) -> String {
+    format!("move_to_position(within_reach({target}){options})")
+}
+
+/// A Python helper the finger programs use to pick up round fruit: the wrist turn (rad) at
+/// which the open fingers point away from the nearest neighbour that stands above the
+/// fruit's bottom. At turn 0 the fingers open along y, so the turn is the direction to the
+/// neighbour. Fruits are yaw-free, but `move_gripper_to` turns the fingers to the fruit's
+/// own yaw; with fruits in a row 8 cm apart that lands a finger on the next fruit and knocks
+/// it away before its own pick.
 const CLEAR_ANGLE_HELPER: &str = r#"
 def clear_angle(name):
     centre = get_obj_pos(name)
@@ -510,8 +516,11 @@ impl Emitter<'_> {
     /// the box's middle y and at `x`'s own x clamped 2.5 cm inside the box (pieces pushed
     /// straight across keep distinct x; a piece knocked off to one side is brought back in).
     fn over_at_own_x(&mut self, x: &str, bbox: &str, hang: &str) {
-        self.line(&format!(
-            "move_to_position(within_reach([min(max(get_obj_pos({x:?})[0], {bbox}[0][0] + 0.025), {bbox}[1][0] - 0.025), ({bbox}[0][1] + {bbox}[1][1]) / 2, {bbox}[1][2] + {hang} + {DROP_CLEARANCE}]))"
+        self.line(&reachable_move(
+            &format!(
+                "[min(max(get_obj_pos({x:?})[0], {bbox}[0][0] + 0.025), {bbox}[1][0] - 0.025), ({bbox}[0][1] + {bbox}[1][1]) / 2, {bbox}[1][2] + {hang} + {DROP_CLEARANCE}]"
+            ),
+            "",
         ));
     }
 
@@ -519,8 +528,9 @@ impl Emitter<'_> {
         let hang = self.hang(&format!("get_obj_size({x:?})[2]"));
         if surface == parts::FLOOR {
             self.line(&format!("spot = get_empty_floor_xy({x:?})"));
-            self.line(&format!(
-                "move_to_position(within_reach([spot[0], spot[1], {TABLE_TOP} + {hang} + {DROP_CLEARANCE}]))"
+            self.line(&reachable_move(
+                &format!("[spot[0], spot[1], {TABLE_TOP} + {hang} + {DROP_CLEARANCE}]"),
+                "",
             ));
         } else {
             // The piece keeps its own x (the sweep pushes it straight across), but a piece no
@@ -672,8 +682,11 @@ impl Emitter<'_> {
             // `move_gripper_to`'s tool point (the top less the depth, capped as the API caps
             // it), with the fingers turned clear of the neighbours.
             self.line(&format!("fb = get_obj_bbox({x:?})"));
-            self.line(&format!(
-                "move_to_position(within_reach([(fb[0][0] + fb[1][0]) / 2, (fb[0][1] + fb[1][1]) / 2, fb[1][2] - min(get_obj_size({x:?})[2] / 2, {MAX_FINGER_DEPTH})]), angle=clear_angle({x:?}))"
+            self.line(&reachable_move(
+                &format!(
+                    "[(fb[0][0] + fb[1][0]) / 2, (fb[0][1] + fb[1][1]) / 2, fb[1][2] - min(get_obj_size({x:?})[2] / 2, {MAX_FINGER_DEPTH})]"
+                ),
+                &format!(", angle=clear_angle({x:?})"),
             ));
         } else {
             let div = if pushes {
@@ -720,8 +733,11 @@ impl Emitter<'_> {
             // kept inside the box.
             self.over_at_own_x(x, "box", &hang);
         } else {
-            self.line(&format!(
-                "move_to_position(within_reach([(box[0][0] + box[1][0]) / 2 + {dx}, (box[0][1] + box[1][1]) / 2 + {dy}, box[1][2] + {hang} + {DROP_CLEARANCE}]))"
+            self.line(&reachable_move(
+                &format!(
+                    "[(box[0][0] + box[1][0]) / 2 + {dx}, (box[0][1] + box[1][1]) / 2 + {dy}, box[1][2] + {hang} + {DROP_CLEARANCE}]"
+                ),
+                "",
             ));
         }
     }
@@ -731,8 +747,11 @@ impl Emitter<'_> {
         let dy = HINGE_SPOTS[k % HINGE_SPOTS.len()];
         let hang = self.hang(&format!("get_obj_size({x:?})[2]"));
         self.line(&format!("body = get_obj_bbox({:?})", parts::HINGE_BODY));
-        self.line(&format!(
-            "move_to_position(within_reach([(body[0][0] + body[1][0]) / 2, (body[0][1] + body[1][1]) / 2 + {dy}, body[1][2] + {hang} + {HINGE_DROP_CLEARANCE}]))"
+        self.line(&reachable_move(
+            &format!(
+                "[(body[0][0] + body[1][0]) / 2, (body[0][1] + body[1][1]) / 2 + {dy}, body[1][2] + {hang} + {HINGE_DROP_CLEARANCE}]"
+            ),
+            "",
         ));
     }
 
@@ -745,9 +764,12 @@ impl Emitter<'_> {
             parts::DRAWER_BODY
         ));
         self.line(&format!("drawer = get_obj_pos({:?})", parts::BOTTOM_DRAWER));
-        self.line(&format!(
-            "move_to_position(within_reach([drawer[0] + {dx}, drawer[1] + {dy} * outward, drawer[2] + get_obj_size({:?})[2] + get_obj_size({x:?})[2] + {DRAWER_DROP_CLEARANCE}]))",
-            parts::BOTTOM_DRAWER
+        self.line(&reachable_move(
+            &format!(
+                "[drawer[0] + {dx}, drawer[1] + {dy} * outward, drawer[2] + get_obj_size({:?})[2] + get_obj_size({x:?})[2] + {DRAWER_DROP_CLEARANCE}]",
+                parts::BOTTOM_DRAWER
+            ),
+            "",
         ));
     }
 
@@ -810,7 +832,13 @@ impl Emitter<'_> {
             "    x = min(body[1][0] + reach * math.cos(a), {})",
             LID_SWING_MAX_X
         ));
-        self.line("    move_to_position(within_reach([x, lid_y, body[1][2] + reach * math.sin(a)]), lift_clearance=0.0, angle=math.pi / 2)");
+        self.line(&format!(
+            "    {}",
+            reachable_move(
+                "[x, lid_y, body[1][2] + reach * math.sin(a)]",
+                ", lift_clearance=0.0, angle=math.pi / 2"
+            )
+        ));
     }
 }
 

@@ -165,10 +165,7 @@ pub fn observe_snapshot(s: &Snapshot) -> State {
     };
     atoms.push(Atom::new(if s.closed { closed_p } else { open_p }, &[]));
     if s.embodiment_in_state {
-        atoms.push(Atom::new(
-            if finger { "FingerGripper" } else { "VacuumSuction" },
-            &[],
-        ));
+        atoms.push(Atom::new(s.embodiment.state_predicate(), &[]));
     }
     for o in &s.objects {
         if let Some((q, lo, hi)) = o.joint

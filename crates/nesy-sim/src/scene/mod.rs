@@ -327,14 +327,10 @@ impl SceneSpec {
     /// ([`SubtaskGoal::symbolic_goal`]) and the end effector released at the end
     /// (`GripperOpen` or `VacuumInactive`), as the goal checks require.
     pub fn symbolic_goal(&self) -> Vec<nesy_core::Atom> {
-        let released = match self.embodiment {
-            Embodiment::Finger => "GripperOpen",
-            Embodiment::Vacuum => "VacuumInactive",
-        };
         self.goals
             .iter()
             .flat_map(SubtaskGoal::symbolic_goal)
-            .chain([nesy_core::Atom::new(released, &[])])
+            .chain([nesy_core::Atom::new(self.embodiment.released_predicate(), &[])])
             .collect()
     }
 

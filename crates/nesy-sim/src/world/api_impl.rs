@@ -44,6 +44,43 @@ const FINGER_MARGIN: f64 = 0.005;
 /// bottom.
 const LEVEL_TOLERANCE: f64 = 0.005;
 
+/// The table-plane footprint of a hand above an object: points at `s` along its closing
+/// axis and `t` across it, from the object's centre.
+struct Footprint {
+    centre: [f64; 3],
+    along: Vector3<f64>,
+    across: Vector3<f64>,
+}
+
+impl Footprint {
+    fn new(centre: [f64; 3], rotation: &UnitQuaternion<f64>) -> Footprint {
+        Footprint {
+            centre,
+            along: rotation * Vector3::y(),
+            across: rotation * Vector3::x(),
+        }
+    }
+
+    fn point(&self, s: f64, t: f64) -> [f64; 2] {
+        [
+            self.centre[0] + self.along.x * s + self.across.x * t,
+            self.centre[1] + self.along.y * s + self.across.y * t,
+        ]
+    }
+}
+
+/// The palm's sample points `(s, t)`: nine along its length, three across its width.
+fn palm_samples() -> impl Iterator<Item = (f64, f64)> {
+    (-4..=4)
+        .map(|k| PALM_HALF_LENGTH * f64::from(k) / 4.0)
+        .flat_map(|s| [-PALM_HALF_WIDTH, 0.0, PALM_HALF_WIDTH].map(|t| (s, t)))
+}
+
+/// Whether the box `n`, widened by [`FINGER_MARGIN`], covers the table point `at`.
+fn covers(n: &Aabb, at: [f64; 2]) -> bool {
+    (0..2).all(|i| at[i] > n.min[i] - FINGER_MARGIN && at[i] < n.max[i] + FINGER_MARGIN)
+}
+
 impl Sim {
     fn known_names(&self) -> String {
         self.names().join(", ")
@@ -345,23 +382,19 @@ impl Sim {
         // A hand coming down stops where its palm would meet a taller neighbour, as a real
         // one stops on contact (its palm came down on a fruit beside a cube and flung it off
         // the table), as long as the pads still reach a little below the object's top.
-        if self.scene.embodiment == Embodiment::Finger && pointing == Direction::Down && !is_handle {
+        if self.scene.embodiment == Embodiment::Finger && !is_handle {
             let rotation = Sim::pointing(pointing, yaw);
-            if let Some(top) = self.palm_ceiling(part, &rotation) {
+            if pointing == Direction::Down
+                && let Some(top) = self.palm_ceiling(part, &rotation)
+            {
                 let palm_clear = top + PALM_CLEARANCE - PALM_ABOVE_TOOL;
                 target[2] = target[2].max(palm_clear.min(aabb.max[2] - MIN_PAD_OVERLAP));
             }
-        }
-        // The empty open hand narrows to the object on its way (the fingers move while the arm
-        // does); `open_gripper` opens it fully again.
-        if self.scene.embodiment == Embodiment::Finger
-            && !is_handle
-            && !self.closed
-            && self.held.is_none()
-            && self.handle_grasp.is_none()
-        {
-            let rotation = Sim::pointing(pointing, yaw);
-            self.gripper_target = self.preshape_travel(part, &rotation);
+            // The empty open hand narrows to the object on its way (the fingers move while
+            // the arm does); `open_gripper` opens it fully again.
+            if !self.closed && self.held.is_none() && self.handle_grasp.is_none() {
+                self.gripper_target = self.preshape_travel(part, &rotation);
+            }
         }
         self.do_move_to_position(target, pointing, crate::api::DEFAULT_LIFT_CLEARANCE, yaw)
     }
@@ -382,34 +415,21 @@ impl Sim {
             return nearest;
         }
         let object = self.part_aabb(part);
-        let centre = object.centre();
-        let held = self.held.map(|h| h.part);
-        let neighbours: Vec<Aabb> = (0..self.parts.len())
-            .filter(|&i| i != part && Some(i) != held && self.parts[i].role == PartRole::Loose)
-            .map(|i| self.part_aabb(i))
-            .collect();
+        let neighbours = self.loose_neighbours(part);
         let palm_z = tool_z + PALM_ABOVE_TOOL;
         // How bad a spin is: the height of the tallest neighbour the hand would touch (a
         // tower knocked over scatters more than a single cube nudged), or 0 when none.
         let crowding = |spin: f64| {
             let rotation = Sim::pointing(pointing, spin);
-            let along = rotation * Vector3::y();
-            let across = rotation * Vector3::x();
+            let footprint = Footprint::new(object.centre(), &rotation);
             let travel = self.preshape_travel(part, &rotation);
             // The tallest neighbour that `reaches` the hand's sample point at `s` along the
             // closing axis and `t` across it.
             let touched = |s: f64, t: f64, reaches: &dyn Fn(&Aabb) -> bool| {
-                let at = [
-                    centre[0] + along.x * s + across.x * t,
-                    centre[1] + along.y * s + across.y * t,
-                ];
+                let at = footprint.point(s, t);
                 neighbours
                     .iter()
-                    .filter(|n| {
-                        reaches(n)
-                            && (0..2)
-                                .all(|i| at[i] > n.min[i] - FINGER_MARGIN && at[i] < n.max[i] + FINGER_MARGIN)
-                    })
+                    .filter(|n| reaches(n) && covers(n, at))
                     .map(|n| n.max[2] - TABLE_TOP)
                     .fold(0.0, f64::max)
             };
@@ -421,9 +441,7 @@ impl Sim {
                 .flat_map(|s| [-FINGER_HALF_WIDTH, 0.0, FINGER_HALF_WIDTH].map(|t| (s, t)))
                 .map(|(s, t)| touched(s, t, &beside))
                 .fold(0.0, f64::max);
-            let palm = (-4..=4)
-                .map(|k| PALM_HALF_LENGTH * f64::from(k) / 4.0)
-                .flat_map(|s| [-PALM_HALF_WIDTH, 0.0, PALM_HALF_WIDTH].map(|t| (s, t)))
+            let palm = palm_samples()
                 .map(|(s, t)| touched(s, t, &under_palm))
                 .fold(0.0, f64::max);
             f64::max(fingers, palm)
@@ -445,30 +463,23 @@ impl Sim {
     /// The highest top of the loose objects (other than `part` and a held one) under the
     /// palm of a hand above `part` with tool orientation `rotation`, if any.
     fn palm_ceiling(&self, part: usize, rotation: &UnitQuaternion<f64>) -> Option<f64> {
-        let centre = self.part_aabb(part).centre();
-        let along = rotation * Vector3::y();
-        let across = rotation * Vector3::x();
+        let footprint = Footprint::new(self.part_aabb(part).centre(), rotation);
+        let points: Vec<[f64; 2]> = palm_samples().map(|(s, t)| footprint.point(s, t)).collect();
+        self.loose_neighbours(part)
+            .into_iter()
+            .filter(|n| points.iter().any(|&at| covers(n, at)))
+            .map(|n| n.max[2])
+            .reduce(f64::max)
+    }
+
+    /// The boxes of the loose objects other than `part` and the held one: what a hand coming
+    /// down to `part` can meet.
+    fn loose_neighbours(&self, part: usize) -> Vec<Aabb> {
         let held = self.held.map(|h| h.part);
-        let samples: Vec<[f64; 2]> = (-4..=4)
-            .map(|k| PALM_HALF_LENGTH * f64::from(k) / 4.0)
-            .flat_map(|s| [-PALM_HALF_WIDTH, 0.0, PALM_HALF_WIDTH].map(|t| (s, t)))
-            .map(|(s, t)| {
-                [
-                    centre[0] + along.x * s + across.x * t,
-                    centre[1] + along.y * s + across.y * t,
-                ]
-            })
-            .collect();
         (0..self.parts.len())
             .filter(|&i| i != part && Some(i) != held && self.parts[i].role == PartRole::Loose)
             .map(|i| self.part_aabb(i))
-            .filter(|n| {
-                samples.iter().any(|at| {
-                    (0..2).all(|k| at[k] > n.min[k] - FINGER_MARGIN && at[k] < n.max[k] + FINGER_MARGIN)
-                })
-            })
-            .map(|n| n.max[2])
-            .reduce(f64::max)
+            .collect()
     }
 
     fn do_move_parallel(&mut self, dir: Direction, offset: f64) -> Result<(), ApiError> {

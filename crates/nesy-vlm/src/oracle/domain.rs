@@ -117,7 +117,7 @@ impl WorldDomain {
             let _ = u.types.declare(*t, *parent);
         }
         for o in objects {
-            if o == "gripper" || o == "vacuum_gripper" {
+            if is_robot_entry(o) {
                 continue;
             }
             let ty = object_type(o);
@@ -143,7 +143,7 @@ impl WorldDomain {
         let mut seen = std::collections::BTreeSet::new();
         let objects = objects
             .into_iter()
-            .filter(|o| *o != "gripper" && *o != "vacuum_gripper")
+            .filter(|o| !is_robot_entry(o))
             .filter(|o| !self.domain.constants.iter().any(|(c, _)| c.as_str() == *o))
             .filter(|o| seen.insert(*o))
             .map(|o| (Symbol::new(o), Symbol::new(object_type(o))))
@@ -156,6 +156,12 @@ impl WorldDomain {
             goal,
         }
     }
+}
+
+/// The robot's own entry in a scene's object list (`gripper` or `vacuum_gripper`), which is
+/// not an object of the domain.
+fn is_robot_entry(name: &str) -> bool {
+    name == "gripper" || name == "vacuum_gripper"
 }
 
 /// The domain type of a scene object, by the benchmark's naming: `floor` and `board` are

@@ -73,16 +73,6 @@ pub enum OraclePatchError {
 /// Predicates the goal and the conversion care about.
 const PHYSICS: [&str; 5] = ["OverOf", "OnTopOf", "InsideOf", "Open", "Closed"];
 
-fn embodiment_atom(e: Embodiment) -> Atom {
-    Atom::new(
-        match e {
-            Embodiment::Finger => "FingerGripper",
-            Embodiment::Vacuum => "VacuumSuction",
-        },
-        &[],
-    )
-}
-
 fn is_other_embodiment_pred(pred: &str, target: Embodiment) -> bool {
     match target {
         Embodiment::Vacuum => pred.starts_with("Gripper") || pred == "FingerGripper",
@@ -118,7 +108,7 @@ struct Planning<'a> {
 impl Planning<'_> {
     /// Plans from `state` to `goal`; returns the printable actions and the state after them.
     fn plan(&self, state: &State, goal: &Formula) -> Result<(Vec<Operator>, State), String> {
-        let emb = embodiment_atom(self.target);
+        let emb = Atom::new(self.target.state_predicate(), &[]);
         let mut init = state.clone();
         init.insert(emb);
         let plan = planner::plan(&self.schemas, &self.universe, &init, goal, self.config)
@@ -442,10 +432,7 @@ fn convert(planning: &Planning<'_>, state: &State, actions: &[Operator]) -> Resu
         s = next;
     }
     let idle = Formula::Atom(AtomPattern::ground(Atom::new(
-        match planning.target {
-            Embodiment::Finger => "GripperOpen",
-            Embodiment::Vacuum => "VacuumInactive",
-        },
+        planning.target.released_predicate(),
         &[],
     )));
     if !holds(&s, &idle) {

@@ -40,6 +40,11 @@ pub(super) fn overlaps_xy(a: &Bbox, b: &Bbox, margin: f64) -> bool {
     (0..2).all(|i| a[0][i] < b[1][i] + margin && b[0][i] < a[1][i] + margin)
 }
 
+/// Whether two boxes overlap in all three axes.
+pub(super) fn overlaps(a: &Bbox, b: &Bbox) -> bool {
+    (0..3).all(|i| a[0][i] < b[1][i] && b[0][i] < a[1][i])
+}
+
 impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
     pub(super) fn new(robot: &'a mut R, subtask: SubtaskKind, loose: &'a [String]) -> Self {
         let vacuum = robot.embodiment() == Embodiment::Vacuum;

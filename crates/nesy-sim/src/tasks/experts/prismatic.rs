@@ -2,7 +2,7 @@
 //! and the bottom one opened first if needed, and the bottom drawer closed at the end.
 
 use super::ExpertError;
-use super::hand::{Bbox, Hand, centre, size};
+use super::hand::{Bbox, Hand, centre, overlaps, size};
 use crate::api::{DEFAULT_LIFT_CLEARANCE, Direction, RobotApi};
 use crate::scene::parts;
 use crate::tasks::layout::{DRAWER_DROP_CLEARANCE, DRAWER_PULL_FRACTION, DRAWER_RETREAT, DRAWER_SPOTS};
@@ -40,12 +40,11 @@ fn clear_handle_approach<R: RobotApi + ?Sized>(
             continue;
         }
         let b = hand.bbox(&name)?;
-        let inside = (0..3).all(|i| b[0][i] < corridor[1][i] && corridor[0][i] < b[1][i]);
-        let shielded = containers.iter().any(|c| {
-            let m = centre(&b);
-            (0..2).all(|i| c[0][i] < m[i] && m[i] < c[1][i]) && b[1][2] <= c[1][2] + 0.005
-        });
-        if inside && !shielded {
+        let m = centre(&b);
+        let shielded = containers
+            .iter()
+            .any(|c| (0..2).all(|i| c[0][i] < m[i] && m[i] < c[1][i]) && b[1][2] <= c[1][2] + 0.005);
+        if overlaps(&b, &corridor) && !shielded {
             hand.move_aside(&name)?;
         }
     }
@@ -86,11 +85,9 @@ fn furniture_in_the_way<R: RobotApi + ?Sized>(
 ) -> Result<bool, ExpertError> {
     let corridor = approach_corridor(hand, handle, pointing)?;
     for name in hand.robot.get_obj_names() {
-        if CONTAINERS.contains(&name.as_str()) && !name.contains("drawer") {
-            let b = hand.bbox(&name)?;
-            if (0..3).all(|i| b[0][i] < corridor[1][i] && corridor[0][i] < b[1][i]) {
-                return Ok(true);
-            }
+        let drawer = name == parts::TOP_DRAWER || name == parts::BOTTOM_DRAWER;
+        if CONTAINERS.contains(&name.as_str()) && !drawer && overlaps(&hand.bbox(&name)?, &corridor) {
+            return Ok(true);
         }
     }
     Ok(false)
