@@ -1,35 +1,78 @@
 #!/usr/bin/env bash
-# Installs what building nesy needs on a fresh Debian/Ubuntu machine, and nothing that is
-# already there: a Rust toolchain (rustup, with rustfmt and clippy), CPython 3.11 and its
-# shared library (nesy-policy embeds it), and the PyPI `mcap` reader the MCAP cross-check
-# test uses. Idempotent; safe to run on every CI start.
+# Installs what building nesy needs on a fresh Debian or Ubuntu machine, and nothing that is
+# already there: a C compiler and linker, curl and CA certificates (for rustup and cargo),
+# the system's CPython 3.11, 3.12 or 3.13 with its shared library (nesy-policy embeds it)
+# and pip, a Rust toolchain (rustup, with rustfmt and clippy), and the PyPI `mcap` reader
+# the MCAP cross-check test uses. Works with APT's Recommends off. Idempotent; safe to run on
+# every CI start.
 set -euo pipefail
 
 log() { printf '\n==> %s\n' "$*"; }
 as_root() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
+apt_install() {
+  if [ -z "${apt_updated:-}" ]; then
+    as_root apt-get update -qq
+    apt_updated=1
+  fi
+  # -o Dpkg::Use-Pty=0 and -qq keep dpkg's progress out of the log.
+  DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq -o Dpkg::Use-Pty=0 \
+    --no-install-recommends "$@" >/dev/null
+}
+# The interpreter the build embeds (scripts/system-python chooses it), or nothing.
+supported_python() {
+  "$(dirname "$0")/system-python" -I -S -c 'import sys; print(sys.executable)' 2>/dev/null
+}
+
+if ! command -v apt-get >/dev/null 2>&1; then
+  echo "install-prereqs.sh supports Debian and Ubuntu (apt-get). Elsewhere install a C compiler, curl, CPython 3.11-3.13 with its shared library and pip, and rustup by hand." >&2
+  exit 2
+fi
+
+log "system packages"
+need=()
+command -v cc >/dev/null 2>&1 || need+=(gcc libc6-dev)
+command -v curl >/dev/null 2>&1 || need+=(curl)
+[ -e /etc/ssl/certs/ca-certificates.crt ] || need+=(ca-certificates)
+command -v git >/dev/null 2>&1 || need+=(git)
+if ! supported_python >/dev/null; then
+  # Debian 12 and Ubuntu 22.04 name it python3.11; Debian 13 and Ubuntu 24.04 ship a
+  # supported python3.
+  if apt-cache show python3.11 >/dev/null 2>&1; then
+    need+=(python3.11)
+  else
+    need+=(python3)
+  fi
+fi
+[ ${#need[@]} -eq 0 ] || apt_install "${need[@]}"
+python=$(supported_python) || {
+  echo "nesy needs CPython 3.11, 3.12 or 3.13, and this system's packages offer none ($(/usr/bin/python3 --version 2>&1 || echo 'no python3'))." >&2
+  exit 2
+}
+version=$("$python" -c 'import sys; print(f"{sys.version_info[0]}.{sys.version_info[1]}")')
+libdir=$("$python" -c 'import sysconfig; print(sysconfig.get_config_var("LIBDIR"))')
+need=()
+[ -e "$libdir/libpython$version.so" ] || need+=("libpython$version-dev")
+"$python" -m pip --version >/dev/null 2>&1 || need+=(python3-pip)
+[ ${#need[@]} -eq 0 ] || apt_install "${need[@]}"
+echo "CPython $version ($python)"
 
 log "toolchain"
 if ! command -v cargo >/dev/null 2>&1; then
   [ -f "$HOME/.cargo/env" ] || curl -sSf https://sh.rustup.rs | sh -s -- -y --profile minimal
   # shellcheck disable=SC1091
   . "$HOME/.cargo/env"
+  installed_rustup=1
 fi
 rustup component add rustfmt clippy >/dev/null 2>&1 || true
 cargo --version
 
-log "system packages"
-need_apt=()
-[ -x /usr/bin/python3.11 ] || need_apt+=(python3.11)
-[ -e /usr/lib/x86_64-linux-gnu/libpython3.11.so ] || need_apt+=(libpython3.11-dev)
-python3.11 -m pip --version >/dev/null 2>&1 || need_apt+=(python3-pip)
-if [ ${#need_apt[@]} -gt 0 ]; then
-  as_root apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq "${need_apt[@]}"
+log "python packages"
+if ! "$python" -c 'import mcap' >/dev/null 2>&1; then
+  "$python" -m pip install --quiet --break-system-packages mcap 2>/dev/null \
+    || "$python" -m pip install --quiet mcap \
+    || echo "warning: could not install the PyPI mcap package; the MCAP cross-reader test will say so"
 fi
 
-log "python packages"
-if ! python3.11 -c 'import mcap' >/dev/null 2>&1; then
-  python3.11 -m pip install --quiet --break-system-packages mcap 2>/dev/null \
-    || python3.11 -m pip install --quiet mcap \
-    || echo "warning: could not install the PyPI mcap package; the MCAP cross-reader test will say so"
+if [ -n "${installed_rustup:-}" ]; then
+  printf '\nRust was installed under ~/.cargo. Before running cargo in this shell:\n    . "$HOME/.cargo/env"\n(new login shells pick it up by themselves).\n'
 fi

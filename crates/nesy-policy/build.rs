@@ -12,7 +12,7 @@ fn main() {
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     println!("cargo:rerun-if-env-changed=PYO3_PYTHON");
     println!("cargo:rerun-if-env-changed=PYO3_CONFIG_FILE");
-    let python = std::env::var("PYO3_PYTHON").unwrap_or_else(|_| "python3.11".to_owned());
+    let python = std::env::var("PYO3_PYTHON").unwrap_or_else(|_| "python3".to_owned());
     for name in SOURCES {
         let source = PathBuf::from(format!("src/python/{name}.py"));
         println!("cargo:rerun-if-changed={}", source.display());

@@ -9,7 +9,9 @@
 //!
 //! Concurrency: `jobs` units run at once; the CPU-bound stages (recording, building and
 //! rendering scenes, executing policies) share `cpu_jobs` slots, and model calls share
-//! `model_jobs` slots across all units.
+//! `model_jobs` slots across all units. When a scenario's first unit starts, the next
+//! scenario's demo is recorded (or loaded) ahead, so a free slot never waits on one
+//! scenario's recording.
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -366,8 +368,13 @@ pub async fn run(
     let mut writer = ResultsWriter::open(&store::shard_file(&config.run_dir, config.shard))?;
     let mut statuses: BTreeMap<String, usize> = BTreeMap::new();
     let mut stopped = None;
-    let mut queue = pending.into_iter();
+    let mut queue: std::collections::VecDeque<Unit> = pending.into();
     let mut set: tokio::task::JoinSet<(UnitKey, UnitRecord)> = tokio::task::JoinSet::new();
+    // The next scenario's inputs are prepared while this one's units run: the units of one
+    // scenario wait on its single recording, which kept every other core idle in a cold run.
+    // Dropped at the end of the run, which aborts what is still pending.
+    let mut prefetch: tokio::task::JoinSet<()> = tokio::task::JoinSet::new();
+    let mut prefetched: std::collections::HashSet<String> = std::collections::HashSet::new();
     let mut in_flight: HashMap<String, Unit> = HashMap::new();
     let (mut finished, mut errors) = (0usize, 0usize);
     let total_pending = queue.len();
@@ -392,7 +399,17 @@ pub async fn run(
                 ));
                 break;
             }
-            let Some(unit) = queue.next() else { break };
+            let Some(unit) = queue.pop_front() else { break };
+            prefetched.insert(unit.scenario.id.clone());
+            if let Some(next) = queue.iter().find(|u| u.scenario.id != unit.scenario.id)
+                && prefetched.insert(next.scenario.id.clone())
+            {
+                let (shared, scenario) = (shared.clone(), next.scenario.clone());
+                prefetch.spawn(async move {
+                    // A failure is stored in the scenario's slot and reported by its units.
+                    let _ = scenario_inputs(&shared, &scenario).await;
+                });
+            }
             let shared = shared.clone();
             in_flight.insert(unit.key.name(), unit.clone());
             set.spawn(async move {

@@ -188,7 +188,8 @@ impl Manifest {
     /// Reads a run's manifest.
     pub fn read(run: &Path) -> Result<Manifest, BenchError> {
         let path = manifest_path(run);
-        let text = std::fs::read_to_string(&path).map_err(|e| BenchError::io(&path, e))?;
+        let text =
+            nesy_input::read_text(&path, nesy_input::MAX_JSON_BYTES).map_err(|e| BenchError::io(&path, e))?;
         serde_json::from_str(&text).map_err(|e| BenchError::Format {
             path,
             message: format!("not a run manifest: {e}"),

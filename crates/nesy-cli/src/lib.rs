@@ -71,6 +71,8 @@ pub fn main() -> ExitCode {
     tracing_subscriber::fmt()
         .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
         .with_writer(std::io::stderr)
+        // Colour codes only for a terminal, not in logs captured to a file.
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
         .init();
     run(cli)
 }
@@ -94,10 +96,28 @@ pub fn run(cli: Cli) -> ExitCode {
         // process ended by SIGPIPE, as tools that die of the signal report.
         Err(err) if is_broken_pipe(&err) => ExitCode::from(EXIT_BROKEN_PIPE),
         Err(err) => {
-            eprintln!("error: {err:#}");
+            eprintln!("error: {}", error_chain(&err));
             ExitCode::from(EXIT_BAD_INPUT)
         }
     }
+}
+
+/// The error and its causes joined by `: `, leaving out a cause whose text the message
+/// before it already ends with (library errors show their source in their own message, so
+/// anyhow's `{:#}` printed it twice: `…: Is a directory (os error 21): Is a directory (os
+/// error 21)`).
+pub fn error_chain(err: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in err.chain() {
+        let part = cause.to_string();
+        if text.is_empty() {
+            text = part;
+        } else if !text.ends_with(&part) {
+            text.push_str(": ");
+            text.push_str(&part);
+        }
+    }
+    text
 }
 
 /// Exit code when standard output was closed by its reader (128 + SIGPIPE).
@@ -110,4 +130,23 @@ fn is_broken_pipe(err: &anyhow::Error) -> bool {
             .downcast_ref::<std::io::Error>()
             .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cause_already_in_the_message_is_not_repeated() {
+        let io = std::io::Error::new(std::io::ErrorKind::IsADirectory, "Is a directory (os error 21)");
+        let scene = nesy_sim::SceneError::Io {
+            path: "x.json".into(),
+            source: io,
+        };
+        let err = anyhow::Error::new(scene).context("running p.py on x.json");
+        assert_eq!(
+            error_chain(&err),
+            "running p.py on x.json: cannot read scene x.json: Is a directory (os error 21)"
+        );
+    }
 }

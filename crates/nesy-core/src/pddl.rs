@@ -195,7 +195,10 @@ pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
                 }
             }
             ":types" => {
-                for (n, t, _) in conv.typed_list(body, false)? {
+                for (n, t, at) in conv.typed_list(body, false)? {
+                    if domain.types.iter().any(|(d, _)| *d == n) {
+                        return Err(duplicate(doc, at, "type", n));
+                    }
                     domain.types.push((
                         n,
                         if t.as_str() == "thing" {
@@ -206,9 +209,14 @@ pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
                     ));
                 }
             }
-            ":constants" => domain
-                .constants
-                .extend(conv.typed_list(body, false)?.into_iter().map(|(n, t, _)| (n, t))),
+            ":constants" => {
+                for (n, t, at) in conv.typed_list(body, false)? {
+                    if domain.constants.iter().any(|(c, _)| *c == n) {
+                        return Err(duplicate(doc, at, "constant", n));
+                    }
+                    domain.constants.push((n, t));
+                }
+            }
             ":predicates" => {
                 for p in body {
                     let Some((head, params)) = p.list().and_then(|l| l.split_first()) else {
@@ -220,6 +228,9 @@ pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
                         ));
                     };
                     let name = conv.expect_name(head, "a predicate name")?;
+                    if domain.predicates.iter().any(|d| d.name == name) {
+                        return Err(duplicate(doc, head.span.start, "predicate", name));
+                    }
                     let params = conv
                         .typed_list(params, true)?
                         .into_iter()
@@ -254,9 +265,24 @@ pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
         .collect();
     let conv = Converter::new(doc, true).with_predicates(declared);
     for s in action_exprs {
-        domain.actions.push(parse_action(doc, &conv, s, &universe)?);
+        let action = parse_action(doc, &conv, s, &universe)?;
+        if domain.actions.iter().any(|a| a.name == action.name) {
+            return Err(duplicate(doc, s.span.start, "action", Symbol::new(&action.name)));
+        }
+        domain.actions.push(action);
     }
     Ok(domain)
+}
+
+/// A name declared a second time: PDDL has no overloading, and a silent redefinition would
+/// verify plans against whichever came last.
+fn duplicate(doc: &str, at: usize, what: &str, name: Symbol) -> ParseError {
+    err(
+        doc,
+        at,
+        ParseErrorKind::Reference,
+        format!("a {what} not declared before (`{name}` is declared twice)"),
+    )
 }
 
 fn parse_action(
@@ -396,6 +422,9 @@ pub fn parse_problem(doc: &str, domain: &Domain) -> Result<Problem, ParseError> 
                             format!("a declared type (`{t}` is not)"),
                         ));
                     }
+                    if objects.iter().any(|(o, _)| *o == n) {
+                        return Err(duplicate(doc, at, "object", n));
+                    }
                     objects.push((n, t));
                 }
             }
@@ -522,7 +551,7 @@ impl Domain {
 pub fn parse_plan(doc: &str) -> Result<Vec<PlanStep>, ParseError> {
     let mut steps = Vec::new();
     let mut offset = 0;
-    for raw in doc.split('\n') {
+    for (line_index, raw) in doc.split('\n').enumerate() {
         let line_start = offset;
         offset += raw.len() + 1;
         let code = raw.split(';').next().unwrap_or("").trim_end_matches('\r');
@@ -563,7 +592,10 @@ pub fn parse_plan(doc: &str) -> Result<Vec<PlanStep>, ParseError> {
             .iter()
             .map(|a| conv.expect_name(a, "an object name"))
             .collect::<Result<_, _>>()?;
-        let (line, column) = crate::text::line_col(doc, e.span.start);
+        // From this line, not from the document's start: counting from the start for every
+        // step made long plans quadratic.
+        let line = line_index + 1;
+        let column = doc[line_start..e.span.start].chars().count() + 1;
         steps.push(PlanStep {
             action,
             args,
@@ -698,6 +730,47 @@ mod tests {
         assert!(report.is_valid(), "{report:?}");
         let bad = ground_plan(&d, &u, &parse_plan("(stack a)").unwrap(), "(stack a)").unwrap_err();
         assert_eq!(bad.kind, ParseErrorKind::Reference);
+    }
+
+    #[test]
+    fn names_declared_twice_are_refused() {
+        let twice = |from: &str, to: &str| {
+            let text = DOMAIN.replacen(from, to, 1);
+            assert_ne!(text, DOMAIN, "{from}");
+            parse_domain(&text).unwrap_err()
+        };
+        let e = twice("(handempty))", "(handempty) (clear ?z - block))");
+        assert!(e.to_string().contains("`clear` is declared twice"), "{e}");
+        let e = twice(
+            "(:types block - object)",
+            "(:types block - object block - object)",
+        );
+        assert!(e.to_string().contains("type"), "{e}");
+        let e = twice(
+            " (:action stack",
+            " (:action pick-up :parameters (?x - block) :precondition (clear ?x) :effect (holding ?x))\n (:action stack",
+        );
+        assert!(e.to_string().contains("`pick-up` is declared twice"), "{e}");
+        let d = parse_domain(DOMAIN).unwrap();
+        let e = parse_problem(&PROBLEM.replace("a b - block", "a b a - block"), &d).unwrap_err();
+        assert!(e.to_string().contains("`a` is declared twice"), "{e}");
+    }
+
+    #[test]
+    fn long_plans_parse_in_linear_time_with_their_positions() {
+        let lines = 100_000;
+        let plan_text: String = (0..lines).map(|i| format!("{i}:  (pick-up b{i})\n")).collect();
+        let started = std::time::Instant::now();
+        let steps = parse_plan(&plan_text).unwrap();
+        assert_eq!(steps.len(), lines);
+        let last = steps.last().unwrap();
+        assert_eq!((last.line, last.column), (lines, "99999:  ".len() + 1));
+        // Quadratic position counting took minutes here.
+        assert!(
+            started.elapsed() < std::time::Duration::from_secs(20),
+            "{:?}",
+            started.elapsed()
+        );
     }
 
     #[test]

@@ -46,6 +46,10 @@ impl DemoInput {
                 ),
             });
         }
+        check_demo(&demo).map_err(|message| PipelineError::Demo {
+            path: path.to_owned(),
+            message,
+        })?;
         Ok(DemoInput {
             path: path.to_owned(),
             demo,
@@ -67,6 +71,67 @@ impl DemoInput {
     pub fn objects(&self) -> Vec<String> {
         scene_objects(&self.demo.metadata.objects)
     }
+}
+
+/// Latest keyframe time (s) a demo may give: a day, far beyond any demonstration.
+pub const MAX_KEYFRAME_TIME_S: f64 = 86_400.0;
+
+/// What the pipeline needs of a demo's contents beyond its format: keyframe times that are
+/// finite, non-negative and in order, and ground-truth states whose atoms use nesy's
+/// predicates at their arity over the demo's objects (the scene's, the floor and the robot's
+/// own parts). Such an atom would otherwise enter the world model as a fact.
+pub fn check_demo(demo: &Demo) -> Result<(), String> {
+    let vocabulary = nesy_core::Vocabulary::new();
+    let known: std::collections::HashSet<&str> = demo
+        .metadata
+        .objects
+        .iter()
+        .map(String::as_str)
+        .chain([parts::FLOOR, parts::GRIPPER, parts::VACUUM_GRIPPER])
+        .collect();
+    let mut previous_time = 0.0;
+    for (i, keyframe) in demo.keyframes.iter().enumerate() {
+        let time = keyframe.time;
+        if !(time.is_finite() && (previous_time..=MAX_KEYFRAME_TIME_S).contains(&time)) {
+            return Err(format!(
+                "keyframes[{i}].time: expected seconds from {previous_time} (the keyframe before) to {MAX_KEYFRAME_TIME_S}, got {time}"
+            ));
+        }
+        previous_time = time;
+        let Some(state) = &keyframe.state else { continue };
+        for atom in state.iter() {
+            let at = format!("keyframes[{i}].state: {atom}");
+            match vocabulary.get(atom.pred()) {
+                None => {
+                    let names: Vec<String> = vocabulary
+                        .predicates()
+                        .iter()
+                        .map(|p| p.name.to_string())
+                        .collect();
+                    return Err(format!(
+                        "{at}: `{}` is not one of nesy's predicates ({})",
+                        atom.pred(),
+                        names.join(", ")
+                    ));
+                }
+                Some(info) if info.arity != atom.args().len() => {
+                    return Err(format!(
+                        "{at}: `{}` takes {} argument(s), not {}",
+                        atom.pred(),
+                        info.arity,
+                        atom.args().len()
+                    ));
+                }
+                Some(_) => {}
+            }
+            if let Some(unknown) = atom.args().iter().find(|a| !known.contains(a.as_str())) {
+                return Err(format!(
+                    "{at}: `{unknown}` is not among the demo's objects (metadata.objects)"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Object names without the robot's own.
@@ -245,5 +310,51 @@ impl KeyframeImages for DemoKeyframes {
 
     fn demo_call(&self, step: usize) -> Option<serde_json::Value> {
         self.calls.get(step).cloned().flatten()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nesy_core::Atom;
+
+    fn fixture() -> Demo {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/demos/adapt-realstyle");
+        DemoInput::load(&dir).expect("the fixture is a valid demo").demo
+    }
+
+    fn with_atom(atom: &str) -> String {
+        let mut demo = fixture();
+        let state = demo.keyframes[1].state.as_mut().unwrap();
+        let mut atoms: Vec<Atom> = state.iter().copied().collect();
+        atoms.push(atom.parse().unwrap());
+        *state = State::from_atoms(atoms);
+        check_demo(&demo).unwrap_err()
+    }
+
+    #[test]
+    fn states_with_unknown_predicates_or_objects_are_refused_by_keyframe() {
+        let err = with_atom("(Flying red_cylinder)");
+        assert!(
+            err.starts_with(
+                "keyframes[1].state: (Flying red_cylinder): `Flying` is not one of nesy's predicates"
+            ),
+            "{err}"
+        );
+        let err = with_atom("(OnTopOf unicorn floor)");
+        assert!(err.contains("`unicorn` is not among the demo's objects"), "{err}");
+        let err = with_atom("(GripperOpen red_cylinder)");
+        assert!(err.contains("takes 0 argument(s), not 1"), "{err}");
+    }
+
+    #[test]
+    fn keyframe_times_must_be_finite_and_in_order() {
+        for (k, time) in [(1, -5.0), (1, 1e308), (2, 0.0)] {
+            let mut demo = fixture();
+            demo.keyframes[1].time = demo.keyframes[1].time.max(0.5);
+            demo.keyframes[k].time = time;
+            let err = check_demo(&demo).unwrap_err();
+            assert!(err.starts_with(&format!("keyframes[{k}].time")), "{err}");
+        }
     }
 }

@@ -9,8 +9,13 @@ use serde::{Deserialize, Serialize};
 pub struct Limits {
     /// Wall-clock budget of the policy itself, in milliseconds (watchdog deadline).
     pub wall_time_ms: u64,
-    /// Extra time the parent grants a worker beyond `wall_time_ms` (start-up, settle steps,
-    /// reporting) before killing it.
+    /// Longest stretch, in milliseconds, the policy may go without a robot API call before it
+    /// is stopped as idle: a policy that spins (`while True: pass`, or a C-level hang such as
+    /// `7 ** (10 ** 9)`) ends within this plus `kill_grace_ms`, not at the wall-clock budget.
+    /// The longest gap between calls of a working policy is a few milliseconds of Python.
+    pub idle_ms: u64,
+    /// Extra time the parent grants a worker beyond `wall_time_ms` or `idle_ms` (start-up,
+    /// settle steps, reporting) before killing it.
     pub kill_grace_ms: u64,
     /// Trace events (Python lines executed plus function calls) allowed.
     pub instruction_budget: u64,
@@ -28,6 +33,7 @@ impl Default for Limits {
     fn default() -> Self {
         Limits {
             wall_time_ms: 120_000,
+            idle_ms: 10_000,
             kill_grace_ms: 3_000,
             instruction_budget: 50_000_000,
             action_calls: 200,

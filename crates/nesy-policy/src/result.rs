@@ -101,6 +101,9 @@ impl Outcome {
 pub enum TimeLimit {
     /// The in-interpreter watchdog saw the wall-clock deadline pass.
     WallClock,
+    /// The policy made no robot API call for `Limits::idle_ms` (stopped by the watchdog, or
+    /// killed by the worker's parent when the interpreter itself was stuck in C code).
+    Idle,
     /// The trace-event (line and call) budget ran out.
     Instructions,
     /// The policy made more robot action calls than allowed.

@@ -169,7 +169,8 @@ fn execute(py: Python<'_>, source: &str, limits: &Limits, deadline: Instant) -> 
 
     abort::reset();
     budget::start_tracing(py, limits.instruction_budget);
-    let mut watchdog = Watchdog::start(py, deadline);
+    budget::mark_progress();
+    let mut watchdog = Watchdog::start(py, deadline, Duration::from_millis(limits.idle_ms));
     audit::arm();
     // SAFETY: GIL held; `code` is a code object, `globals` a dict.
     let result = unsafe { ffi::PyEval_EvalCode(code.as_ptr(), globals.as_ptr(), globals.as_ptr()) };

@@ -347,9 +347,11 @@ fn recording_is_deterministic_and_complete() {
     assert_eq!(back.keyframes.len(), demo.keyframes.len());
 }
 
-/// The Python interpreter that has the PyPI `mcap` package (the one CI installs it into).
-fn python_with_mcap() -> Option<&'static str> {
-    ["python3.11", "python3"].into_iter().find(|py| {
+/// The Python interpreter that has the PyPI `mcap` package: the one the build embeds
+/// (`PYO3_PYTHON`, which `scripts/install-prereqs.sh` installs it into), else one on the path.
+fn python_with_mcap() -> Option<String> {
+    let build = std::env::var("PYO3_PYTHON").ok();
+    build.into_iter().chain(["python3".to_owned()]).find(|py| {
         std::process::Command::new(py)
             .args(["-c", "import mcap.reader"])
             .output()
@@ -364,7 +366,7 @@ fn python_mcap_reads_every_channel() {
             panic!("CI must provide the PyPI mcap package (scripts/install-prereqs.sh installs it)");
         }
         eprintln!(
-            "SKIPPED python_mcap_reads_every_channel: no python3.11/python3 with the PyPI `mcap` package"
+            "SKIPPED python_mcap_reads_every_channel: no PYO3_PYTHON or python3 with the PyPI `mcap` package"
         );
         return;
     };

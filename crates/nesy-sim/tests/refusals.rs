@@ -261,7 +261,41 @@ fn malformed_scenes_name_the_json_path_and_the_expectation() {
 
     let e = load_error(|j| j["objects"][2]["size"] = serde_json::json!([0.03, -0.03, 0.03]));
     assert_eq!(e.json_path(), Some("objects[2].size[1]"));
-    assert!(e.to_string().contains("expected a positive size"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("expected a size in metres from 0.001 to 2"),
+        "{e}"
+    );
+
+    let e = load_error(|j| j["objects"][2]["size"] = serde_json::json!([0.03, 1e-300, 0.03]));
+    assert_eq!(e.json_path(), Some("objects[2].size[1]"));
+
+    // Values that would overflow the simulator's f32, or are simply far off the table.
+    for (k, v) in [(0, 1e308), (0, 3.5e38), (1, 100.0), (2, -5.0)] {
+        let e = load_error(|j| j["objects"][1]["pose"]["position"][k] = v.into());
+        assert_eq!(
+            e.json_path(),
+            Some(format!("objects[1].pose.position[{k}]").as_str()),
+            "{v}"
+        );
+        assert!(e.to_string().contains("a position in metres from"), "{e}");
+    }
+
+    let e = load_error(|j| j["goals"][0]["objects"] = serde_json::json!([]));
+    assert_eq!(e.json_path(), Some("goals[0].objects"));
+    assert!(e.to_string().contains("at least one object"), "{e}");
+
+    let e = load_error(|j| {
+        let cube = j["objects"][1].clone();
+        let objects = j["objects"].as_array_mut().unwrap();
+        for i in 0..2000 {
+            let mut c = cube.clone();
+            c["name"] = format!("cube_{i}").into();
+            objects.push(c);
+        }
+    });
+    assert_eq!(e.json_path(), Some("objects"));
+    assert!(e.to_string().contains("at most 100 objects"), "{e}");
 
     let e = load_error(|j| j["objects"][3]["name"] = "red_cube".into());
     assert_eq!(e.json_path(), Some("objects[3].name"));
@@ -302,7 +336,7 @@ fn malformed_scenes_name_the_json_path_and_the_expectation() {
     let e = Sim::new(&spec).err().unwrap();
     assert_eq!(e.json_path(), Some("objects[1].pose.position[1]"));
     assert!(
-        e.to_string().contains("expected a finite number, found NaN"),
+        e.to_string().contains("a position in metres from -2 to 2") && e.to_string().contains("NaN"),
         "{e}"
     );
 }

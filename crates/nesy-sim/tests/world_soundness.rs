@@ -101,3 +101,32 @@ fn the_open_hand_narrows_to_a_crowded_cube() {
         assert!(moved < 0.002, "{name} moved {moved:.4} m");
     }
 }
+
+/// An object put down close to the robot's base: pointing down, the arm cannot rise the full
+/// lift clearance there (its elbow would fold past its limit), and the next move died on an
+/// unreachable lift point above the object just released. It now lifts as far as it can.
+#[test]
+fn the_hand_leaves_an_object_put_down_near_the_base() {
+    use nesy_sim::api::Direction;
+    let object = |name: &str, kind: &str, x: f64, y: f64| serde_json::json!({"name": name, "kind": kind, "pose": {"position": [x, y, 0.5], "yaw": 0.0}});
+    let scene = serde_json::json!({
+        "schema_version": 1,
+        "embodiment": "vacuum",
+        "objects": [object("lemon", "lemon", 0.45, 0.0), object("red_cube", "cube", 0.5, -0.2)],
+        "goals": []
+    });
+    let scene = SceneSpec::from_json_str(&scene.to_string(), "near_base").unwrap();
+    let mut sim = Sim::new(&scene).unwrap();
+    sim.move_gripper_to("lemon", Direction::Down, 0.0).unwrap();
+    sim.activate_vacuum().unwrap();
+    // Where the traced run's free-floor search put the lemon.
+    sim.move_to_position([0.234, 0.006, 0.56], Direction::Down, 0.12, 0.0)
+        .unwrap();
+    sim.deactivate_vacuum().unwrap();
+    sim.move_gripper_to("red_cube", Direction::Down, 0.0).unwrap();
+    let lemon = sim.get_obj_pos("lemon").unwrap();
+    assert!(
+        (lemon[0] - 0.234).abs() < 0.02 && lemon[1].abs() < 0.03,
+        "lemon at {lemon:?}"
+    );
+}

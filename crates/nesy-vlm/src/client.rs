@@ -14,6 +14,7 @@ use crate::profile::{AuthScheme, Profile};
 use crate::request::ChatRequest;
 use crate::response::{ChatResponse, parse_completion};
 use crate::retry::{RetryPolicy, status_is_retryable};
+use crate::secret::SecretString;
 use crate::transport::http::Auth;
 use crate::transport::{HttpTransport, Origin, Transport, WireRequest, WireResponse};
 
@@ -32,6 +33,8 @@ struct Inner {
     max_concurrency: usize,
     prices: PriceTable,
     usage: Mutex<RunUsage>,
+    /// The configured key, redacted from every provider error by its exact text.
+    api_key: Option<SecretString>,
 }
 
 impl std::fmt::Debug for VlmClient {
@@ -150,6 +153,7 @@ impl VlmClient {
                 max_concurrency,
                 prices: config.prices.clone(),
                 usage: Mutex::new(RunUsage::default()),
+                api_key: config.api_key.clone(),
             }),
         }
     }
@@ -236,7 +240,10 @@ impl VlmClient {
                     return (Ok(response), attempts, Some(origin));
                 }
                 Ok(response) => {
-                    let provider = ProviderError::from_body(&response.body);
+                    let mut provider = ProviderError::from_body(&response.body);
+                    if let Some(key) = &self.inner.api_key {
+                        provider = provider.without_secret(key);
+                    }
                     if can_retry && status_is_retryable(&response, &provider) {
                         let delay = policy.delay(attempts, Some(&response));
                         tracing::warn!(

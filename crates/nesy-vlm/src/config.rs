@@ -273,7 +273,8 @@ impl Sources<'_> {
         key: &str,
     ) -> Result<Option<Duration>, ConfigError> {
         match (flag, self.env.var(var), file) {
-            (Some(v), _, _) => Ok(Some(seconds(v, "flag")?)),
+            // Only the total timeout has a flag.
+            (Some(v), _, _) => Ok(Some(seconds(v, "--vlm-timeout-secs")?)),
             (None, Some(v), _) => Ok(Some(seconds(parse(&v, var)?, var)?)),
             (None, None, Some(v)) => Ok(Some(seconds(v, &self.file_origin(key))?)),
             (None, None, None) => Ok(None),
@@ -370,6 +371,18 @@ impl Sources<'_> {
         if let Some(temperature) =
             self.setting(flags.temperature, "NESY_VLM_TEMPERATURE", file.temperature)?
         {
+            // NaN would go out as JSON `null`; providers accept 0 to 2.
+            if !(0.0..=2.0).contains(&temperature) {
+                let origin = match (flags.temperature, self.env.var("NESY_VLM_TEMPERATURE")) {
+                    (Some(_), _) => "--vlm-temperature".to_owned(),
+                    (None, Some(_)) => "NESY_VLM_TEMPERATURE".to_owned(),
+                    (None, None) => self.file_origin("temperature"),
+                };
+                return Err(invalid(
+                    &origin,
+                    &format!("expected a temperature from 0 to 2, got {temperature}"),
+                ));
+            }
             config.defaults.temperature = Some(temperature);
         }
         if let Some(detail) = self.setting(flags.image_detail, "NESY_VLM_IMAGE_DETAIL", file.image_detail)? {
@@ -500,12 +513,16 @@ fn parse_bool(value: &str, origin: &str) -> Result<bool, ConfigError> {
 }
 
 fn seconds(value: f64, origin: &str) -> Result<Duration, ConfigError> {
-    Duration::try_from_secs_f64(value).map_err(|_| {
-        invalid(
-            origin,
-            &format!("expected a non-negative number of seconds, got {value}"),
-        )
-    })
+    // A zero timeout would fail every call before it is sent.
+    Duration::try_from_secs_f64(value)
+        .ok()
+        .filter(|d| !d.is_zero())
+        .ok_or_else(|| {
+            invalid(
+                origin,
+                &format!("expected a positive number of seconds, got {value}"),
+            )
+        })
 }
 
 fn invalid(origin: &str, message: &str) -> ConfigError {
@@ -625,13 +642,15 @@ struct FileCassette {
 
 impl FileConfig {
     fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
-            path: path.to_path_buf(),
-            error: source,
-        })?;
+        let text =
+            nesy_input::read_text(path, nesy_input::MAX_JSON_BYTES).map_err(|source| ConfigError::Io {
+                path: path.to_path_buf(),
+                error: source,
+            })?;
+        // The parser quotes the offending line, which may hold a key.
         toml::from_str(&text).map_err(|err| ConfigError::File {
             path: path.to_path_buf(),
-            message: err.to_string(),
+            message: crate::secret::redact_credentials(&err.to_string()),
         })
     }
 }
@@ -746,6 +765,46 @@ output_per_mtok = 10.0
             err.contains("bad.toml") && err.contains("max_tokens") && err.contains("line 2"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn out_of_range_flags_are_refused_by_name() {
+        let vars = env(&[("NESY_VLM_MODEL", "m")]);
+        for temperature in [f32::NAN, -0.5, 2.5] {
+            let flags = ConfigOverrides {
+                temperature: Some(temperature),
+                ..ConfigOverrides::default()
+            };
+            let err = VlmConfig::resolve(&flags, &vars).unwrap_err().to_string();
+            assert!(err.starts_with("--vlm-temperature:"), "{err}");
+        }
+        for seconds in [0.0, -1.0, f64::NAN, 1e300] {
+            let flags = ConfigOverrides {
+                timeout_secs: Some(seconds),
+                ..ConfigOverrides::default()
+            };
+            let err = VlmConfig::resolve(&flags, &vars).unwrap_err().to_string();
+            assert!(err.starts_with("--vlm-timeout-secs:"), "{err}");
+            assert!(err.contains("positive number of seconds"), "{err}");
+        }
+        let vars = env(&[("NESY_VLM_MODEL", "m"), ("NESY_VLM_TEMPERATURE", "NaN")]);
+        let err = VlmConfig::resolve(&ConfigOverrides::default(), &vars)
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("NESY_VLM_TEMPERATURE:"), "{err}");
+    }
+
+    #[test]
+    fn a_key_in_a_bad_config_file_is_not_echoed() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("vlm.toml");
+        std::fs::write(&path, "model = \"m\"\napi_key = \"sk-proj-from-a-file-0042\"\n").unwrap();
+        let vars = env(&[("NESY_VLM_CONFIG", path.to_str().unwrap())]);
+        let err = VlmConfig::resolve(&ConfigOverrides::default(), &vars)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("vlm.toml") && err.contains("api_key"), "{err}");
+        assert!(!err.contains("from-a-file"), "{err}");
     }
 
     #[cfg(feature = "clap")]

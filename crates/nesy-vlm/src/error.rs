@@ -167,7 +167,24 @@ pub struct ProviderError {
 
 impl ProviderError {
     /// Reads an error body. Never fails: a body that is not JSON becomes the message.
+    /// Anything in it that looks like a credential is redacted
+    /// ([`crate::secret::redact_credentials`]): providers echo a rejected key in their 401s.
     pub fn from_body(body: &[u8]) -> Self {
+        let mut error = Self::parse_body(body);
+        error.message = crate::secret::redact_credentials(&error.message);
+        error.body = crate::secret::redact_credentials(&error.body);
+        error
+    }
+
+    /// This error with every occurrence of `secret` redacted (the configured key, whatever
+    /// its shape).
+    pub fn without_secret(mut self, secret: &crate::secret::SecretString) -> Self {
+        self.message = secret.redact_in(&self.message);
+        self.body = secret.redact_in(&self.body);
+        self
+    }
+
+    fn parse_body(body: &[u8]) -> Self {
         #[derive(Deserialize)]
         struct Envelope {
             error: Option<Inner>,

@@ -66,19 +66,19 @@ impl RetryPolicy {
 }
 
 /// `retry-after-ms` (milliseconds, may be fractional), else `retry-after` (seconds or an
-/// HTTP date).
+/// HTTP date). A value that is negative, not a number or too long for a [`Duration`]
+/// (`1e308`) counts as absent: the headers come from the server, so none of them may panic.
 pub(crate) fn server_requested_delay(response: &WireResponse, now: SystemTime) -> Option<Duration> {
     if let Some(ms) = response
         .header("retry-after-ms")
         .and_then(|v| v.trim().parse::<f64>().ok())
-        && ms.is_finite()
-        && ms >= 0.0
+        && let Ok(delay) = Duration::try_from_secs_f64(ms / 1e3)
     {
-        return Some(Duration::from_secs_f64(ms / 1e3));
+        return Some(delay);
     }
     let value = response.header("retry-after")?.trim();
     if let Ok(seconds) = value.parse::<f64>() {
-        return (seconds.is_finite() && seconds >= 0.0).then(|| Duration::from_secs_f64(seconds));
+        return Duration::try_from_secs_f64(seconds).ok();
     }
     let when = httpdate::parse_http_date(value).ok()?;
     Some(when.duration_since(now).unwrap_or(Duration::ZERO))
@@ -174,5 +174,28 @@ mod tests {
         }
         let too_long = response(429, &[("retry-after", "600")], "");
         assert!(policy.delay(1, Some(&too_long)) <= Duration::from_millis(500));
+    }
+
+    #[test]
+    fn absurd_retry_delays_fall_back_to_the_backoff() {
+        let policy = RetryPolicy::default();
+        let now = SystemTime::now();
+        for (header, value) in [
+            ("retry-after", "1e20"),
+            ("retry-after", "18446744073709551616"),
+            ("retry-after", "1e308"),
+            ("retry-after", "-3"),
+            ("retry-after", "NaN"),
+            ("retry-after", "inf"),
+            ("retry-after-ms", "1e308"),
+            ("retry-after-ms", "-1"),
+        ] {
+            let reply = response(429, &[(header, value)], "");
+            assert_eq!(server_requested_delay(&reply, now), None, "{header}: {value}");
+            assert!(
+                policy.delay(1, Some(&reply)) <= Duration::from_millis(500),
+                "{header}: {value}"
+            );
+        }
     }
 }

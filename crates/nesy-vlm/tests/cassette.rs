@@ -437,3 +437,67 @@ fn opening_modes_that_record_without_a_live_transport_fails_clearly() {
         .unwrap(),
     );
 }
+
+/// `verify` on a hand-made hostile cassette: a blob reference that is a path (`../`, an
+/// absolute device), a blob that is a named pipe, a stored credential header and an empty
+/// success body. None of them may be opened, block or pass.
+#[test]
+fn verify_refuses_paths_pipes_credentials_and_empty_successes() {
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/cassettes");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("hostile.json");
+    let mut file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fixtures.join("adapt-realstyle.json")).unwrap())
+            .unwrap();
+    let refs: Vec<String> = {
+        let text = file.to_string();
+        text.match_indices("blob:sha256:")
+            .map(|(at, _)| text[at..].split('"').next().unwrap().to_string())
+            .collect()
+    };
+    assert!(refs.len() >= 3, "the fixture holds images");
+    std::fs::create_dir(dir.path().join("blobs")).unwrap();
+    let pipe_name = format!("{}.png", "ab".repeat(32));
+    let pipe = dir.path().join("blobs").join(&pipe_name);
+    let made = std::process::Command::new("mkfifo").arg(&pipe).status().unwrap();
+    assert!(made.success());
+    let text = file
+        .to_string()
+        .replacen(&refs[0], "blob:sha256:../../../../../etc/hostname", 1)
+        .replacen(&refs[1], "blob:sha256:/dev/zero", 1)
+        .replacen(&refs[2], &format!("blob:sha256:{pipe_name}"), 1);
+    file = serde_json::from_str(&text).unwrap();
+    let interactions = file["interactions"].as_array_mut().unwrap();
+    interactions[0]["response"]["headers"]["authorization"] = json!("Bearer sk-stored-by-hand-0001");
+    let response = interactions[1]["response"].as_object_mut().unwrap();
+    response.remove("body");
+    response.remove("body_text");
+    std::fs::write(&path, serde_json::to_string_pretty(&file).unwrap()).unwrap();
+
+    let started = std::time::Instant::now();
+    let problems: Vec<String> = tools::verify(&path)
+        .unwrap()
+        .into_iter()
+        .map(|p| p.message)
+        .collect();
+    assert!(
+        started.elapsed() < std::time::Duration::from_secs(10),
+        "no blocking read"
+    );
+    let has = |needle: &str| problems.iter().any(|p| p.contains(needle));
+    assert!(
+        has("\"../../../../../etc/hostname\" is not a content address"),
+        "{problems:?}"
+    );
+    assert!(has("\"/dev/zero\" is not a content address"), "{problems:?}");
+    assert!(has("is not a regular file"), "{problems:?}");
+    assert!(
+        has("header `authorization` is not on the allowlist"),
+        "{problems:?}"
+    );
+    assert!(has("with no body"), "{problems:?}");
+    assert!(
+        problems.iter().all(|p| !p.contains("sk-stored-by-hand")),
+        "{problems:?}"
+    );
+}

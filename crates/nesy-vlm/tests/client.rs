@@ -617,3 +617,63 @@ fn a_missing_key_is_a_clear_config_error_but_replay_needs_none() {
     });
     VlmClient::from_config(&replay).expect("replay needs no key");
 }
+
+#[tokio::test]
+async fn absurd_retry_after_headers_do_not_panic() {
+    for (name, value) in [
+        ("retry-after", "1e20"),
+        ("retry-after", "18446744073709551616"),
+        ("retry-after", "1e308"),
+        ("retry-after-ms", "1e308"),
+    ] {
+        let server = MockServer::start().await;
+        Mock::given(method("POST"))
+            .respond_with(
+                ResponseTemplate::new(429)
+                    .set_body_json(json!({"error": {"message": "slow down", "code": "rate_limit_exceeded"}}))
+                    .insert_header(name, value),
+            )
+            .up_to_n_times(1)
+            .with_priority(1)
+            .mount(&server)
+            .await;
+        Mock::given(method("POST"))
+            .respond_with(ResponseTemplate::new(200).set_body_json(completion("after the back-off")))
+            .with_priority(2)
+            .mount(&server)
+            .await;
+        let mut cfg = config(BackendKind::OpenAi, "gpt-5", &server.uri());
+        cfg.api_key = Some(SecretString::new("sk-test-openai-key-0009"));
+        let client = VlmClient::from_config(&cfg).unwrap();
+        let reply = client.chat(simple_request()).await.unwrap();
+        // The unrepresentable wait is ignored for the (5 ms) exponential back-off.
+        assert_eq!(reply.text, "after the back-off", "{name}: {value}");
+        assert_eq!(reply.attempts, 2, "{name}: {value}");
+    }
+}
+
+#[tokio::test]
+async fn a_key_echoed_in_a_401_never_reaches_the_error() {
+    for key in ["sk-proj-test-Ab12cd34EF56gh78", "local-vllm-secret-000"] {
+        let server = MockServer::start().await;
+        let echo = format!(
+            "Incorrect API key provided: {key}. You can find your API key at https://platform.openai.com/account/api-keys."
+        );
+        Mock::given(method("POST"))
+            .respond_with(ResponseTemplate::new(401).set_body_json(
+                json!({"error": {"message": echo, "type": "invalid_request_error", "code": "invalid_api_key"}}),
+            ))
+            .mount(&server)
+            .await;
+        let mut cfg = config(BackendKind::OpenAi, "gpt-5", &server.uri());
+        cfg.api_key = Some(SecretString::new(key));
+        let client = VlmClient::from_config(&cfg).unwrap();
+        let err = client.chat(simple_request()).await.unwrap_err();
+        assert!(matches!(err, VlmError::Http { status: 401, .. }), "{err:?}");
+        for shown in [err.to_string(), format!("{err:?}"), format!("{err:#?}")] {
+            assert!(!shown.contains(key), "{shown}");
+            assert!(!shown.contains("Ab12cd34"), "{shown}");
+        }
+        assert!(err.to_string().contains("[REDACTED]"), "{err}");
+    }
+}

@@ -62,6 +62,10 @@ pub struct AdaptArgs {
     /// Wall-clock budget of the policy in seconds (with `--execute`).
     #[arg(long, value_name = "SECS", default_value_t = 300.0)]
     pub timeout: f64,
+    /// Stop the policy when it makes no robot API call for this many seconds (with
+    /// `--execute`).
+    #[arg(long, value_name = "SECS", default_value_t = 10.0)]
+    pub idle_timeout: f64,
     /// VLM settings (also from the environment and `--vlm-config`).
     #[command(flatten)]
     pub vlm_config: ConfigOverrides,
@@ -110,12 +114,8 @@ pub fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn options(args: &AdaptArgs) -> anyhow::Result<AdaptOptions> {
-    if !(args.timeout.is_finite() && args.timeout > 0.0) {
-        anyhow::bail!(
-            "--timeout must be a positive number of seconds, got {}",
-            args.timeout
-        );
-    }
+    let wall_time_ms = super::seconds_to_ms("--timeout", args.timeout)?;
+    let idle_ms = super::seconds_to_ms("--idle-timeout", args.idle_timeout)?;
     if args.induction_tries == 0 {
         anyhow::bail!("--induction-tries must be at least 1");
     }
@@ -145,7 +145,8 @@ fn options(args: &AdaptArgs) -> anyhow::Result<AdaptOptions> {
             ..AdaptConfig::default()
         },
         limits: Limits {
-            wall_time_ms: (args.timeout * 1000.0) as u64,
+            wall_time_ms,
+            idle_ms,
             ..Limits::default()
         },
         worker: None,

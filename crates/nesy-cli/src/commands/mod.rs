@@ -9,3 +9,12 @@ pub mod run;
 pub mod scenarios;
 pub mod verify;
 pub mod worker;
+
+/// A `--flag SECONDS` value as whole milliseconds: finite and positive, or an error naming
+/// the flag.
+pub(crate) fn seconds_to_ms(flag: &str, seconds: f64) -> anyhow::Result<u64> {
+    if !(seconds.is_finite() && seconds > 0.0 && seconds <= 1e9) {
+        anyhow::bail!("{flag} must be a positive number of seconds (at most 1e9), got {seconds}");
+    }
+    Ok((seconds * 1000.0).ceil() as u64)
+}

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use nesy_sim::demo::{RecordOptions, record_scene, write_mcap_file};
-use nesy_sim::perception::render::{VIEW_SIZE, default_threads};
+use nesy_sim::perception::render::{MAX_RENDER_THREADS, VIEW_SIZE, default_threads};
 use nesy_sim::tasks::scenario::{self, Side};
 
 use super::scenarios::{SideArg, load_suite};
@@ -27,9 +27,9 @@ pub struct RecordArgs {
     /// Image side in pixels.
     #[arg(long, default_value_t = VIEW_SIZE)]
     pub size: u32,
-    /// Render threads (default: available cores, at most 4).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    /// Render threads (default: available cores, at most 4; at most 64).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_RENDER_THREADS as u64))]
+    pub threads: Option<u64>,
     /// Read the configurations from this directory instead of generating them.
     #[arg(long)]
     pub suite: Option<PathBuf>,
@@ -49,7 +49,7 @@ pub fn run(args: RecordArgs) -> anyhow::Result<ExitCode> {
     let target = scenario.generate(Side::Target)?.scene;
     let options = RecordOptions {
         image_size: args.size,
-        render_threads: args.threads.unwrap_or_else(default_threads).max(1),
+        render_threads: args.threads.map_or_else(default_threads, |n| n as usize).max(1),
         scenario_id: Some(scenario.id.clone()),
         side: Some(side.as_str().to_owned()),
         target_scene: Some(target.clone()),

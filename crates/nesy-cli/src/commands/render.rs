@@ -5,7 +5,9 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
-use nesy_sim::perception::render::{VIEW_SIZE, default_threads, render_views, write_views};
+use nesy_sim::perception::render::{
+    MAX_RENDER_THREADS, VIEW_SIZE, default_threads, render_views, write_views,
+};
 use nesy_sim::{Sim, SimConfig};
 
 /// Arguments of `nesy render`.
@@ -20,13 +22,17 @@ pub struct RenderArgs {
     /// Image side in pixels.
     #[arg(long, default_value_t = VIEW_SIZE)]
     pub size: u32,
-    /// Render threads (default: available cores, at most 4).
-    #[arg(long)]
-    pub threads: Option<usize>,
-    /// Control steps to let objects settle before rendering (0.01 s each).
-    #[arg(long, default_value_t = 50)]
+    /// Render threads (default: available cores, at most 4; at most 64).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_RENDER_THREADS as u64))]
+    pub threads: Option<u64>,
+    /// Control steps to let objects settle before rendering (0.01 s each; at most
+    /// 100 000, 1000 s simulated).
+    #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(0..=MAX_SETTLE_STEPS as i64))]
     pub settle_steps: u32,
 }
+
+/// Most settle steps `nesy render` takes: 1000 s simulated, far past any scene at rest.
+pub const MAX_SETTLE_STEPS: u32 = 100_000;
 
 /// Runs `nesy render`.
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
@@ -40,7 +46,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     };
     let sim =
         Sim::with_config(&spec, config).map_err(|e| e.with_origin(&args.scene.display().to_string()))?;
-    let threads = args.threads.unwrap_or_else(default_threads).max(1);
+    let threads = args.threads.map_or_else(default_threads, |n| n as usize).max(1);
     let started = Instant::now();
     let views = render_views(&sim, args.size, threads);
     let elapsed = started.elapsed();

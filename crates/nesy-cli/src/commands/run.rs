@@ -28,6 +28,9 @@ pub struct RunArgs {
     /// Wall-clock budget of the policy in seconds.
     #[arg(long, default_value_t = 120.0)]
     pub timeout: f64,
+    /// Stop the policy when it makes no robot API call for this many seconds.
+    #[arg(long, value_name = "SECS", default_value_t = 10.0)]
+    pub idle_timeout: f64,
     /// Maximum number of robot action calls.
     #[arg(long, default_value_t = 200)]
     pub max_actions: usize,
@@ -44,16 +47,11 @@ fn parse_embodiment(text: &str) -> Result<Embodiment, String> {
 /// Runs `nesy run`: exit 0 if the policy ran to its end, 1 if it failed in any way, 2 on
 /// bad input.
 pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
-    let source = std::fs::read_to_string(&args.policy)
+    let source = nesy_input::read_text(&args.policy, nesy_input::MAX_POLICY_BYTES)
         .with_context(|| format!("reading the policy {}", args.policy.display()))?;
-    if !(args.timeout.is_finite() && args.timeout > 0.0) {
-        anyhow::bail!(
-            "--timeout must be a positive number of seconds, got {}",
-            args.timeout
-        );
-    }
     let limits = Limits {
-        wall_time_ms: (args.timeout * 1000.0) as u64,
+        wall_time_ms: super::seconds_to_ms("--timeout", args.timeout)?,
+        idle_ms: super::seconds_to_ms("--idle-timeout", args.idle_timeout)?,
         action_calls: args.max_actions,
         ..Limits::default()
     };

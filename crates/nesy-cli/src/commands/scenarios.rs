@@ -242,7 +242,8 @@ fn parse_scenes(text: &str) -> anyhow::Result<Vec<(String, Side)>> {
 /// The scenes of a sweep report that were not fully successful or ended with displaced
 /// objects.
 fn failed_scenes(path: &std::path::Path) -> anyhow::Result<Vec<(String, Side)>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let text = nesy_input::read_text(path, nesy_input::MAX_JSON_BYTES)
+        .with_context(|| format!("reading {}", path.display()))?;
     let mut out = Vec::new();
     for (i, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let v: serde_json::Value = serde_json::from_str(line)

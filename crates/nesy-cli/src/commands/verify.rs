@@ -31,7 +31,8 @@ pub struct VerifyArgs {
 }
 
 fn read(path: &Path) -> anyhow::Result<String> {
-    std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+    nesy_input::read_text(path, nesy_input::MAX_JSON_BYTES)
+        .with_context(|| format!("cannot read {}", path.display()))
 }
 
 fn located(path: &Path, e: ParseError) -> anyhow::Error {

@@ -23,6 +23,8 @@ pub enum AbortReason {
     ApiCalls = 4,
     /// The audit hook refused an operation.
     SandboxViolation = 5,
+    /// No robot API call within the idle limit.
+    Idle = 6,
 }
 
 impl AbortReason {
@@ -33,6 +35,7 @@ impl AbortReason {
             3 => AbortReason::ActionCalls,
             4 => AbortReason::ApiCalls,
             5 => AbortReason::SandboxViolation,
+            6 => AbortReason::Idle,
             _ => return None,
         })
     }
@@ -44,6 +47,7 @@ impl AbortReason {
             AbortReason::Instructions => Some(TimeLimit::Instructions),
             AbortReason::ActionCalls => Some(TimeLimit::ActionCalls),
             AbortReason::ApiCalls => Some(TimeLimit::ApiCalls),
+            AbortReason::Idle => Some(TimeLimit::Idle),
             AbortReason::SandboxViolation => None,
         }
     }
@@ -55,6 +59,7 @@ impl AbortReason {
             AbortReason::Instructions => "policy exceeded its instruction budget",
             AbortReason::ActionCalls => "policy exceeded its budget of robot action calls",
             AbortReason::ApiCalls => "policy exceeded its budget of robot API calls",
+            AbortReason::Idle => "policy made no robot API call within its idle limit",
             AbortReason::SandboxViolation => "the sandbox refused an operation; the episode is terminated",
         }
     }

@@ -5,7 +5,8 @@
 //! Both are needed: a one-line `while True: pass` emits no trace events on 3.11, so only
 //! the asynchronous exception stops it; and a policy that swallows the watchdog's exception
 //! hits the trace function on its very next line. C-level hangs (`7**(10**9)`) hold the
-//! interpreter lock and stop neither: the worker's parent kills those.
+//! interpreter lock and stop neither: the worker's parent kills those. The watchdog also
+//! stops a policy that goes [`crate::Limits::idle_ms`] without a robot API call.
 
 use std::ffi::{CString, c_int};
 use std::sync::Arc;
@@ -22,6 +23,27 @@ use super::abort::{self, AbortReason};
 pub const WATCHDOG_PERIOD: Duration = Duration::from_millis(20);
 
 static REMAINING: AtomicU64 = AtomicU64::new(u64::MAX);
+/// When the policy last made progress (its start or a robot API call), in milliseconds since
+/// [`progress_epoch`].
+static LAST_PROGRESS_MS: AtomicU64 = AtomicU64::new(0);
+
+fn progress_epoch() -> Instant {
+    static EPOCH: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+    *EPOCH.get_or_init(Instant::now)
+}
+
+/// Records that the policy made progress now (called at its start and at every robot API
+/// call), restarting the idle clock.
+pub(crate) fn mark_progress() {
+    let elapsed = Instant::now().saturating_duration_since(progress_epoch());
+    LAST_PROGRESS_MS.store(elapsed.as_millis() as u64, Ordering::Release);
+}
+
+/// How long since the last [`mark_progress`].
+fn since_progress() -> Duration {
+    let last = progress_epoch() + Duration::from_millis(LAST_PROGRESS_MS.load(Ordering::Acquire));
+    Instant::now().saturating_duration_since(last)
+}
 /// The exception type raised for sandbox violations (`robot.SandboxViolation`).
 static VIOLATION_TYPE: AtomicPtr<ffi::PyObject> = AtomicPtr::new(std::ptr::null_mut());
 
@@ -92,8 +114,9 @@ pub(crate) struct Watchdog {
 }
 
 impl Watchdog {
-    /// Starts watching the calling thread (which must hold the GIL) until `deadline`.
-    pub(crate) fn start(_py: Python<'_>, deadline: Instant) -> Watchdog {
+    /// Starts watching the calling thread (which must hold the GIL) until `deadline`, and
+    /// for stretches longer than `idle` without a robot API call.
+    pub(crate) fn start(_py: Python<'_>, deadline: Instant, idle: Duration) -> Watchdog {
         // `PyThreadState_SetAsyncExc` matches the thread's pthread id (what
         // `threading.get_ident()` returns), not `PyThreadState_GetID`.
         // SAFETY: pthread_self has no preconditions.
@@ -102,7 +125,7 @@ impl Watchdog {
         let stop_flag = Arc::clone(&stop);
         let handle = std::thread::Builder::new()
             .name("nesy-policy-watchdog".into())
-            .spawn(move || watch(thread_id, deadline, &stop_flag))
+            .spawn(move || watch(thread_id, deadline, idle, &stop_flag))
             .ok();
         Watchdog { stop, handle }
     }
@@ -141,11 +164,13 @@ impl Watchdog {
     }
 }
 
-fn watch(thread_id: std::ffi::c_long, deadline: Instant, stop: &AtomicBool) {
+fn watch(thread_id: std::ffi::c_long, deadline: Instant, idle: Duration, stop: &AtomicBool) {
     loop {
         let now = Instant::now();
         let wait = if now < deadline && abort::current().is_none() {
-            (deadline - now).min(WATCHDOG_PERIOD)
+            (deadline - now)
+                .min(idle.saturating_sub(since_progress()))
+                .clamp(Duration::from_millis(1), WATCHDOG_PERIOD)
         } else {
             WATCHDOG_PERIOD
         };
@@ -156,6 +181,8 @@ fn watch(thread_id: std::ffi::c_long, deadline: Instant, stop: &AtomicBool) {
         }
         if Instant::now() >= deadline {
             abort::request(AbortReason::WallClock);
+        } else if since_progress() >= idle {
+            abort::request(AbortReason::Idle);
         }
         let Some(reason) = abort::current() else { continue };
         Python::attach(|_py| {

@@ -157,6 +157,13 @@ class Checker(ast.NodeVisitor):
 
 def check(source):
     """Returns a list of (line, column, message); empty if the source may run."""
+    # CPython 3.11 refuses a null byte with ValueError, 3.12 and later with SyntaxError and
+    # other wording: checked here so every version gives the same finding at its position.
+    if "\0" in source:
+        before = source[: source.index("\0")]
+        line = before.count("\n") + 1
+        column = len(before) - (before.rfind("\n") + 1) + 1
+        return [(line, column, "invalid source: a null byte")]
     try:
         tree = ast.parse(source, filename="policy.py", mode="exec")
     except SyntaxError as err:

@@ -72,6 +72,9 @@ pub(crate) fn call<T: Send>(
     let Some(episode) = guard.as_mut() else {
         return Err(Refusal::NoEpisode);
     };
+    // Time inside a call (a long move simulating) is not idle time: the clock restarts both
+    // when the call starts and when it returns.
+    super::budget::mark_progress();
     episode.api_calls += 1;
     if episode.api_calls > episode.api_budget {
         abort::request(AbortReason::ApiCalls);
@@ -87,6 +90,7 @@ pub(crate) fn call<T: Send>(
     let robot: &mut dyn Episode = &mut *episode.robot;
     let robot: &mut (dyn RobotApi + Send) = robot;
     let value = py.detach(move || f(robot));
+    super::budget::mark_progress();
     if let Some(sink) = episode.sink.as_mut() {
         let trace = episode.robot.trace();
         for entry in &trace[episode.streamed.min(trace.len())..] {

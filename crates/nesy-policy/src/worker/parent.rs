@@ -201,6 +201,12 @@ fn run(
     });
 
     let kill_at = started + Duration::from_millis(limits.wall_time_ms + limits.kill_grace_ms);
+    // The watchdog inside the worker stops an idle policy that still runs bytecode; one stuck
+    // in C code holds the interpreter lock, so the parent also kills a worker that has sent
+    // nothing (no `Ready`, no API call) for the idle limit plus the grace.
+    let idle_grace = Duration::from_millis(limits.idle_ms.saturating_add(limits.kill_grace_ms));
+    let mut last_heard = Instant::now();
+    let mut idle_kill = false;
     let mut trace = Vec::new();
     let mut startup_s = None;
     let mut final_result = None;
@@ -208,14 +214,22 @@ fn run(
     let mut killed_by_parent = false;
     loop {
         let now = Instant::now();
-        if now >= kill_at {
+        let idle_at = last_heard + idle_grace;
+        if now >= kill_at || now >= idle_at {
             kill_group(&mut child);
             killed_by_parent = true;
+            idle_kill = now < kill_at;
             break;
         }
-        match rx.recv_timeout(kill_at - now) {
-            Ok(WorkerMessage::Ready { startup_s: s, .. }) => startup_s = Some(s),
-            Ok(WorkerMessage::Trace { entry, .. }) => trace.push(entry),
+        match rx.recv_timeout(kill_at.min(idle_at) - now) {
+            Ok(WorkerMessage::Ready { startup_s: s, .. }) => {
+                startup_s = Some(s);
+                last_heard = Instant::now();
+            }
+            Ok(WorkerMessage::Trace { entry, .. }) => {
+                trace.push(entry);
+                last_heard = Instant::now();
+            }
             Ok(WorkerMessage::Result { result, .. }) => {
                 final_result = Some(*result);
                 break;
@@ -255,7 +269,11 @@ fn run(
     }
     let outcome = if killed_by_parent {
         Outcome::Timeout {
-            limit: TimeLimit::ParentKill,
+            limit: if idle_kill {
+                TimeLimit::Idle
+            } else {
+                TimeLimit::ParentKill
+            },
             error: None,
         }
     } else {

@@ -120,7 +120,7 @@ fn parse_frame_name(name: &str) -> Option<(usize, CameraName, bool)> {
 }
 
 fn read_file(path: &Path) -> Result<Vec<u8>, DemoError> {
-    std::fs::read(path).map_err(|e| DemoError::io(path, e))
+    nesy_input::read_bytes(path, nesy_input::MAX_IMAGE_BYTES).map_err(|e| DemoError::io(path, e))
 }
 
 /// Reads a demo folder.

@@ -340,7 +340,8 @@ pub fn write_mcap_file(demo: &Demo, path: &Path) -> Result<(), DemoError> {
 
 /// Reads a `demo.mcap` file.
 pub fn read_mcap(path: &Path) -> Result<Demo, DemoError> {
-    let bytes = std::fs::read(path).map_err(|e| DemoError::io(path, e))?;
+    let bytes =
+        nesy_input::read_bytes(path, nesy_input::MAX_DEMO_BYTES).map_err(|e| DemoError::io(path, e))?;
     read_mcap_bytes(&bytes, path)
 }
 

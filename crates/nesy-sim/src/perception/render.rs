@@ -434,6 +434,10 @@ pub fn render_views(sim: &Sim, size: u32, threads: usize) -> Vec<View> {
         .collect()
 }
 
+/// Most render threads a caller may ask for: a view is split into rows, so more threads than
+/// this only add start-up cost.
+pub const MAX_RENDER_THREADS: usize = 64;
+
 /// Number of threads the renderer uses by default: the available cores, at most 4.
 pub fn default_threads() -> usize {
     std::thread::available_parallelism()

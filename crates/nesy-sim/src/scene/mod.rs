@@ -316,10 +316,11 @@ impl SceneSpec {
 
     /// Reads, parses and validates a scene file.
     pub fn from_file(path: &Path) -> Result<SceneSpec, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text =
+            nesy_input::read_text(path, nesy_input::MAX_JSON_BYTES).map_err(|source| SceneError::Io {
+                path: path.display().to_string(),
+                source,
+            })?;
         SceneSpec::from_json_str(&text, &path.display().to_string())
     }
 
@@ -355,6 +356,13 @@ impl SceneSpec {
                 self.schema_version.to_string(),
             ));
         }
+        if self.objects.len() > MAX_SCENE_OBJECTS {
+            return Err(SceneError::invalid(
+                "objects",
+                format!("at most {MAX_SCENE_OBJECTS} objects"),
+                format!("{} objects", self.objects.len()),
+            ));
+        }
         let reserved = [parts::FLOOR, parts::GRIPPER, parts::VACUUM_GRIPPER];
         let mut seen: HashSet<String> = reserved.iter().map(|s| s.to_string()).collect();
         for (i, o) in self.objects.iter().enumerate() {
@@ -385,10 +393,11 @@ impl SceneSpec {
                 }
             }
             for (k, v) in o.pose.position.iter().enumerate() {
-                if !v.is_finite() {
+                let (lo, hi) = SCENE_POSITION_BOUNDS[k];
+                if !(v.is_finite() && (lo..=hi).contains(v)) {
                     return Err(SceneError::invalid(
                         at(&format!("pose.position[{k}]")),
-                        "a finite number",
+                        format!("a position in metres from {lo} to {hi} (the table and the space around it)"),
                         v.to_string(),
                     ));
                 }
@@ -409,10 +418,10 @@ impl SceneSpec {
                     ));
                 }
                 for (k, v) in size.iter().enumerate() {
-                    if !(v.is_finite() && *v > 0.0 && *v <= 2.0) {
+                    if !(v.is_finite() && (MIN_OBJECT_SIZE..=2.0).contains(v)) {
                         return Err(SceneError::invalid(
                             at(&format!("size[{k}]")),
-                            "a positive size in metres (at most 2)",
+                            format!("a size in metres from {MIN_OBJECT_SIZE} to 2"),
                             v.to_string(),
                         ));
                     }
@@ -455,6 +464,20 @@ impl SceneSpec {
             }
         }
         for (g, goal) in self.goals.iter().enumerate() {
+            let (field, moved) = match goal {
+                SubtaskGoal::Sweep { placements } => ("placements", placements.len()),
+                SubtaskGoal::PickPlace { objects, .. }
+                | SubtaskGoal::PutInHinge { objects, .. }
+                | SubtaskGoal::PutInPrismatic { objects, .. } => ("objects", objects.len()),
+            };
+            if moved == 0 {
+                // An empty goal would be met by doing nothing.
+                return Err(SceneError::invalid(
+                    format!("goals[{g}].{field}"),
+                    "at least one object",
+                    "an empty list",
+                ));
+            }
             for (field, name) in goal.referenced_names() {
                 if !seen.contains(name) || reserved.contains(&name) {
                     return Err(SceneError::invalid(
@@ -468,6 +491,17 @@ impl SceneSpec {
         Ok(())
     }
 }
+
+/// Most objects a scene may hold (the benchmark's largest has 16, with 26 parts).
+pub const MAX_SCENE_OBJECTS: usize = 100;
+
+/// Range (m) of each coordinate of an object's position: x and y within 2 m of the robot's
+/// base (the table is 1 m deep), z from the ground to 2 m above it. Anything outside is a
+/// typing error, and far-off values overflow the simulator's single-precision floats.
+pub const SCENE_POSITION_BOUNDS: [(f64, f64); 3] = [(-2.0, 2.0), (-2.0, 2.0), (0.0, 2.0)];
+
+/// Smallest side (m) of an object: 1 mm. Smaller shapes make the contact solver diverge.
+pub const MIN_OBJECT_SIZE: f64 = 0.001;
 
 /// The JSON Schema of [`SceneSpec`], pretty-printed (committed at
 /// `assets/schema/scene.schema.json`).

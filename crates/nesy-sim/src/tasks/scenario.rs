@@ -289,10 +289,11 @@ impl ConfigFile {
 
     /// Reads a configuration file.
     pub fn from_file(path: &Path) -> Result<ConfigFile, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text =
+            nesy_input::read_text(path, nesy_input::MAX_JSON_BYTES).map_err(|source| ScenarioError::Io {
+                path: path.display().to_string(),
+                source,
+            })?;
         ConfigFile::from_json_str(&text, &path.display().to_string())
     }
 

@@ -10,6 +10,7 @@ use super::{FLOOR_AABB, HandleGrasp, Sim};
 use crate::api::{
     ApiCall, ApiError, ApiValue, Direction, Embodiment, HANDLE_REACH, MAX_FINGER_DEPTH, RobotApi, TraceEntry,
 };
+use crate::robot::kinematics::IkOptions;
 use crate::robot::model::FINGER_OPEN;
 use crate::robot::motion::{MOTION_SETTLE_STEPS, PARALLEL_MIN_DURATION, ToolGoal};
 use crate::scene::parts;
@@ -43,6 +44,8 @@ const FINGER_MARGIN: f64 = 0.005;
 /// A neighbour counts as beside the object when its top is this much (m) above the object's
 /// bottom.
 const LEVEL_TOLERANCE: f64 = 0.005;
+/// Fractions of the lift clearance tried, largest first, when the full lift is out of reach.
+const LIFT_FRACTIONS: [f64; 4] = [1.0, 0.75, 0.5, 0.25];
 
 /// The table-plane footprint of a hand above an object: points at `s` along its closing
 /// axis and `t` across it, from the object's centre.
@@ -277,8 +280,9 @@ impl Sim {
         let mut transit = None;
         if clearance > 0.0 {
             if self.moved_since_reset {
+                let lift = self.reachable_lift(lift_from, current_dir, &current.rotation, clearance);
                 waypoints.push(ToolGoal {
-                    position: lift_from - current_dir * clearance,
+                    position: lift_from - current_dir * lift,
                     rotation: current.rotation,
                 });
             }
@@ -304,6 +308,39 @@ impl Sim {
         self.execute(&plan, MOTION_SETTLE_STEPS);
         self.moved_since_reset = true;
         Ok(())
+    }
+
+    /// How far the tool backs off along its axis before a transit: the full `clearance`
+    /// where the arm reaches that point, else the largest reachable fraction of it. Close to
+    /// the base the arm cannot rise as high pointing down (its elbow would have to fold past
+    /// its limit), and an object put down there left the hand unable to leave.
+    fn reachable_lift(
+        &self,
+        from: Vector3<f64>,
+        tool_axis: Vector3<f64>,
+        rotation: &UnitQuaternion<f64>,
+        clearance: f64,
+    ) -> f64 {
+        // A single quick solve settles the common case; the planner's full search with
+        // restarts only runs when it fails.
+        let quick = IkOptions {
+            restarts: 1,
+            iterations: 60,
+            ..IkOptions::default()
+        };
+        let reaches = |lift: f64| {
+            let goal = ToolGoal {
+                position: from - tool_axis * lift,
+                rotation: *rotation,
+            };
+            self.ik(&goal, &self.q, &quick).is_some()
+                || self.ik(&goal, &self.q, &IkOptions::default()).is_some()
+        };
+        LIFT_FRACTIONS
+            .iter()
+            .map(|fraction| clearance * fraction)
+            .find(|&lift| reaches(lift))
+            .unwrap_or(clearance)
     }
 
     fn do_move_gripper_to(&mut self, name: &str, pointing: Direction, depth: f64) -> Result<(), ApiError> {

@@ -23,6 +23,15 @@ const DYNAMIC_CCD: bool = true;
 /// about 5 mm a fruit resting on its rounded edge rocked without end: the contact vanished
 /// at each swing's far end and came back with energy, so the fruit never came to rest.
 const PREDICTION_DISTANCE: f32 = 0.005;
+/// Speed (m/s, of the body's farthest point, solver corrections included) under which a loose
+/// object counts as at rest. Rapier's default, 5 cm/s, would put a slowly sliding or tipping
+/// object to sleep mid-motion; at 2 mm/s only objects that have stopped sleep (resting
+/// contact jitter is far below it).
+const SLEEP_SPEED: f32 = 0.002;
+/// How long (s) a loose object stays under [`SLEEP_SPEED`] before it sleeps. A sleeping body
+/// costs the solver nothing; any contact with a moving body (the arm, a carried or falling
+/// object) or a new joint wakes it and its island.
+const SLEEP_AFTER: f32 = 1.0;
 /// Deepest overlap (m) between two objects, or an object and the table, that a scene may
 /// start with.
 const MAX_START_OVERLAP: f64 = 0.0015;
@@ -165,6 +174,11 @@ impl WorldBuilder {
                     _ => (None, frame * build.offset),
                 };
                 let body = self.world.insert_body(body_builder(build, spec).pose(pose));
+                if build.motion == PartMotion::Dynamic {
+                    let activation = self.world.bodies[body].activation_mut();
+                    activation.normalized_linear_threshold = SLEEP_SPEED;
+                    activation.time_until_sleep = SLEEP_AFTER;
+                }
                 let colliders = self.add_part_colliders(build, spec, body, part_index);
                 parts.push(Part {
                     name: build.name.clone(),
@@ -328,7 +342,7 @@ fn body_builder(build: &PartBuild, spec: &ObjectSpec) -> RigidBodyBuilder {
         PartMotion::Dynamic => RigidBodyBuilder::dynamic()
             .ccd_enabled(DYNAMIC_CCD)
             .angular_damping(objects::angular_damping(spec.kind))
-            .can_sleep(false),
+            .can_sleep(true),
         PartMotion::Fixed => RigidBodyBuilder::fixed(),
         PartMotion::Articulated => RigidBodyBuilder::kinematic_position_based().can_sleep(false),
     }

@@ -28,9 +28,9 @@ pub const PIECE_BASE_DENSITY: f32 = 5.0 * DENSITY;
 
 /// Angular damping (1/s) of round objects' bodies. Rapier has no rolling resistance: a fruit
 /// or a fallen cylinder touched by the arm or a neighbour rolled (or wobbled on its rounded
-/// rim) at a few cm/s without ever stopping, until it left the workspace or fell off the
-/// table. Damping the spin makes the friction at the contact stop the roll within a second;
-/// it does not slow free falls or slides.
+/// rim) for metres. Damping the spin makes the friction at the contact stop the roll within
+/// a second; it does not slow free falls or slides. (Damping alone did not stop a fruit's
+/// implicit round cylinder lying on its side, which is why fruits are hulls.)
 pub const ROUND_ANGULAR_DAMPING: f32 = 50.0;
 
 /// Angular damping of a kind's body.
@@ -313,14 +313,40 @@ fn fixed(name: &str, role: PartRole, shapes: Vec<ShapeBuild>) -> PartBuild {
     }
 }
 
+/// Points around the circle at each ring of the fruit's hull.
+const FRUIT_HULL_SEGMENTS: usize = 16;
+/// Rings over each quarter-round border of the fruit's hull.
+const FRUIT_HULL_RINGS: usize = 3;
+
 fn round_fruit(size: [f32; 3], colour: [f32; 3]) -> ShapeBuild {
     // A round-edged cylinder: round from above and the side, with a small flat base so
-    // fruit rests instead of rolling away (rapier has no rolling resistance).
+    // fruit rests instead of rolling away (rapier has no rolling resistance). It is built as
+    // a convex hull sampled on that surface rather than rapier's implicit round cylinder: a
+    // round or plain cylinder lying on its side on a box gains spin from its contact manifold
+    // and keeps rolling at a few cm/s whatever the damping, while the polyhedron comes to rest.
     let radius = size[0].min(size[1]) / 2.0;
     let half_h = size[2] / 2.0;
     let border = (radius * 0.6).min(half_h * 0.9);
+    let mut points = Vec::with_capacity(2 * FRUIT_HULL_SEGMENTS * (FRUIT_HULL_RINGS + 1));
+    for ring in 0..=FRUIT_HULL_RINGS {
+        // From the equator of the border (phi = 0) to the edge of the flat face (phi = pi/2).
+        let phi = std::f32::consts::FRAC_PI_2 * ring as f32 / FRUIT_HULL_RINGS as f32;
+        let ring_radius = radius - border + border * phi.cos();
+        let ring_height = half_h - border + border * phi.sin();
+        for segment in 0..FRUIT_HULL_SEGMENTS {
+            let theta = std::f32::consts::TAU * segment as f32 / FRUIT_HULL_SEGMENTS as f32;
+            let (x, z) = (ring_radius * theta.cos(), ring_radius * theta.sin());
+            // The cylinder's axis is y in the shape's frame, as for parry's cylinders.
+            points.push(v(x, ring_height, z));
+            points.push(v(x, -ring_height, z));
+        }
+    }
+    // A hull of points too close to tell apart (a sub-micron fruit) falls back to the
+    // implicit shape rather than failing the scene.
+    let shape = SharedShape::convex_hull(&points)
+        .unwrap_or_else(|| SharedShape::round_cylinder(half_h - border, radius - border, border));
     ShapeBuild {
-        shape: SharedShape::round_cylinder(half_h - border, radius - border, border),
+        shape,
         local: Pose::from_parts(v(0.0, 0.0, half_h), upright()),
         colour,
         pattern: Pattern::Plain,
@@ -539,5 +565,47 @@ pub fn joint_motion(joint: JointBuild, q: f64) -> Pose {
             rapier3d::prelude::Rotation::from_rotation_y((q - closed_q) as f32),
         ),
         JointBuild::Prismatic => Pose::from_translation(v(0.0, -(q as f32), 0.0)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::Sim;
+    use crate::scene::SceneSpec;
+    use rapier3d::prelude::{Rotation, Vector};
+
+    /// A fruit knocked onto its side, rolling slowly as the arm left it: Rapier's implicit
+    /// round cylinder kept rolling at about 2 cm/s (its contact with the table fed the spin
+    /// back in whatever the damping) until it left the table; the hull comes to rest.
+    #[test]
+    fn a_fruit_lying_on_its_side_comes_to_rest() {
+        for kind in ["apple", "orange", "lemon"] {
+            let scene = serde_json::json!({
+                "schema_version": 1,
+                "embodiment": "finger",
+                "objects": [{"name": kind, "kind": kind, "pose": {"position": [0.45, 0.1, 0.5], "yaw": 0.0}}],
+                "goals": []
+            });
+            let scene = SceneSpec::from_json_str(&scene.to_string(), "fruit").unwrap();
+            let mut sim = Sim::new(&scene).unwrap();
+            let part = sim.part_index(kind).unwrap();
+            let radius = sim.part_aabb(part).size()[0] / 2.0;
+            let handle = sim.parts()[part].body;
+            let body = &mut sim.world.bodies[handle];
+            // Lying with its axis along y, centre one radius above the table, rolling along
+            // -x (the state a traced run left an orange in).
+            body.set_translation(Vector::new(0.45, 0.1, 0.5 + radius as f32 + 1e-4), true);
+            body.set_rotation(Rotation::from_rotation_x(std::f32::consts::FRAC_PI_2), true);
+            body.set_linvel(Vector::new(-0.022, -0.003, 0.0), true);
+            body.set_angvel(Vector::new(0.09, -0.69, 0.0), true);
+            sim.step_idle(500);
+            let speed = sim.part_velocity(part).iter().map(|v| v * v).sum::<f64>().sqrt();
+            let p = sim.part_pose(part).translation.vector;
+            assert!(speed < 1e-3, "{kind} still moves at {speed:.4} m/s");
+            assert!(
+                (p.x - 0.45).abs() < 0.05 && (p.y - 0.1).abs() < 0.05,
+                "{kind} rolled to {p:?}"
+            );
+        }
     }
 }

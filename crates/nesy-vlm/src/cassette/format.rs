@@ -177,9 +177,11 @@ impl CassetteFile {
 
     /// Reads a cassette; errors name the file, line and column.
     pub fn load(path: &Path) -> Result<Self, CassetteError> {
-        let text = fs::read_to_string(path).map_err(|source| CassetteError::Io {
-            path: path.to_path_buf(),
-            error: source,
+        let text = nesy_input::read_text(path, nesy_input::MAX_CASSETTE_BYTES).map_err(|source| {
+            CassetteError::Io {
+                path: path.to_path_buf(),
+                error: source,
+            }
         })?;
         Self::parse(path, &text)
     }
@@ -225,10 +227,8 @@ impl CassetteFile {
     pub fn to_pretty_json(&self, redactions: &[SecretString]) -> String {
         // Serialising plain data to a String cannot fail.
         let mut text = serde_json::to_string_pretty(self).unwrap_or_default();
-        for secret in redactions.iter().filter(|s| s.expose().len() >= 8) {
-            if text.contains(secret.expose()) {
-                text = text.replace(secret.expose(), "[REDACTED]");
-            }
+        for secret in redactions {
+            text = secret.redact_in(&text);
         }
         text.push('\n');
         text

@@ -11,6 +11,7 @@ use sha2::{Digest, Sha256};
 use super::canonical::{BLOB_SCHEME, hex, request_key};
 use super::format::{CassetteFile, blobs_dir, write_atomically};
 use super::{CassetteError, InteractionRef, UsageReport};
+use crate::error::truncate_chars;
 
 /// One interaction as `inspect` lists it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -171,11 +172,27 @@ pub fn verify(path: &Path) -> Result<Vec<Problem>, CassetteError> {
                 ),
             });
         }
-        if let Err(message) = interaction.response.to_wire(crate::transport::Origin::Replayed) {
-            problems.push(Problem {
+        match interaction.response.to_wire(crate::transport::Origin::Replayed) {
+            Err(message) => problems.push(Problem {
                 interaction: at,
                 message: format!("response: {message}"),
-            });
+            }),
+            // A replayed success must be a completion; an empty one fails every replay.
+            Ok(wire) if wire.is_success() && wire.body.is_empty() => problems.push(Problem {
+                interaction: at,
+                message: format!("response: status {} with no body", wire.status),
+            }),
+            Ok(_) => {}
+        }
+        for name in interaction.response.headers.keys() {
+            if !crate::transport::is_allowed_header(name) {
+                problems.push(Problem {
+                    interaction: at,
+                    message: format!(
+                        "response header `{name}` is not on the allowlist (a recorder never stores it; it may hold a credential)"
+                    ),
+                });
+            }
         }
         let mut refs = Vec::new();
         collect_refs(&interaction.request.body, &mut refs);
@@ -189,14 +206,14 @@ pub fn verify(path: &Path) -> Result<Vec<Problem>, CassetteError> {
                 }
                 continue;
             }
-            let blob = blobs.join(&name);
-            let expected = name.split('.').next().unwrap_or_default();
-            let result = match fs::read(&blob) {
-                Err(err) => Err(format!("blob {} is missing: {err}", blob.display())),
-                Ok(bytes) if hex(&Sha256::digest(&bytes)) != expected => {
-                    Err(format!("blob {} does not hash to its name", blob.display()))
-                }
-                Ok(_) => Ok(()),
+            let result = if is_blob_name(&name) {
+                check_blob(&blobs.join(&name), name.split('.').next().unwrap_or_default())
+            } else {
+                // Never a path: `../`, `/dev/zero` or a pipe must not be opened.
+                Err(format!(
+                    "blob reference {:?} is not a content address (expected {BLOB_SCHEME}<64 hex digits>.<extension>)",
+                    truncate_chars(&name, 80)
+                ))
             };
             checked.insert(name, result.is_ok());
             if let Err(message) = result {
@@ -208,6 +225,45 @@ pub fn verify(path: &Path) -> Result<Vec<Problem>, CassetteError> {
         }
     }
     Ok(problems)
+}
+
+/// Largest blob `verify` reads (a keyframe PNG is well under 1 MiB).
+pub const MAX_BLOB_BYTES: u64 = 64 << 20;
+
+/// Whether a blob reference is a bare content address, `<64 lowercase hex>.<1–8 [a-z0-9]>`.
+fn is_blob_name(name: &str) -> bool {
+    let Some((digest, ext)) = name.split_once('.') else {
+        return false;
+    };
+    digest.len() == 64
+        && digest.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f'))
+        && (1..=8).contains(&ext.len())
+        && ext.bytes().all(|b| b.is_ascii_lowercase() || b.is_ascii_digit())
+}
+
+/// Reads one blob, if it is a regular file of at most [`MAX_BLOB_BYTES`], and checks it
+/// hashes to `expected`.
+fn check_blob(blob: &Path, expected: &str) -> Result<(), String> {
+    use std::io::Read as _;
+    let shown = blob.display();
+    let meta = fs::metadata(blob).map_err(|err| format!("blob {shown} is missing: {err}"))?;
+    if !meta.is_file() {
+        return Err(format!("blob {shown} is not a regular file"));
+    }
+    if meta.len() > MAX_BLOB_BYTES {
+        return Err(format!(
+            "blob {shown} is {} bytes, more than the {MAX_BLOB_BYTES} a blob may hold",
+            meta.len()
+        ));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    fs::File::open(blob)
+        .and_then(|file| file.take(MAX_BLOB_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(|err| format!("blob {shown} cannot be read: {err}"))?;
+    if hex(&Sha256::digest(&bytes)) != expected {
+        return Err(format!("blob {shown} does not hash to its name"));
+    }
+    Ok(())
 }
 
 /// What `prune` did (or would do, in a dry run).
@@ -324,10 +380,11 @@ fn orphan_blobs(cassette: &Path, pending: Option<&CassetteFile>) -> Result<Vec<P
 
 /// Reads a usage report written by a cassette run.
 pub fn load_usage_report(path: &Path) -> Result<UsageReport, CassetteError> {
-    let text = fs::read_to_string(path).map_err(|source| CassetteError::Io {
-        path: path.to_path_buf(),
-        error: source,
-    })?;
+    let text =
+        nesy_input::read_text(path, nesy_input::MAX_JSON_BYTES).map_err(|source| CassetteError::Io {
+            path: path.to_path_buf(),
+            error: source,
+        })?;
     serde_json::from_str(&text).map_err(|err| CassetteError::Parse {
         path: path.to_path_buf(),
         line: err.line(),

@@ -1,0 +1,79 @@
+//! `nesy run` on policies that stop making progress: a Python spin and a C-level hang are
+//! stopped at the idle limit, long before the wall-clock budget, and reported as a timeout.
+
+mod common;
+
+use std::time::{Duration, Instant};
+
+use serde_json::Value;
+
+/// Runs `policy` on the pick-and-place scene with a 1 s idle limit and a 120 s wall clock;
+/// returns the JSON result and how long the run took.
+fn run_policy(policy: &str) -> (Value, Duration) {
+    let dir = common::scratch();
+    let path = dir.path().join("spin.py");
+    std::fs::write(&path, policy).unwrap();
+    let started = Instant::now();
+    let output = common::nesy(&[
+        "run".into(),
+        "--scene".into(),
+        "fixtures/scenes/pick_place_finger.json".into(),
+        "--policy".into(),
+        path.display().to_string(),
+        "--idle-timeout".into(),
+        "1".into(),
+        "--json".into(),
+    ]);
+    let took = started.elapsed();
+    assert_eq!(
+        output.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    (serde_json::from_slice(&output.stdout).expect("JSON result"), took)
+}
+
+#[test]
+fn a_policy_spinning_in_python_is_stopped_at_the_idle_limit() {
+    let (result, took) = run_policy("get_obj_names()\nwhile True: pass\n");
+    assert_eq!(result["outcome"]["kind"], "timeout", "{result}");
+    assert_eq!(result["outcome"]["limit"], "idle", "{result}");
+    assert_eq!(result["trace"].as_array().unwrap().len(), 1, "{result}");
+    assert!(took < Duration::from_secs(20), "{took:?}");
+}
+
+#[test]
+fn a_policy_hanging_in_c_is_killed_at_the_idle_limit() {
+    // One big-integer power holds the interpreter lock for minutes; only the parent can stop it.
+    let (result, took) = run_policy("get_obj_names()\nx = 7 ** (10 ** 9)\n");
+    assert_eq!(result["outcome"]["kind"], "timeout", "{result}");
+    assert_eq!(result["outcome"]["limit"], "idle", "{result}");
+    // 1 s idle + 3 s grace, far under the 120 s wall clock.
+    assert!(took < Duration::from_secs(20), "{took:?}");
+}
+
+#[test]
+fn the_default_idle_limit_stops_a_spin_within_fifteen_seconds() {
+    let limits = nesy_policy::Limits::default();
+    assert!(limits.idle_ms + limits.kill_grace_ms <= 15_000, "{limits:?}");
+}
+
+#[test]
+fn a_bad_idle_limit_names_its_flag() {
+    let output = common::nesy(&[
+        "run".into(),
+        "--scene".into(),
+        "fixtures/scenes/pick_place_finger.json".into(),
+        "--policy".into(),
+        "fixtures/scenes/pick_place_finger.json".into(),
+        "--idle-timeout".into(),
+        "NaN".into(),
+    ]);
+    assert_ne!(output.status.code(), Some(0));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("--idle-timeout must be a positive number"),
+        "{stderr}"
+    );
+}
