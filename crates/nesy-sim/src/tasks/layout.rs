@@ -1,6 +1,8 @@
 //! Where the scripted experts put things and how they move the articulated parts. The
 //! template compiler emits the same numbers into its programs and the tests check against
-//! them, so a compiled policy places objects exactly where the expert does.
+//! them, so a compiled policy places objects where the expert does; the one difference is
+//! that the expert moves a fruit's drop spot in the hinge box away from fruits that landed
+//! off theirs ([`hinge_drop_spot`]), while a compiled policy drops at [`HINGE_SPOTS`].
 
 use crate::world::FLOOR_AABB;
 
@@ -16,9 +18,113 @@ pub const TOY_BOX_CELLS: [[f64; 2]; 6] = [
     [0.042, 0.022],
 ];
 
-/// Fruit drop spots along the hinge box's long side (y offsets, m): fruits are round with a
-/// flat base and do not roll aside when dropped onto each other.
+/// Fruit drop spots along the hinge box's long side (y offsets, m). The template compiler
+/// drops at these; the scripted expert starts from them and then keeps clear of the fruits
+/// already in the box ([`hinge_drop_spot`]).
 pub const HINGE_SPOTS: [f64; 3] = [-0.06, 0.0, 0.06];
+
+/// Clearance (m) a dropped fruit's footprint keeps from the hinge box's inner walls.
+pub const HINGE_WALL_MARGIN: f64 = 0.003;
+
+/// Where the expert drops a fruit of footprint radius `radius` into the hinge box whose inside
+/// spans `inside` (`[[x_min, y_min], [x_max, y_max]]`), given the fruits already in the box
+/// (footprint centre and radius each) and the radii of the fruits still to come after it, as
+/// an `[x, y]` point.
+///
+/// Fixed spots 6 cm apart do not hold three fruits up to 6.4 cm across: a fruit that lands a
+/// centimetre or two off its spot (it falls about 14 cm from above the rim) has the next one
+/// dropped onto its edge, the pair stacks, and the closing lid comes down on the stack. So the
+/// spot is chosen on a grid over the inside (the footprint kept [`HINGE_WALL_MARGIN`] inside
+/// the walls) to leave the most room, both to the fruits where they actually lie and to the
+/// fruits still to come (each placed in turn where it has the most room); with room enough
+/// everywhere (the box empty), the point nearest `nominal` wins.
+///
+/// ```
+/// use nesy_sim::tasks::layout::hinge_drop_spot;
+/// let inside = [[0.0, 0.0], [0.0925, 0.195]];
+/// // An empty box and nothing to follow: the nominal spot.
+/// assert_eq!(hinge_drop_spot(inside, 0.03, &[], &[], [0.046, 0.04]), [0.046, 0.04]);
+/// // An apple that landed in the middle: the next fruit goes to an end, not onto it.
+/// let spot = hinge_drop_spot(inside, 0.03, &[([0.046, 0.0975], 0.029)], &[], [0.046, 0.0975]);
+/// assert!((spot[1] - 0.0975).abs() > 0.059);
+/// ```
+pub fn hinge_drop_spot(
+    inside: [[f64; 2]; 2],
+    radius: f64,
+    placed: &[([f64; 2], f64)],
+    upcoming: &[f64],
+    nominal: [f64; 2],
+) -> [f64; 2] {
+    let distance = |p: [f64; 2]| (p[0] - nominal[0]).powi(2) + (p[1] - nominal[1]).powi(2);
+    let score = |p: [f64; 2]| {
+        let mut lying = placed.to_vec();
+        let mut worst = room(p, radius, &lying);
+        lying.push((p, radius));
+        for &r in upcoming {
+            // The later fruit where it has the most room (its own nominal spot is unknown here).
+            let q = HingeGrid::new(inside, r)
+                .points()
+                .max_by(|a, b| room(*a, r, &lying).total_cmp(&room(*b, r, &lying)))
+                .unwrap_or(p);
+            worst = worst.min(room(q, r, &lying));
+            lying.push((q, r));
+        }
+        worst.min(ENOUGH_ROOM)
+    };
+    let grid = HingeGrid::new(inside, radius);
+    let mut best = grid.clamp(nominal);
+    let mut best_key = (score(best), -distance(best));
+    for p in grid.points() {
+        let key = (score(p), -distance(p));
+        if key > best_key {
+            best = p;
+            best_key = key;
+        }
+    }
+    best
+}
+
+/// Room (m) beyond touching that counts as enough: a spot with this much to every other fruit
+/// is as good as one with more, so the nominal spot is kept when it has it.
+const ENOUGH_ROOM: f64 = 0.008;
+
+/// Room (m) beyond touching between a fruit at `p` of radius `radius` and the nearest of
+/// `lying` (infinite with none).
+fn room(p: [f64; 2], radius: f64, lying: &[([f64; 2], f64)]) -> f64 {
+    lying
+        .iter()
+        .map(|(c, r)| ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2)).sqrt() - r - radius)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The candidate centres of a fruit of one radius in the hinge box: a grid over the inside,
+/// kept [`HINGE_WALL_MARGIN`] from the walls.
+struct HingeGrid {
+    lo: [f64; 2],
+    hi: [f64; 2],
+}
+
+impl HingeGrid {
+    /// Points along x and y.
+    const STEPS: [usize; 2] = [7, 33];
+
+    fn new(inside: [[f64; 2]; 2], radius: f64) -> Self {
+        let lo = [0, 1].map(|k| inside[0][k] + radius + HINGE_WALL_MARGIN);
+        let hi = [0, 1].map(|k| (inside[1][k] - radius - HINGE_WALL_MARGIN).max(lo[k]));
+        HingeGrid { lo, hi }
+    }
+
+    fn clamp(&self, p: [f64; 2]) -> [f64; 2] {
+        [0, 1].map(|k| p[k].clamp(self.lo[k], self.hi[k]))
+    }
+
+    fn points(&self) -> impl Iterator<Item = [f64; 2]> + '_ {
+        let at = |k: usize, i: usize| {
+            self.lo[k] + (self.hi[k] - self.lo[k]) * i as f64 / (Self::STEPS[k] - 1) as f64
+        };
+        (0..Self::STEPS[0]).flat_map(move |i| (0..Self::STEPS[1]).map(move |j| [at(0, i), at(1, j)]))
+    }
+}
 
 /// Cylinder drop spots in the bottom drawer (x offset, outward y offset from the drawer's
 /// centre, m). They are 5 cm or more apart, because a cylinder dropped onto another one tips

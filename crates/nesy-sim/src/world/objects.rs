@@ -425,6 +425,9 @@ pub fn build_object(spec: &ObjectSpec) -> Vec<PartBuild> {
     }
 }
 
+/// Wall thickness (m) of the hinge box's body.
+pub const HINGE_BOX_WALL: f32 = 0.005;
+
 /// Hinge box geometry: body 0.1025 × 0.205 × 0.1165 open at the top; lid 0.109 × 0.21 ×
 /// 0.01 hinged about y at the body's far (+x) top edge; a handle block on the lid's free
 /// (−x) edge.
@@ -433,7 +436,7 @@ fn hinge_box(colour: [f32; 3]) -> Vec<PartBuild> {
     let body = fixed(
         parts::HINGE_BODY,
         PartRole::ArticulatedBody,
-        open_box([bx, by, bz], 0.005, colour),
+        open_box([bx, by, bz], HINGE_BOX_WALL, colour),
     );
     let lid_len = 0.109_f32;
     let lid_colour = [colour[0] * 0.8, colour[1] * 0.8, colour[2] * 0.9];

@@ -5,7 +5,10 @@ use super::ExpertError;
 use super::hand::{Hand, centre, overlaps_xy, size};
 use crate::api::RobotApi;
 use crate::scene::parts;
-use crate::tasks::layout::{HINGE_DROP_CLEARANCE, HINGE_SPOTS, LID_CLOSING_ARC, LID_OPENING_ARC};
+use crate::tasks::layout::{
+    HINGE_DROP_CLEARANCE, HINGE_SPOTS, LID_CLOSING_ARC, LID_OPENING_ARC, hinge_drop_spot,
+};
+use crate::world::objects::HINGE_BOX_WALL;
 
 /// Swings of the lid tried before the expert carries on regardless.
 const SWING_ATTEMPTS: usize = 3;
@@ -35,18 +38,59 @@ pub(super) fn run<R: RobotApi + ?Sized>(
         swing_until(hand, lid, axis, y, reach, &LID_OPENING_ARC, true)?;
     }
     for (k, fruit) in fruits.iter().enumerate() {
-        let h = hand.pick_round(fruit)?;
         let b = hand.bbox(body)?;
         let c = centre(&b);
-        hand.put(
-            c[0],
-            c[1] + HINGE_SPOTS[k % HINGE_SPOTS.len()],
-            b[1][2],
-            h,
-            HINGE_DROP_CLEARANCE,
+        let spot = drop_spot(
+            hand,
+            fruit,
+            &fruits[k + 1..],
+            &b,
+            [c[0], c[1] + HINGE_SPOTS[k % HINGE_SPOTS.len()]],
         )?;
+        let h = hand.pick_round(fruit)?;
+        hand.put(spot[0], spot[1], b[1][2], h, HINGE_DROP_CLEARANCE)?;
     }
     swing_until(hand, lid, axis, y, reach, &LID_CLOSING_ARC, false)
+}
+
+/// Where to drop `fruit` into the hinge box (its box `b`): [`hinge_drop_spot`] from
+/// `nominal`, given the loose objects lying in the box now and the fruits still to come.
+fn drop_spot<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    fruit: &str,
+    upcoming: &[String],
+    b: &[[f64; 3]; 2],
+    nominal: [f64; 2],
+) -> Result<[f64; 2], ExpertError> {
+    let wall = f64::from(HINGE_BOX_WALL);
+    let inside = [[b[0][0] + wall, b[0][1] + wall], [b[1][0] - wall, b[1][1] - wall]];
+    let footprint = |o: &[[f64; 3]; 2]| {
+        let s = size(o);
+        (
+            [(o[0][0] + o[1][0]) / 2.0, (o[0][1] + o[1][1]) / 2.0],
+            s[0].max(s[1]) / 2.0,
+        )
+    };
+    let mut placed = Vec::new();
+    for other in hand.robot.get_obj_names() {
+        if other == fruit || !hand.is_loose(&other) {
+            continue;
+        }
+        let o = hand.bbox(&other)?;
+        let (c, r) = footprint(&o);
+        let in_box = (inside[0][0]..=inside[1][0]).contains(&c[0])
+            && (inside[0][1]..=inside[1][1]).contains(&c[1])
+            && o[0][2] < b[1][2];
+        if in_box {
+            placed.push((c, r));
+        }
+    }
+    let (_, radius) = footprint(&hand.bbox(fruit)?);
+    let mut to_come = Vec::with_capacity(upcoming.len());
+    for next in upcoming {
+        to_come.push(footprint(&hand.bbox(next)?).1);
+    }
+    Ok(hinge_drop_spot(inside, radius, &placed, &to_come, nominal))
 }
 
 /// Swings the lid through `arc` by its handle until it is open (`open`) or closed, up to
