@@ -77,3 +77,24 @@ fn a_bad_idle_limit_names_its_flag() {
         "{stderr}"
     );
 }
+
+#[test]
+fn a_policy_the_static_checks_reject_is_bad_input() {
+    let dir = common::scratch();
+    let path = dir.path().join("bad.py");
+    std::fs::write(&path, "import os\n").unwrap();
+    let output = common::nesy(&[
+        "run".into(),
+        "--scene".into(),
+        "fixtures/scenes/pick_place_finger.json".into(),
+        "--policy".into(),
+        path.display().to_string(),
+    ]);
+    assert_eq!(
+        output.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&output.stdout)
+    );
+    assert!(String::from_utf8_lossy(&output.stdout).contains("outcome: rejected"));
+}

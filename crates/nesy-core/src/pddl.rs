@@ -733,6 +733,17 @@ mod tests {
     }
 
     #[test]
+    fn a_huge_token_is_not_echoed_in_full() {
+        let d = parse_domain(DOMAIN).unwrap();
+        let p = parse_problem(PROBLEM, &d).unwrap();
+        let u = d.universe(&p).unwrap();
+        let plan = format!("({} a)\n", "x".repeat(1_000_000));
+        let steps = parse_plan(&plan).unwrap();
+        let e = ground_plan(&d, &u, &steps, &plan).unwrap_err();
+        assert!(e.to_string().len() < 1_000, "{} bytes", e.to_string().len());
+    }
+
+    #[test]
     fn names_declared_twice_are_refused() {
         let twice = |from: &str, to: &str| {
             let text = DOMAIN.replacen(from, to, 1);

@@ -44,8 +44,8 @@ fn parse_embodiment(text: &str) -> Result<Embodiment, String> {
     }
 }
 
-/// Runs `nesy run`: exit 0 if the policy ran to its end, 1 if it failed in any way, 2 on
-/// bad input.
+/// Runs `nesy run`: exit 0 if the policy ran to its end, 1 if it failed while running, 2 on
+/// bad input, a policy the static checks reject included (it never ran).
 pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     let source = nesy_input::read_text(&args.policy, nesy_input::MAX_POLICY_BYTES)
         .with_context(|| format!("reading the policy {}", args.policy.display()))?;
@@ -70,6 +70,8 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     }
     Ok(if result.is_ok() {
         ExitCode::SUCCESS
+    } else if matches!(result.outcome, Outcome::Rejected { .. }) {
+        ExitCode::from(crate::EXIT_BAD_INPUT)
     } else {
         ExitCode::from(1)
     })

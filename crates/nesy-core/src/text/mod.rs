@@ -91,7 +91,7 @@ impl ParseError {
             kind,
             line,
             column,
-            expected: expected.into(),
+            expected: shorten(expected.into()),
             found: excerpt(&doc[offset..]),
         }
     }
@@ -110,6 +110,17 @@ pub(crate) fn line_col(doc: &str, offset: usize) -> (usize, usize) {
     let line = before.matches('\n').count() + 1;
     let line_start = before.rfind('\n').map_or(0, |i| i + 1);
     (line, doc[line_start..offset].chars().count() + 1)
+}
+
+/// Longest `expected` text an error keeps, in characters: it can quote names from the input,
+/// and a 10 MB token must not come back in full.
+pub const MAX_EXPECTED_CHARS: usize = 300;
+
+fn shorten(text: String) -> String {
+    match text.char_indices().nth(MAX_EXPECTED_CHARS) {
+        Some((cut, _)) => format!("{}…", &text[..cut]),
+        None => text,
+    }
 }
 
 fn excerpt(rest: &str) -> String {
