@@ -7,23 +7,36 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
+/// `nesy run` of the policy file `policy` on the pick-and-place scene, with `extra` flags.
+fn nesy_run(policy: &str, extra: &[&str]) -> std::process::Output {
+    let mut args: Vec<String> = [
+        "run",
+        "--scene",
+        "fixtures/scenes/pick_place_finger.json",
+        "--policy",
+        policy,
+    ]
+    .map(String::from)
+    .to_vec();
+    args.extend(extra.iter().map(|a| a.to_string()));
+    common::nesy(&args)
+}
+
+/// Writes `source` as a policy file in a scratch directory (kept alive by the returned guard).
+fn policy_file(source: &str) -> (tempfile::TempDir, String) {
+    let dir = common::scratch();
+    let path = dir.path().join("policy_under_test.py");
+    std::fs::write(&path, source).unwrap();
+    let path = path.display().to_string();
+    (dir, path)
+}
+
 /// Runs `policy` on the pick-and-place scene with a 1 s idle limit and a 120 s wall clock;
 /// returns the JSON result and how long the run took.
 fn run_policy(policy: &str) -> (Value, Duration) {
-    let dir = common::scratch();
-    let path = dir.path().join("spin.py");
-    std::fs::write(&path, policy).unwrap();
+    let (_dir, path) = policy_file(policy);
     let started = Instant::now();
-    let output = common::nesy(&[
-        "run".into(),
-        "--scene".into(),
-        "fixtures/scenes/pick_place_finger.json".into(),
-        "--policy".into(),
-        path.display().to_string(),
-        "--idle-timeout".into(),
-        "1".into(),
-        "--json".into(),
-    ]);
+    let output = nesy_run(&path, &["--idle-timeout", "1", "--json"]);
     let took = started.elapsed();
     assert_eq!(
         output.status.code(),
@@ -61,15 +74,10 @@ fn the_default_idle_limit_stops_a_spin_within_fifteen_seconds() {
 
 #[test]
 fn a_bad_idle_limit_names_its_flag() {
-    let output = common::nesy(&[
-        "run".into(),
-        "--scene".into(),
-        "fixtures/scenes/pick_place_finger.json".into(),
-        "--policy".into(),
-        "fixtures/scenes/pick_place_finger.json".into(),
-        "--idle-timeout".into(),
-        "NaN".into(),
-    ]);
+    let output = nesy_run(
+        "fixtures/scenes/pick_place_finger.json",
+        &["--idle-timeout", "NaN"],
+    );
     assert_ne!(output.status.code(), Some(0));
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(
@@ -80,16 +88,8 @@ fn a_bad_idle_limit_names_its_flag() {
 
 #[test]
 fn a_policy_the_static_checks_reject_is_bad_input() {
-    let dir = common::scratch();
-    let path = dir.path().join("bad.py");
-    std::fs::write(&path, "import os\n").unwrap();
-    let output = common::nesy(&[
-        "run".into(),
-        "--scene".into(),
-        "fixtures/scenes/pick_place_finger.json".into(),
-        "--policy".into(),
-        path.display().to_string(),
-    ]);
+    let (_dir, path) = policy_file("import os\n");
+    let output = nesy_run(&path, &[]);
     assert_eq!(
         output.status.code(),
         Some(2),

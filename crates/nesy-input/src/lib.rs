@@ -46,7 +46,7 @@ pub fn read_bytes(path: &Path, max_bytes: u64) -> io::Result<Vec<u8>> {
         };
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
-            format!("not a regular file ({what})"),
+            format!("the path is not a regular file ({what})"),
         ));
     }
     let too_big = |size: u64| {

@@ -264,21 +264,37 @@ impl Sources<'_> {
         })
     }
 
+    /// As [`Sources::setting`], with the name of the source the value came from (the flag's
+    /// name, given with its value; the variable; the file key), for errors about the value.
+    fn setting_with_origin<T: FromStr>(
+        &self,
+        flag: Option<(T, &str)>,
+        var: &'static str,
+        file: Option<T>,
+        key: &str,
+    ) -> Result<Option<(T, String)>, ConfigError>
+    where
+        T::Err: std::fmt::Display,
+    {
+        Ok(match (flag, self.env.var(var), file) {
+            (Some((value, name)), _, _) => Some((value, name.to_owned())),
+            (None, Some(value), _) => Some((parse(&value, var)?, var.to_owned())),
+            (None, None, Some(value)) => Some((value, self.file_origin(key))),
+            (None, None, None) => None,
+        })
+    }
+
     /// A duration in seconds from the flag, the environment variable or the file key.
     fn seconds_setting(
         &self,
-        flag: Option<f64>,
+        flag: Option<(f64, &str)>,
         var: &'static str,
         file: Option<f64>,
         key: &str,
     ) -> Result<Option<Duration>, ConfigError> {
-        match (flag, self.env.var(var), file) {
-            // Only the total timeout has a flag.
-            (Some(v), _, _) => Ok(Some(seconds(v, "--vlm-timeout-secs")?)),
-            (None, Some(v), _) => Ok(Some(seconds(parse(&v, var)?, var)?)),
-            (None, None, Some(v)) => Ok(Some(seconds(v, &self.file_origin(key))?)),
-            (None, None, None) => Ok(None),
-        }
+        self.setting_with_origin(flag, var, file, key)?
+            .map(|(value, origin)| seconds(value, &origin))
+            .transpose()
     }
 
     fn backend(&self, file: &FileConfig) -> Result<BackendKind, ConfigError> {
@@ -368,16 +384,14 @@ impl Sources<'_> {
         )? {
             config.defaults.max_output_tokens = Some(tokens);
         }
-        if let Some(temperature) =
-            self.setting(flags.temperature, "NESY_VLM_TEMPERATURE", file.temperature)?
-        {
+        if let Some((temperature, origin)) = self.setting_with_origin(
+            flags.temperature.map(|t| (t, "--vlm-temperature")),
+            "NESY_VLM_TEMPERATURE",
+            file.temperature,
+            "temperature",
+        )? {
             // NaN would go out as JSON `null`; providers accept 0 to 2.
             if !(0.0..=2.0).contains(&temperature) {
-                let origin = match (flags.temperature, self.env.var("NESY_VLM_TEMPERATURE")) {
-                    (Some(_), _) => "--vlm-temperature".to_owned(),
-                    (None, Some(_)) => "NESY_VLM_TEMPERATURE".to_owned(),
-                    (None, None) => self.file_origin("temperature"),
-                };
                 return Err(invalid(
                     &origin,
                     &format!("expected a temperature from 0 to 2, got {temperature}"),
@@ -442,7 +456,7 @@ impl Sources<'_> {
             config.timeouts.read = Some(t);
         }
         if let Some(t) = self.seconds_setting(
-            self.flags.timeout_secs,
+            self.flags.timeout_secs.map(|t| (t, "--vlm-timeout-secs")),
             "NESY_VLM_TIMEOUT_TOTAL_SECS",
             timeouts.total_secs,
             "timeouts.total_secs",

@@ -56,13 +56,15 @@ pub fn hinge_drop_spot(
     nominal: [f64; 2],
 ) -> [f64; 2] {
     let distance = |p: [f64; 2]| (p[0] - nominal[0]).powi(2) + (p[1] - nominal[1]).powi(2);
+    let later: Vec<(f64, HingeGrid)> = upcoming.iter().map(|&r| (r, HingeGrid::new(inside, r))).collect();
     let score = |p: [f64; 2]| {
         let mut lying = placed.to_vec();
         let mut worst = room(p, radius, &lying);
         lying.push((p, radius));
-        for &r in upcoming {
+        for (r, grid) in &later {
+            let r = *r;
             // The later fruit where it has the most room (its own nominal spot is unknown here).
-            let q = HingeGrid::new(inside, r)
+            let q = grid
                 .points()
                 .max_by(|a, b| room(*a, r, &lying).total_cmp(&room(*b, r, &lying)))
                 .unwrap_or(p);

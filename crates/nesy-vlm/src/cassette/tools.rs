@@ -227,9 +227,6 @@ pub fn verify(path: &Path) -> Result<Vec<Problem>, CassetteError> {
     Ok(problems)
 }
 
-/// Largest blob `verify` reads (a keyframe PNG is well under 1 MiB).
-pub const MAX_BLOB_BYTES: u64 = 64 << 20;
-
 /// Whether a blob reference is a bare content address, `<64 lowercase hex>.<1–8 [a-z0-9]>`.
 fn is_blob_name(name: &str) -> bool {
     let Some((digest, ext)) = name.split_once('.') else {
@@ -241,25 +238,16 @@ fn is_blob_name(name: &str) -> bool {
         && ext.bytes().all(|b| b.is_ascii_lowercase() || b.is_ascii_digit())
 }
 
-/// Reads one blob, if it is a regular file of at most [`MAX_BLOB_BYTES`], and checks it
-/// hashes to `expected`.
+/// Reads one blob through [`nesy_input::read_bytes`] (a regular file of at most
+/// [`nesy_input::MAX_IMAGE_BYTES`]: blobs are the requests' images) and checks it hashes to
+/// `expected`.
 fn check_blob(blob: &Path, expected: &str) -> Result<(), String> {
-    use std::io::Read as _;
     let shown = blob.display();
-    let meta = fs::metadata(blob).map_err(|err| format!("blob {shown} is missing: {err}"))?;
-    if !meta.is_file() {
-        return Err(format!("blob {shown} is not a regular file"));
-    }
-    if meta.len() > MAX_BLOB_BYTES {
-        return Err(format!(
-            "blob {shown} is {} bytes, more than the {MAX_BLOB_BYTES} a blob may hold",
-            meta.len()
-        ));
-    }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    fs::File::open(blob)
-        .and_then(|file| file.take(MAX_BLOB_BYTES + 1).read_to_end(&mut bytes))
-        .map_err(|err| format!("blob {shown} cannot be read: {err}"))?;
+    let bytes =
+        nesy_input::read_bytes(blob, nesy_input::MAX_IMAGE_BYTES).map_err(|err| match err.kind() {
+            std::io::ErrorKind::NotFound => format!("blob {shown} is missing: {err}"),
+            _ => format!("blob {shown} cannot be read: {err}"),
+        })?;
     if hex(&Sha256::digest(&bytes)) != expected {
         return Err(format!("blob {shown} does not hash to its name"));
     }

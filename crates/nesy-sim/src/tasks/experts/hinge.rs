@@ -65,11 +65,8 @@ fn drop_spot<R: RobotApi + ?Sized>(
     let wall = f64::from(HINGE_BOX_WALL);
     let inside = [[b[0][0] + wall, b[0][1] + wall], [b[1][0] - wall, b[1][1] - wall]];
     let footprint = |o: &[[f64; 3]; 2]| {
-        let s = size(o);
-        (
-            [(o[0][0] + o[1][0]) / 2.0, (o[0][1] + o[1][1]) / 2.0],
-            s[0].max(s[1]) / 2.0,
-        )
+        let (c, s) = (centre(o), size(o));
+        ([c[0], c[1]], s[0].max(s[1]) / 2.0)
     };
     let mut placed = Vec::new();
     for other in hand.robot.get_obj_names() {
