@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 scripts/install-prereqs.sh
 [ -f "$HOME/.cargo/env" ] && . "$HOME/.cargo/env"
 
-printf '\n==> build (the first build takes about ten minutes on two cores)\n'
+printf '\n==> build (the first build takes about six minutes on two cores)\n'
 cargo build -p nesy-cli
 
 printf '\n==> nesy adapt on fixtures/demos/adapt-realstyle (replayed VLM, executed)\n'
