@@ -138,3 +138,39 @@ fn an_exhausted_budget_is_unresolved_and_ships_no_policy() {
     assert_eq!(adaptation["status"], "unresolved");
     assert_eq!(adaptation["proposals"][0]["verdict"], "rejected");
 }
+
+#[test]
+fn a_replay_writes_the_usage_report_the_environment_asks_for() {
+    let out = common::scratch();
+    let report = out.path().join("usage.json");
+    let args: Vec<String> = [
+        "adapt",
+        "--out",
+        &out.path().join("run").display().to_string(),
+        "--demo",
+        DEMO,
+        "--target",
+        TARGET,
+        "--vlm",
+        CASSETTE,
+    ]
+    .map(String::from)
+    .to_vec();
+    let output = common::nesy_with_env(&args, &[("NESY_CASSETTE_USAGE", &report.display().to_string())]);
+    assert_eq!(
+        output.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let usage: Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("usage report")).unwrap();
+    assert!(!usage["used"].as_array().unwrap().is_empty(), "{usage}");
+    assert!(
+        usage["cassette"]
+            .as_str()
+            .unwrap()
+            .ends_with("adapt-realstyle.json"),
+        "{usage}"
+    );
+}

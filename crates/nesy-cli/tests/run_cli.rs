@@ -98,3 +98,52 @@ fn a_policy_the_static_checks_reject_is_bad_input() {
     );
     assert!(String::from_utf8_lossy(&output.stdout).contains("outcome: rejected"));
 }
+
+#[test]
+fn findings_and_tracebacks_name_the_policy_file_as_given() {
+    let (_dir, path) = policy_file("x = 1 +\n");
+    let output = nesy_run(&path, &[]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(2), "{stdout}");
+    assert!(stdout.contains(&format!("{path}:1:")), "{stdout}");
+    assert!(!stdout.contains("policy.py"), "{stdout}");
+
+    let (_dir, path) = policy_file("open_gripper()\nraise ValueError('on purpose')\n");
+    let output = nesy_run(&path, &[]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains(&format!("File \"{path}\", line 2")), "{stdout}");
+    assert!(!stdout.contains("policy.py"), "{stdout}");
+}
+
+#[test]
+fn a_latin_1_policy_with_its_coding_line_runs() {
+    let dir = common::scratch();
+    let path = dir.path().join("latin.py");
+    std::fs::write(&path, b"# -*- coding: latin-1 -*-\nprint('caf\xe9')\n").unwrap();
+    let output = nesy_run(&path.display().to_string(), &[]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(0), "{stdout}");
+    assert!(stdout.contains("café"), "{stdout}");
+}
+
+#[test]
+fn a_policy_that_is_not_utf_8_is_bad_input_with_its_position() {
+    let dir = common::scratch();
+    let path = dir.path().join("bytes.py");
+    std::fs::write(&path, b"open_gripper()\nx = '\xff'\n").unwrap();
+    let output = nesy_run(&path.display().to_string(), &[]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("bytes.py"), "{stderr}");
+    assert!(stderr.contains("line 2, column 6 (byte offset 20)"), "{stderr}");
+}
+
+#[test]
+fn a_policy_nested_too_deeply_is_rejected_with_a_message() {
+    let (_dir, path) = policy_file(&format!("x = {}1\n", "-".repeat(100_000)));
+    let output = nesy_run(&path, &[]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(2), "{stdout}");
+    assert!(stdout.contains("nested too deeply"), "{stdout}");
+}

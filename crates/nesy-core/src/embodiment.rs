@@ -4,10 +4,20 @@
 
 use std::fmt;
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize};
 
-/// The robot's end effector.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+/// The robot's end effector. Read from its name; anything else is refused with the two
+/// names it could be ("invalid type: integer `5`, expected `finger` or `vacuum`").
+///
+/// ```
+/// use nesy_core::Embodiment;
+///
+/// let vacuum: Embodiment = serde_json::from_str("\"vacuum\"").unwrap();
+/// assert_eq!(vacuum, Embodiment::Vacuum);
+/// let err = serde_json::from_str::<Embodiment>("5").unwrap_err().to_string();
+/// assert!(err.contains("expected `finger` or `vacuum`"), "{err}");
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
 #[cfg_attr(feature = "schemars", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum Embodiment {
@@ -50,6 +60,33 @@ impl Embodiment {
             Embodiment::Finger => "GripperOpen",
             Embodiment::Vacuum => "VacuumInactive",
         }
+    }
+}
+
+/// The names [`Embodiment::as_str`] gives, in declaration order.
+const EMBODIMENT_NAMES: [&str; 2] = ["finger", "vacuum"];
+
+// By hand rather than derived: serde's derived unit-enum reader reports a number or a list
+// as only "expected value", which names neither the field's kind nor its choices.
+impl<'de> Deserialize<'de> for Embodiment {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Name;
+        impl serde::de::Visitor<'_> for Name {
+            type Value = Embodiment;
+
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("`finger` or `vacuum`")
+            }
+
+            fn visit_str<E: serde::de::Error>(self, name: &str) -> Result<Embodiment, E> {
+                match name {
+                    "finger" => Ok(Embodiment::Finger),
+                    "vacuum" => Ok(Embodiment::Vacuum),
+                    other => Err(E::unknown_variant(other, &EMBODIMENT_NAMES)),
+                }
+            }
+        }
+        deserializer.deserialize_str(Name)
     }
 }
 

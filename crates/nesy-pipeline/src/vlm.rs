@@ -152,9 +152,12 @@ pub fn build_client(setup: &VlmSetup) -> Result<VlmClient, PipelineError> {
             let file = CassetteFile::load(path)
                 .map_err(|e| setup_error(format!("reading the cassette {}: {e}", path.display())))?;
             let config = replay_config(path, &file)?;
-            let transport =
-                CassetteTransport::open(path, CassetteMode::None, None, CassetteOptions::default())
-                    .map_err(|e| setup_error(format!("opening the cassette {}: {e}", path.display())))?;
+            let options = CassetteOptions {
+                usage_report: std::env::var_os(nesy_vlm::config::CASSETTE_USAGE_ENV).map(PathBuf::from),
+                ..CassetteOptions::default()
+            };
+            let transport = CassetteTransport::open(path, CassetteMode::None, None, options)
+                .map_err(|e| setup_error(format!("opening the cassette {}: {e}", path.display())))?;
             return Ok(VlmClient::with_transport(&config, Arc::new(transport)));
         }
         VlmSource::Configured(overrides) => {

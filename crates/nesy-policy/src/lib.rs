@@ -55,6 +55,7 @@ pub mod python;
 pub mod result;
 pub mod runner;
 pub mod sim_episode;
+pub mod source;
 pub mod testing;
 pub mod worker;
 

@@ -35,6 +35,29 @@ impl ExecutionResult {
     pub fn is_ok(&self) -> bool {
         matches!(self.outcome, Outcome::Ok)
     }
+
+    /// Names the policy's file `file` in every traceback and frame, in place of the
+    /// [`crate::POLICY_FILE`] it was compiled under, so a user running their own `tilt.py`
+    /// reads `File "tilt.py", line 3`. Other frames (`<nesy-robot>`, ...) keep their names.
+    pub fn name_policy_file(&mut self, file: &str) {
+        let errors = match &mut self.outcome {
+            Outcome::PythonError(error) => vec![error],
+            Outcome::SandboxViolation { error, .. }
+            | Outcome::Timeout { error, .. }
+            | Outcome::Memory { error } => error.iter_mut().collect(),
+            Outcome::Ok | Outcome::Rejected { .. } | Outcome::Killed { .. } => Vec::new(),
+        };
+        let compiled_as = format!("File \"{}\"", crate::POLICY_FILE);
+        let named = format!("File \"{file}\"");
+        for error in errors {
+            error.traceback = error.traceback.replace(&compiled_as, &named);
+            for frame in &mut error.frames {
+                if frame.file == crate::POLICY_FILE {
+                    frame.file = file.to_owned();
+                }
+            }
+        }
+    }
 }
 
 /// How an episode ended.
@@ -153,9 +176,16 @@ pub struct StaticViolation {
     pub message: String,
 }
 
+impl StaticViolation {
+    /// `file:line:column: message`, the way compilers name a finding.
+    pub fn located(&self, file: &str) -> String {
+        format!("{file}:{}:{}: {}", self.line, self.column, self.message)
+    }
+}
+
 impl std::fmt::Display for StaticViolation {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "policy.py:{}:{}: {}", self.line, self.column, self.message)
+        f.write_str(&self.located(crate::POLICY_FILE))
     }
 }
 

@@ -3,7 +3,7 @@
 
 use nesy_policy::runner::run_in_process_without_static_checks;
 use nesy_policy::testing::RecordingRobot;
-use nesy_policy::{ExecutionResult, Limits, Outcome, TimeLimit, run_in_process};
+use nesy_policy::{ExecutionResult, Limits, Outcome, TimeLimit, check_source, run_in_process};
 use nesy_sim::api::{ApiCall, Direction, Embodiment};
 
 fn run_with(source: &str, embodiment: Embodiment, limits: &Limits) -> ExecutionResult {
@@ -365,6 +365,15 @@ fn static_checks_reject_before_anything_runs() {
         ("x = 1 +", "syntax error"),
         ("print('\\0')\n\0", "invalid source"),
     ];
+    // Nesting deep enough that CPython's parser gives up with an empty MemoryError or a
+    // RecursionError: a finding with a message, never "static checker failed".
+    let unary_chain = format!("x = {}1\n", "-".repeat(100_000));
+    let additions = format!("x = 1{}\n", "+1".repeat(200_000));
+    for source in [unary_chain, additions] {
+        let found = check_source(&source).unwrap();
+        assert_eq!(found.len(), 1, "{found:?}");
+        assert!(found[0].message.contains("nested too deeply"), "{found:?}");
+    }
     for (source, expected) in rejected {
         let result = run(source);
         match &result.outcome {

@@ -259,6 +259,15 @@ fn malformed_scenes_name_the_json_path_and_the_expectation() {
     assert_eq!(e.json_path(), Some("embodiment"));
     assert!(e.to_string().contains("expected `finger` or `vacuum`"), "{e}");
 
+    // Not a string at all: the same two choices, not serde's bare "expected value".
+    let e = load_error(|j| j["embodiment"] = 5.into());
+    assert_eq!(e.json_path(), Some("embodiment"));
+    assert!(
+        e.to_string()
+            .contains("invalid type: integer `5`, expected `finger` or `vacuum`"),
+        "{e}"
+    );
+
     let e = load_error(|j| j["objects"][2]["size"] = serde_json::json!([0.03, -0.03, 0.03]));
     assert_eq!(e.json_path(), Some("objects[2].size[1]"));
     assert!(

@@ -6,6 +6,7 @@
 mod common;
 
 use common::{expect, load};
+use nesy_sim::tasks::layout::PUSH_DEPTH_DIVISOR;
 use nesy_sim::{Direction, RobotApi, Sim};
 
 fn grasp(sim: &mut Sim) {
@@ -307,7 +308,8 @@ fn sweep(scene: &str) {
         ("black_bishop", "right_chess_box"),
     ] {
         let h = sim.get_obj_size(piece).unwrap()[2];
-        sim.move_gripper_to(piece, Direction::Down, h / 1.3).unwrap();
+        sim.move_gripper_to(piece, Direction::Down, h / PUSH_DEPTH_DIVISOR)
+            .unwrap();
         if vacuum {
             sim.activate_vacuum().unwrap();
             expect(&sim, "attach", &[&format!("(VacuumAttached {piece})")], &[]);
@@ -459,7 +461,8 @@ fn composite(embodiment: nesy_sim::Embodiment) {
         ("white_bishop", "left_chess_box"),
     ] {
         let h = sim.get_obj_size(piece).unwrap()[2];
-        sim.move_gripper_to(piece, Direction::Down, h / 1.3).unwrap();
+        sim.move_gripper_to(piece, Direction::Down, h / PUSH_DEPTH_DIVISOR)
+            .unwrap();
         if vacuum {
             sim.activate_vacuum().unwrap();
         }
@@ -606,7 +609,7 @@ fn wrong_box_piece(embodiment: nesy_sim::Embodiment) {
         &["(OnTopOf white_rook board)"],
         &["(InsideOf white_rook right_chess_box)"],
     );
-    sim.move_gripper_to("white_rook", Direction::Down, h / 1.3)
+    sim.move_gripper_to("white_rook", Direction::Down, h / PUSH_DEPTH_DIVISOR)
         .unwrap();
     if vacuum {
         sim.activate_vacuum().unwrap();

@@ -20,6 +20,11 @@ use crate::secret::SecretString;
 /// and `max_completion_tokens`.
 pub const DEFAULT_AZURE_API_VERSION: &str = "2025-04-01-preview";
 
+/// The environment variable naming the file a replayed cassette's usage report (which
+/// interactions were replayed, which were not) is written to, for configured cassettes and
+/// `--vlm replay:` alike.
+pub const CASSETTE_USAGE_ENV: &str = "NESY_CASSETTE_USAGE";
+
 /// A configuration problem, naming where the bad value came from.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
@@ -486,7 +491,7 @@ impl Sources<'_> {
             };
         let usage_report = self
             .env
-            .var("NESY_CASSETTE_USAGE")
+            .var(CASSETTE_USAGE_ENV)
             .map(PathBuf::from)
             .or(cassette.usage_report);
         Ok(Some(CassetteSettings {

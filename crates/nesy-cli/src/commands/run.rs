@@ -47,7 +47,9 @@ fn parse_embodiment(text: &str) -> Result<Embodiment, String> {
 /// Runs `nesy run`: exit 0 if the policy ran to its end, 1 if it failed while running, 2 on
 /// bad input, a policy the static checks reject included (it never ran).
 pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
-    let source = nesy_input::read_text(&args.policy, nesy_input::MAX_POLICY_BYTES)
+    let bytes = nesy_input::read_bytes(&args.policy, nesy_input::MAX_POLICY_BYTES)
+        .with_context(|| format!("reading the policy {}", args.policy.display()))?;
+    let source = nesy_policy::source::decode_policy_source(&bytes)
         .with_context(|| format!("reading the policy {}", args.policy.display()))?;
     let limits = Limits {
         wall_time_ms: super::seconds_to_ms("--timeout", args.timeout)?,
@@ -61,12 +63,14 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         render_every: args.render_every,
     };
     let worker = WorkerCommand::current_exe().context("locating the nesy executable")?;
-    let result = run_policy(&worker, &source, &spec, &limits)
+    let mut result = run_policy(&worker, &source, &spec, &limits)
         .with_context(|| format!("running {} on {}", args.policy.display(), args.scene.display()))?;
+    let policy_file = args.policy.display().to_string();
+    result.name_policy_file(&policy_file);
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&result)?)?;
     } else {
-        print_summary(&result)?;
+        print_summary(&result, &policy_file)?;
     }
     Ok(if result.is_ok() {
         ExitCode::SUCCESS
@@ -77,7 +81,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     })
 }
 
-fn print_summary(result: &ExecutionResult) -> std::io::Result<()> {
+fn print_summary(result: &ExecutionResult, policy_file: &str) -> std::io::Result<()> {
     if !result.stdout.text.is_empty() {
         out!("{}", result.stdout.text)?;
     }
@@ -96,7 +100,7 @@ fn print_summary(result: &ExecutionResult) -> std::io::Result<()> {
         Outcome::Ok => {}
         Outcome::Rejected { violations } => {
             for v in violations {
-                outln!("  {v}")?;
+                outln!("  {}", v.located(policy_file))?;
             }
         }
         Outcome::PythonError(error) => outln!("{}", error.traceback)?,

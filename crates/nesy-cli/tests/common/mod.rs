@@ -31,6 +31,11 @@ pub fn scratch() -> tempfile::TempDir {
 
 /// Runs the `nesy` binary with `args`, without any VLM settings from the environment.
 pub fn nesy(args: &[String]) -> Output {
+    nesy_with_env(args, &[])
+}
+
+/// Runs the `nesy` binary with `args` and only the VLM settings of `env` (`(name, value)`).
+pub fn nesy_with_env(args: &[String], env: &[(&str, &str)]) -> Output {
     let mut command = Command::new(env!("CARGO_BIN_EXE_nesy"));
     command.args(args).current_dir(workspace());
     for (key, _) in std::env::vars() {
@@ -38,6 +43,7 @@ pub fn nesy(args: &[String]) -> Output {
             command.env_remove(key);
         }
     }
+    command.envs(env.iter().copied());
     command.output().expect("running nesy")
 }
 

@@ -349,9 +349,10 @@ pub enum AdaptError {
     #[error(transparent)]
     Reasoner(#[from] ReasonerError),
     /// No reply for a transition even parsed within the allowed attempts.
-    #[error("no parsable operator for transition {step} after {attempts} attempt(s)")]
+    #[error("no parsable operator for transition {} after {attempts} attempt(s)", step + 1)]
     NoOperator {
-        /// The transition.
+        /// The transition, 0-based; messages count transitions from 1, as the reasoner's
+        /// own errors and the prompts do.
         step: usize,
         /// Attempts made.
         attempts: usize,

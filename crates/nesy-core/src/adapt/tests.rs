@@ -553,3 +553,27 @@ fn goal_excludes_embodiment_atoms() {
     let g = derive_goal(&[s0, s1, s2], &v);
     assert_eq!(g.to_string(), "(and (Gathered a) (InsideOf a box))");
 }
+
+#[test]
+fn an_unreadable_transition_is_numbered_from_one_like_the_reasoners_errors() {
+    let mut r = Scripted::default();
+    let config = AdaptConfig::default();
+    r.induction.extend(std::iter::repeat_n(
+        "no operator here".to_string(),
+        config.induction_tries,
+    ));
+    let mut trace = Trace::default();
+    let err = pollster::block_on(construct_world_model(&mut r, &demo(), &config, &mut trace)).unwrap_err();
+    assert_eq!(
+        err,
+        AdaptError::NoOperator {
+            step: 0,
+            attempts: config.induction_tries
+        }
+    );
+    assert!(
+        err.to_string()
+            .starts_with("no parsable operator for transition 1 "),
+        "{err}"
+    );
+}

@@ -170,6 +170,13 @@ def check(source):
         return [(err.lineno or 1, err.offset or 1, f"syntax error: {err.msg}")]
     except ValueError as err:
         return [(1, 1, f"invalid source: {err}")]
+    except (MemoryError, RecursionError):
+        # CPython's parser gives up on deep nesting with an empty MemoryError (a long chain
+        # of unary operators) or a RecursionError, neither with a position.
+        return [(1, 1, "invalid source: nested too deeply for the parser")]
     checker = Checker()
-    checker.visit(tree)
+    try:
+        checker.visit(tree)
+    except RecursionError:
+        return [(1, 1, "invalid source: nested too deeply to check")]
     return sorted(checker.findings)

@@ -10,9 +10,10 @@ use pyo3::ffi;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyByteArray, PyBytes, PyDict, PyFloat, PyInt, PyString, PyTuple};
 
-/// Height of the table surface in the world frame (`docs/benchmark.md` §1: `Z_OFFSET = 0.5`). A
-/// two-element position `(x, y)` means a point on the table surface, `(x, y, 0.5)`.
-pub const TABLE_TOP_Z: f64 = 0.5;
+/// Height of the table surface in the world frame (`docs/benchmark.md` §1: `Z_OFFSET = 0.5`),
+/// the scene format's one definition. A two-element position `(x, y)` means a point on the
+/// table surface, `(x, y, TABLE_TOP_Z)`.
+pub const TABLE_TOP_Z: f64 = nesy_sim::scene::TABLE_TOP;
 
 /// A robot API function's name and parameters, in order.
 #[derive(Debug)]
