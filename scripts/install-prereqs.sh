@@ -58,7 +58,16 @@ echo "CPython $version ($python)"
 
 log "toolchain"
 if ! command -v cargo >/dev/null 2>&1; then
-  [ -f "$HOME/.cargo/env" ] || curl -sSf https://sh.rustup.rs | sh -s -- -y --profile minimal
+  if [ ! -f "$HOME/.cargo/env" ]; then
+    # rustup-init straight from its release host (what https://sh.rustup.rs downloads too),
+    # which machines limited to package registries and Rust's own hosts can still reach.
+    init=$(mktemp)
+    curl -sSf --proto '=https' --tlsv1.2 -o "$init" \
+      "https://static.rust-lang.org/rustup/dist/$(uname -m)-unknown-linux-gnu/rustup-init"
+    chmod +x "$init"
+    "$init" -y --profile minimal >/dev/null
+    rm -f "$init"
+  fi
   # shellcheck disable=SC1091
   . "$HOME/.cargo/env"
   installed_rustup=1
