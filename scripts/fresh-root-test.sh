@@ -3,8 +3,8 @@
 # debootstrap (minbase variant, APT's Recommends turned off), then inside it, as a newcomer
 # would: installs git, clones this repository, runs `scripts/quickstart.sh`, sources
 # ~/.cargo/env as the installer says, and runs `cargo test --workspace`. Nothing from the
-# host is used but the committed repository (cloned over a read-only bind mount) and the
-# network to the package registries and Rust's release host.
+# host is used but the committed repository (cloned over a read-only bind mount), the host's
+# local CA certificates, and the network to the package registries and Rust's release host.
 #
 #   scripts/fresh-root-test.sh bookworm /work/roots/bookworm   # Debian 12
 #   scripts/fresh-root-test.sh trixie   /work/roots/trixie     # Debian 13
@@ -30,6 +30,10 @@ fi
 printf 'APT::Install-Recommends "false";\nAPT::Install-Suggests "false";\n' \
   >"$root/etc/apt/apt.conf.d/99no-recommends"
 cp /etc/resolv.conf "$root/etc/resolv.conf"
+# A network that intercepts TLS (a sandbox's egress proxy) signs with a local CA the host
+# trusts; the root trusts it too once the installer's ca-certificates picks these up.
+mkdir -p "$root/usr/local/share/ca-certificates"
+cp /usr/local/share/ca-certificates/*.crt "$root/usr/local/share/ca-certificates/" 2>/dev/null || true
 
 mounted=()
 mount_in() { mkdir -p "$root$2"; mount "${@:3}" "$1" "$root$2"; mounted=("$root$2" "${mounted[@]}"); }
