@@ -34,6 +34,8 @@ cp /etc/resolv.conf "$root/etc/resolv.conf"
 # trusts; the root trusts it too once the installer's ca-certificates picks these up.
 mkdir -p "$root/usr/local/share/ca-certificates"
 cp /usr/local/share/ca-certificates/*.crt "$root/usr/local/share/ca-certificates/" 2>/dev/null || true
+# (A reused root may have ca-certificates already: refresh its bundle.)
+if [ -x "$root/usr/sbin/update-ca-certificates" ]; then chroot "$root" update-ca-certificates >/dev/null 2>&1 || true; fi
 
 mounted=()
 mount_in() { mkdir -p "$root$2"; mount "${@:3}" "$1" "$root$2"; mounted=("$root$2" "${mounted[@]}"); }
