@@ -61,12 +61,13 @@ if ! command -v cargo >/dev/null 2>&1; then
   if [ ! -f "$HOME/.cargo/env" ]; then
     # rustup-init straight from its release host (what https://sh.rustup.rs downloads too),
     # which machines limited to package registries and Rust's own hosts can still reach.
-    init=$(mktemp)
-    curl -sSf --proto '=https' --tlsv1.2 -o "$init" \
+    # The file must be called rustup-init: rustup decides what to be from its own name.
+    scratch=$(mktemp -d)
+    curl -sSf --proto '=https' --tlsv1.2 -o "$scratch/rustup-init" \
       "https://static.rust-lang.org/rustup/dist/$(uname -m)-unknown-linux-gnu/rustup-init"
-    chmod +x "$init"
-    "$init" -y --profile minimal >/dev/null
-    rm -f "$init"
+    chmod +x "$scratch/rustup-init"
+    "$scratch/rustup-init" -y --profile minimal >/dev/null
+    rm -rf "$scratch"
   fi
   # shellcheck disable=SC1091
   . "$HOME/.cargo/env"
