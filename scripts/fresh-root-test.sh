@@ -8,6 +8,12 @@
 #
 #   scripts/fresh-root-test.sh bookworm /work/roots/bookworm   # Debian 12
 #   scripts/fresh-root-test.sh trixie   /work/roots/trixie     # Debian 13
+#   DEBIAN_MIRROR=http://archive.ubuntu.com/ubuntu \
+#   DEBOOTSTRAP_ARGS="--no-check-gpg --components=main,universe" \
+#     scripts/fresh-root-test.sh noble /work/roots/noble        # Ubuntu 24.04
+#
+# (A Debian host's debootstrap may lack a script for a newer Ubuntu release: `ln -s gutsy
+# /usr/share/debootstrap/scripts/noble` adds it; without Ubuntu's keyring, --no-check-gpg.)
 #
 # Needs root and debootstrap. The log of each step goes to ROOT.log; the last line says
 # PASSED or FAILED with the step. A root that already exists is reused as it is.
@@ -25,7 +31,8 @@ command -v debootstrap >/dev/null || { echo "fresh-root-test.sh needs debootstra
 : >"$log"
 if [ ! -e "$root/etc/os-release" ]; then
   say "debootstrap --variant=minbase $suite"
-  debootstrap --variant=minbase "$suite" "$root" "$mirror" >>"$log" 2>&1
+  # shellcheck disable=SC2086
+  debootstrap --variant=minbase ${DEBOOTSTRAP_ARGS:-} "$suite" "$root" "$mirror" >>"$log" 2>&1
 fi
 printf 'APT::Install-Recommends "false";\nAPT::Install-Suggests "false";\n' \
   >"$root/etc/apt/apt.conf.d/99no-recommends"
@@ -61,7 +68,7 @@ step() {
     exit 1
   fi
 }
-say "$(chroot "$root" cat /etc/debian_version) ($(uname -m)); Recommends off"
+say "$(. "$root/etc/os-release" && echo "$PRETTY_NAME") ($(uname -m)); Recommends off"
 step "apt-get install git" "apt-get update -qq && apt-get install -y -qq git"
 step "git clone" "rm -rf /root/nesy && git clone -q /src /root/nesy"
 step "scripts/quickstart.sh" "set -o pipefail; cd /root/nesy && scripts/quickstart.sh | tee /root/quickstart.out && grep -q 'nesy adapt: SUCCEEDED' /root/quickstart.out"

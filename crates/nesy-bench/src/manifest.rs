@@ -190,8 +190,13 @@ impl Manifest {
         let path = manifest_path(run);
         let text =
             nesy_input::read_text(&path, nesy_input::MAX_JSON_BYTES).map_err(|e| BenchError::io(&path, e))?;
-        serde_json::from_str(&text).map_err(|e| BenchError::Format {
-            path,
+        Manifest::parse(&path, &text)
+    }
+
+    /// Parses manifest text (`path` names it in errors).
+    pub fn parse(path: &Path, text: &str) -> Result<Manifest, BenchError> {
+        serde_json::from_str(text).map_err(|e| BenchError::Format {
+            path: path.to_owned(),
             message: format!("not a run manifest: {e}"),
         })
     }

@@ -6,17 +6,7 @@ use std::fmt;
 
 use serde::{Deserialize, Deserializer, Serialize};
 
-/// The robot's end effector. Read from its name; anything else is refused with the two
-/// names it could be ("invalid type: integer `5`, expected `finger` or `vacuum`").
-///
-/// ```
-/// use nesy_core::Embodiment;
-///
-/// let vacuum: Embodiment = serde_json::from_str("\"vacuum\"").unwrap();
-/// assert_eq!(vacuum, Embodiment::Vacuum);
-/// let err = serde_json::from_str::<Embodiment>("5").unwrap_err().to_string();
-/// assert!(err.contains("expected `finger` or `vacuum`"), "{err}");
-/// ```
+/// The robot's end effector.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
 #[cfg_attr(feature = "schemars", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
@@ -67,7 +57,19 @@ impl Embodiment {
 const EMBODIMENT_NAMES: [&str; 2] = ["finger", "vacuum"];
 
 // By hand rather than derived: serde's derived unit-enum reader reports a number or a list
-// as only "expected value", which names neither the field's kind nor its choices.
+// as only "expected value", which names neither the field's kind nor its choices. (The
+// example lives here, not on the type, whose doc becomes the JSON schemas' description.)
+/// Read from its name; anything else is refused with the two names it could be
+/// ("invalid type: integer `5`, expected `finger` or `vacuum`").
+///
+/// ```
+/// use nesy_core::Embodiment;
+///
+/// let vacuum: Embodiment = serde_json::from_str("\"vacuum\"").unwrap();
+/// assert_eq!(vacuum, Embodiment::Vacuum);
+/// let err = serde_json::from_str::<Embodiment>("5").unwrap_err().to_string();
+/// assert!(err.contains("expected `finger` or `vacuum`"), "{err}");
+/// ```
 impl<'de> Deserialize<'de> for Embodiment {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         struct Name;

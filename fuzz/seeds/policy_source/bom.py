@@ -1,0 +1,2 @@
+﻿open_gripper()
+move_gripper_to('red_cube')
