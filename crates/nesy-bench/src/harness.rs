@@ -744,7 +744,7 @@ async fn make_code(
 
 fn synth_status(e: &SynthError) -> (UnitStatus, String) {
     match e {
-        SynthError::NoProgram { message } => (UnitStatus::CodegenFailed, message.clone()),
+        SynthError::NoProgram { message, .. } => (UnitStatus::CodegenFailed, message.clone()),
         SynthError::Call { message, failure } => {
             let f = MethodFailure::from_reasoner(*failure, message.clone());
             (f.status, f.message)

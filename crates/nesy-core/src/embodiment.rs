@@ -43,6 +43,15 @@ impl Embodiment {
         }
     }
 
+    /// The unary predicate that holds of the object it holds: `GripperHolding` or
+    /// `VacuumAttached`.
+    pub fn holding_predicate(self) -> &'static str {
+        match self {
+            Embodiment::Finger => "GripperHolding",
+            Embodiment::Vacuum => "VacuumAttached",
+        }
+    }
+
     /// The nullary predicate that holds when it is released, as every goal ends:
     /// `GripperOpen` or `VacuumInactive`.
     pub fn released_predicate(self) -> &'static str {

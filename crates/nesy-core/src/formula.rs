@@ -156,6 +156,20 @@ impl Formula {
         }
     }
 
+    /// Every atom pattern the formula mentions, in order (repeats included).
+    pub fn patterns<'a>(&'a self, out: &mut Vec<&'a AtomPattern>) {
+        match self {
+            Formula::Atom(p) => out.push(p),
+            Formula::Eq(..) => {}
+            Formula::Not(f) | Formula::Forall(_, f) | Formula::Exists(_, f) => f.patterns(out),
+            Formula::And(fs) | Formula::Or(fs) => fs.iter().for_each(|f| f.patterns(out)),
+            Formula::Imply(a, b) => {
+                a.patterns(out);
+                b.patterns(out)
+            }
+        }
+    }
+
     /// Every object constant the formula mentions.
     pub fn constants(&self, out: &mut Vec<Symbol>) {
         match self {
@@ -320,6 +334,18 @@ pub enum Effect {
 }
 
 impl Effect {
+    /// Every atom pattern the effect (and any `when` condition) mentions, in order.
+    pub fn patterns<'a>(&'a self, out: &mut Vec<&'a AtomPattern>) {
+        match self {
+            Effect::Add(p) | Effect::Del(p) => out.push(p),
+            Effect::Forall(_, es) => es.iter().for_each(|e| e.patterns(out)),
+            Effect::When(c, es) => {
+                c.patterns(out);
+                es.iter().for_each(|e| e.patterns(out));
+            }
+        }
+    }
+
     /// Every object constant the effect mentions.
     pub fn constants(&self, out: &mut Vec<Symbol>) {
         match self {

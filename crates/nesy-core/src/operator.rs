@@ -93,6 +93,14 @@ impl Operator {
         }
     }
 
+    /// Every atom pattern in the preconditions and effects, in order.
+    pub fn patterns(&self) -> Vec<&crate::formula::AtomPattern> {
+        let mut out = Vec::new();
+        self.pre.iter().for_each(|f| f.patterns(&mut out));
+        self.eff.iter().for_each(|e| e.patterns(&mut out));
+        out
+    }
+
     /// Every object constant in the preconditions and effects.
     pub fn constants(&self) -> Vec<Symbol> {
         let mut out = Vec::new();

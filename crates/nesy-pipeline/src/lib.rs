@@ -212,6 +212,11 @@ pub fn adaptation_inputs(
             tier: setting.tier,
             vocabulary: vocabulary.clone(),
         },
+        scene_names: std::iter::once(nesy_sim::scene::parts::FLOOR.to_string())
+            .chain(target.scene.part_names())
+            .chain(target.objects.iter().cloned())
+            .map(|n| Symbol::new(&n))
+            .collect(),
     };
     (demonstration, target_task)
 }

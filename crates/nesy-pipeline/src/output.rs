@@ -192,17 +192,49 @@ fn inductions(adaptation: &Adaptation) -> Vec<serde_json::Value> {
         .collect()
 }
 
-/// Counts (calls, rejected) of induction attempts.
-pub fn induction_counts(adaptation: &Adaptation) -> (usize, usize) {
-    let mut calls = 0;
-    let mut rejected = 0;
+/// How many induction calls the run made, and how many replies were rejected or unreadable.
+pub fn induction_counts(adaptation: &Adaptation) -> InductionCounts {
+    let mut counts = InductionCounts::default();
     for event in &adaptation.trace.events {
         if let TraceEvent::Induction { verdict, .. } = event {
-            calls += 1;
-            rejected += usize::from(matches!(verdict, Verdict::Rejected { .. }));
+            counts.calls += 1;
+            if let Verdict::Rejected { feedback } = verdict {
+                if feedback.problem.is_unreadable() {
+                    counts.unreadable += 1;
+                } else {
+                    counts.rejected += 1;
+                }
+            }
         }
     }
-    (calls, rejected)
+    counts
+}
+
+/// How the induction calls of a run went.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct InductionCounts {
+    /// Induction calls made.
+    pub calls: usize,
+    /// Replies the verifier rejected.
+    pub rejected: usize,
+    /// Replies that could not be read (nothing was verified).
+    pub unreadable: usize,
+}
+
+impl InductionCounts {
+    /// `N induction calls, M rejected by the verifier[, K could not be read]`.
+    pub fn summary(&self) -> String {
+        let mut text = format!(
+            "{} induction call{}, {} rejected by the verifier",
+            self.calls,
+            if self.calls == 1 { "" } else { "s" },
+            self.rejected
+        );
+        if self.unreadable > 0 {
+            text.push_str(&format!(", {} could not be read", self.unreadable));
+        }
+        text
+    }
 }
 
 /// `procedure.txt`.
@@ -326,16 +358,15 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
     }
     let _ = writeln!(md, "\n\nInitial state:\n\n```\n{}\n```\n", run.target_state);
 
-    let (calls, rejected) = induction_counts(&run.adaptation);
+    let counts = induction_counts(&run.adaptation);
     let wm = &run.adaptation.world_model;
     let _ = writeln!(md, "## World model\n");
     let _ = writeln!(
         md,
-        "{} operators from {} keyframes; {} induction call(s), {} rejected by the verifier; {}.\n",
+        "{} operators from {} keyframes; {}; {}.\n",
         wm.procedure.len(),
         run.demo_states.len(),
-        calls,
-        rejected,
+        counts.summary(),
         if wm.is_verified() {
             "every operator verified".to_owned()
         } else {

@@ -11,6 +11,7 @@ use nesy_core::adapt::ReasonerErrorKind;
 use nesy_sim::api::Embodiment;
 use nesy_sim::codegen::{CodegenError as TemplateError, compile_policy};
 use nesy_sim::scene::SceneSpec;
+use nesy_vlm::codegen::RejectedProgram;
 use nesy_vlm::{
     CodeGenerationContext, CodeGenerationRequest, CodegenError, PolicyCompileError, PolicyCompiler,
     VlmReasoner,
@@ -59,6 +60,9 @@ pub struct SynthesizedPolicy {
     pub extended: bool,
     /// Import lines removed from the model's program, with why.
     pub stripped: Vec<String>,
+    /// Earlier replies that could not be used and were re-asked (`vlm` only).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub rejected: Vec<RejectedProgram>,
 }
 
 /// Why synthesis produced no program.
@@ -69,6 +73,9 @@ pub enum SynthError {
     NoProgram {
         /// What was wrong.
         message: String,
+        /// Every reply the budget allowed, with why it could not be used (`vlm` only).
+        #[serde(skip_serializing_if = "Vec::is_empty")]
+        replies: Vec<RejectedProgram>,
     },
     /// The generator could not be asked (transport, cassette miss, prompt defect): the run
     /// fails with an error after writing its outputs.
@@ -83,7 +90,7 @@ pub enum SynthError {
 impl std::fmt::Display for SynthError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            SynthError::NoProgram { message } => write!(f, "no program: {message}"),
+            SynthError::NoProgram { message, .. } => write!(f, "no program: {message}"),
             SynthError::Call { message, .. } => write!(f, "code generation failed: {message}"),
         }
     }
@@ -108,9 +115,14 @@ pub async fn synthesize(
                 .await;
             let source = match result {
                 Ok(source) => source,
-                Err(e @ CodegenError::NoProgram { .. }) => {
+                Err(CodegenError::NoProgram { attempts }) => {
+                    let message = CodegenError::NoProgram {
+                        attempts: attempts.clone(),
+                    }
+                    .to_string();
                     return Err(SynthError::NoProgram {
-                        message: e.to_string(),
+                        message,
+                        replies: attempts,
                     });
                 }
                 Err(e) => {
@@ -130,6 +142,7 @@ pub async fn synthesize(
                     .iter()
                     .map(|s| format!("line {}: {} ({})", s.line, s.text, s.reason))
                     .collect(),
+                rejected: source.rejected,
             })
         }
         CodegenMode::Template => template(request),
@@ -140,6 +153,7 @@ fn template(request: &SynthesisRequest<'_>) -> Result<SynthesizedPolicy, SynthEr
     let compiled = compile_policy(&request.procedure, &request.objects, request.target).map_err(|e| {
         SynthError::NoProgram {
             message: e.to_string(),
+            replies: Vec::new(),
         }
     })?;
     Ok(SynthesizedPolicy {
@@ -148,6 +162,7 @@ fn template(request: &SynthesisRequest<'_>) -> Result<SynthesizedPolicy, SynthEr
         reply: None,
         extended: false,
         stripped: Vec::new(),
+        rejected: Vec::new(),
     })
 }
 

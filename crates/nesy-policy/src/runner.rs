@@ -149,6 +149,7 @@ fn execute(py: Python<'_>, source: &str, limits: &Limits, deadline: Instant) -> 
                 .getattr("compile")?
                 .call1((source, POLICY_FILE, "exec", 0, true))?;
         let globals = PyDict::new(py);
+        // Exactly interpreter::POLICY_GLOBALS, which the static checker counts as defined.
         globals.set_item("__builtins__", builtins::curated(py)?)?;
         globals.set_item("__name__", "__main__")?;
         globals.set_item("robot", prepared.robot.bind(py))?;

@@ -15,6 +15,18 @@ fn run(source: &str) -> ExecutionResult {
     run_with(source, Embodiment::Finger, &Limits::default())
 }
 
+/// Runs `source` without the static checks, to show what the run-time layers do with what
+/// the checks would already refuse (arity errors, undefined names).
+fn run_unchecked(source: &str) -> ExecutionResult {
+    run_in_process_without_static_checks(
+        source,
+        Box::new(RecordingRobot::new(Embodiment::Finger)),
+        &Limits::default(),
+        None,
+    )
+    .expect("interpreter starts")
+}
+
 fn python_error(result: &ExecutionResult) -> &nesy_policy::PythonError {
     match &result.outcome {
         Outcome::PythonError(e) => e,
@@ -186,7 +198,9 @@ fn bad_types_and_arity_raise_type_error_with_the_signature() {
         ),
     ];
     for (call, expected) in cases {
-        let result = run(call);
+        // Arity is also refused by the static checks; the run-time binding is the layer
+        // under them, for calls whose arguments are only known then (`*args`).
+        let result = run_unchecked(call);
         let error = python_error(&result);
         assert_eq!(error.exception, "TypeError", "{call}: {error:?}");
         assert!(error.message.contains(expected), "{call}: {}", error.message);
@@ -308,7 +322,9 @@ fn output_is_captured_and_capped() {
 #[test]
 fn episodes_do_not_share_globals() {
     assert_eq!(run("leftover = 42").outcome, Outcome::Ok);
-    let result = run("print(leftover)");
+    // The static checks refuse the name outright; run unchecked, it is a NameError.
+    assert!(matches!(run("print(leftover)").outcome, Outcome::Rejected { .. }));
+    let result = run_unchecked("print(leftover)");
     assert_eq!(python_error(&result).exception, "NameError");
 }
 
@@ -364,6 +380,26 @@ fn static_checks_reject_before_anything_runs() {
         ("async def f():\n    pass", "async functions are not available"),
         ("x = 1 +", "syntax error"),
         ("print('\\0')\n\0", "invalid source"),
+        // Names nothing defines: each would be a NameError after the robot has moved.
+        (
+            "open_gripper()\ngrasp_object('red_cube')",
+            "name 'grasp_object' is not defined",
+        ),
+        ("open_gripper()\nopen_gripp", "did you mean 'open_gripper'?"),
+        ("print(cube_names)", "name 'cube_names' is not defined"),
+        // Robot API calls whose arguments cannot bind.
+        (
+            "move_gripper_to()",
+            "move_gripper_to() is missing its argument 'obj_name'",
+        ),
+        (
+            "move_gripper_to('red_cube', dept=0.02)",
+            "move_gripper_to() has no parameter 'dept'",
+        ),
+        (
+            "close_gripper(1)",
+            "close_gripper() takes at most 0 argument(s) (1 given)",
+        ),
     ];
     // Nesting deep enough that CPython's parser gives up with an empty MemoryError or a
     // RecursionError: a finding with a message, never "static checker failed".
@@ -401,6 +437,12 @@ fn static_checks_accept_ordinary_policy_code() {
         "x = '{} {:.2f} {name!r}'.format(1, 2.0, name='a')\ny = f'{x} {1 + 2:>5}'",
         "names = [n for n in get_obj_names() if n.endswith('cube')]\nnames.sort(key=lambda n: n)",
         "try:\n    move_gripper_to('nothing')\nexcept robot.UnknownObjectError:\n    pass",
+        // Names bound in every way Python binds them, used before or after, in any scope.
+        "def place(name, depth=0.01):\n    move_gripper_to(name, depth=depth)\n    return helper()\ndef helper():\n    global count\n    count = 1\n    return count\nplace('red_cube')",
+        "with_items = {k: v for k, v in zip('ab', range(2))}\nfor key, (a, *rest) in [('k', (1, 2))]:\n    print(key, a, rest)\ntry:\n    pass\nexcept ValueError as err:\n    print(err)",
+        "class Plan:\n    steps = []\nif __name__ == '__main__':\n    print(Plan.steps, robot.get_obj_names, np.array([1]))",
+        "from robot import *\nfrom math import *\nprint(TABLE_TOP_Z, UnknownObjectError, sqrt(4))",
+        "args = ('red_cube',)\nmove_gripper_to(*args)\nopts = {'depth': 0.02}\nmove_gripper_to('red_cube', **opts)",
     ];
     for source in accepted {
         assert_eq!(nesy_policy::check_source(source).unwrap(), [], "{source}");
@@ -412,15 +454,6 @@ fn static_checks_accept_ordinary_policy_code() {
 
 #[test]
 fn curated_builtins_and_import_allowlist_hold_without_static_checks() {
-    let run_unchecked = |source: &str| {
-        run_in_process_without_static_checks(
-            source,
-            Box::new(RecordingRobot::new(Embodiment::Finger)),
-            &Limits::default(),
-            None,
-        )
-        .unwrap()
-    };
     for (source, exception) in [
         ("import os", "ImportError"),
         ("import subprocess", "ImportError"),

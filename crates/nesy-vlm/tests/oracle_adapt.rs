@@ -111,6 +111,7 @@ async fn adapt_and_execute(case: &Case, noise: OracleNoise, budget: usize) -> Ru
             tier,
             vocabulary: Vocabulary::default(),
         },
+        scene_names: Vec::new(),
     };
     // The oracle behind the real client and reasoner.
     let oracle = Arc::new(

@@ -18,6 +18,9 @@ use nesy_vlm::{
     VlmTask, WireRequest, WireResponse,
 };
 
+/// The prefix that makes [`Scripted`] answer with `finish_reason: length`.
+const TRUNCATED: &str = "<length>";
+
 /// Answers each purpose from its own queue of replies and keeps every request.
 #[derive(Debug, Default)]
 struct Scripted {
@@ -63,7 +66,15 @@ impl Transport for Scripted {
                     message: format!("script has no reply left for purpose {purpose:?}"),
                     retryable: false,
                 })?;
-            let body = common::completion(&reply);
+            // A reply written "<length>TEXT" comes back cut off at the token cap.
+            let body = match reply.strip_prefix(TRUNCATED) {
+                Some(partial) => {
+                    let mut body = common::completion(partial);
+                    body["choices"][0]["finish_reason"] = "length".into();
+                    body
+                }
+                None => common::completion(&reply),
+            };
             Ok(WireResponse::new(
                 200,
                 serde_json::to_vec(&body).unwrap(),
@@ -236,7 +247,8 @@ async fn the_loop_recovers_from_a_rejected_operator_and_a_non_matching_patch() {
     assert_eq!(context.target_embodiment, Embodiment::Finger);
 
     // Code generation on the adapted procedure; the foreign import is stripped and recorded.
-    let codegen = Scripted::with(&[("codegen", &[scenario::CODE, "Sorry, I cannot help with that."])]);
+    let sorry = "Sorry, I cannot help with that.";
+    let codegen = Scripted::with(&[("codegen", &[scenario::CODE, sorry, sorry, sorry])]);
     let reasoner = VlmReasoner::new(client(codegen.clone())).unwrap();
     let request = CodeGenerationRequest {
         instruction: "Put the fruits in the hinge box.".into(),
@@ -267,13 +279,27 @@ async fn the_loop_recovers_from_a_rejected_operator_and_a_non_matching_patch() {
     };
     assert_eq!(context.action_names[6], "7. OpenGripperToDropAppleIntoHingeBody");
     assert_eq!(context.procedure, *procedure);
-    // A reply without code is a typed error that keeps the reply.
+    // Replies without code are re-asked; when the budget runs out, a typed error keeps them.
     match reasoner.generate_code(&request).await {
-        Err(CodegenError::NoProgram { reply, .. }) => assert!(reply.starts_with("Sorry")),
+        Err(CodegenError::NoProgram { attempts }) => {
+            assert_eq!(attempts.len(), nesy_vlm::codegen::CODEGEN_ATTEMPTS);
+            assert!(attempts.iter().all(|a| a.reply.starts_with("Sorry")));
+            assert!(
+                attempts[0]
+                    .problem
+                    .to_string()
+                    .starts_with("reply could not be read"),
+                "{}",
+                attempts[0].problem
+            );
+        }
         other => panic!("{other:?}"),
     }
     let usage = reasoner.client().usage();
-    assert_eq!(usage.by_purpose["codegen"].calls, 2);
+    assert_eq!(
+        usage.by_purpose["codegen"].calls,
+        1 + nesy_vlm::codegen::CODEGEN_ATTEMPTS as u64
+    );
 }
 
 #[tokio::test]
@@ -318,4 +344,71 @@ async fn state_translation_adds_checked_atoms_to_the_known_ones() {
     }
     let usage = reasoner.client().usage();
     assert_eq!(usage.by_purpose["translate"].calls, 2);
+}
+
+/// A program in a python block, as a model would answer.
+fn program(body: &str) -> String {
+    format!("Here is the program.\n\n```python\n{body}\n```\n")
+}
+
+#[tokio::test]
+async fn plausible_but_wrong_programs_are_re_asked_before_anything_runs() {
+    let good = program("move_gripper_to(\"red_cube\")\nclose_gripper()\nopen_gripper()");
+    let cases: [(&str, String, &str); 5] = [
+        (
+            "an API function that does not exist",
+            program("move_gripper_to(\"red_cube\")\ngrasp_object(\"red_cube\")"),
+            "name 'grasp_object' is not defined",
+        ),
+        (
+            "a program cut off mid-line",
+            program("move_gripper_to(\"red_cube\")\nclose_gripper()\nopen_gripp"),
+            "did you mean 'open_gripper'?",
+        ),
+        (
+            "a code block that never closes",
+            "```python\nmove_gripper_to(\"red_cube\")\nclose_gripper()\n".to_string(),
+            "is never closed",
+        ),
+        (
+            "a reply cut off at the token cap",
+            format!("{TRUNCATED}```python\nmove_gripper_to(\"red_cube\")\nclose_"),
+            "cut off at the token cap",
+        ),
+        (
+            "a function of the other end effector",
+            program("move_gripper_to(\"red_cube\")\nactivate_vacuum()"),
+            "activate_vacuum() is not available: this robot has a finger gripper",
+        ),
+    ];
+    for (what, wrong, expected) in cases {
+        let codegen = Scripted::with(&[("codegen", &[wrong.as_str(), good.as_str()])]);
+        let reasoner = VlmReasoner::new(client(codegen.clone())).unwrap();
+        let request = CodeGenerationRequest {
+            instruction: "Place the cube in the box.".into(),
+            objects: vec!["red_cube".into(), "box".into()],
+            procedure: Vec::new(),
+            embodiment: Embodiment::Finger,
+            extended: false,
+        };
+        let policy = reasoner
+            .generate_code(&request)
+            .await
+            .unwrap_or_else(|e| panic!("{what}: {e}"));
+        assert!(
+            policy.code.ends_with("open_gripper()\n"),
+            "{what}: {}",
+            policy.code
+        );
+        assert_eq!(policy.rejected.len(), 1, "{what}");
+        let problem = policy.rejected[0].problem.to_string();
+        assert!(problem.contains(expected), "{what}: {problem}");
+        // The re-ask carries the wrong reply as the assistant's turn and the reason after it.
+        let sent = codegen.requests("codegen");
+        assert_eq!(sent.len(), 2, "{what}");
+        let turns = messages(&sent[1]);
+        assert_eq!(turns.len(), 4, "{what}");
+        let feedback = text_of(&turns[3]);
+        assert!(feedback.contains(expected), "{what}: {feedback}");
+    }
 }

@@ -231,18 +231,17 @@ pub fn summary(run: &AdaptRun) -> String {
     };
     let _ = writeln!(out, "  states    {states}");
     let wm = &run.adaptation.world_model;
-    let (calls, rejected) = induction_counts(&run.adaptation);
+    let counts = induction_counts(&run.adaptation);
     let _ = writeln!(
         out,
-        "  world     {} operators, {} ({} induction calls, {} rejected by the verifier)",
+        "  world     {} operators, {} ({})",
         wm.procedure.len(),
         if wm.is_verified() {
             "all verified".to_owned()
         } else {
             format!("UNVERIFIED steps {:?}", wm.unverified_steps)
         },
-        calls,
-        rejected
+        counts.summary()
     );
     let found = violations(&run.adaptation);
     let props = proposals(&run.adaptation);
@@ -294,6 +293,9 @@ pub fn summary(run: &AdaptRun) -> String {
             "  policy    policy.py ({mode}, {} lines)",
             p.code.lines().count()
         );
+        for (i, rejected) in p.rejected.iter().enumerate() {
+            let _ = writeln!(out, "            reply {} re-asked: {}", i + 1, rejected.problem);
+        }
     }
     if let Some(e) = &run.codegen_error {
         let first = e.to_string();

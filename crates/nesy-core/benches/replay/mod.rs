@@ -74,6 +74,7 @@ impl RecordedRun {
             target: Target {
                 init: self.target_state.clone(),
                 task: task(&self.target_objects),
+                scene_names: Vec::new(),
             },
             config: AdaptConfig {
                 budget: self.budget,

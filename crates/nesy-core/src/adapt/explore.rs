@@ -1,6 +1,7 @@
 //! Counterfactual identification (Eq. 6) and exploration with verified patches (Eq. 7–8).
 
 use super::reasoner::{Feedback, PatchRequest, Problem, Reasoner, ReasonerErrorKind, ViolationKind};
+use super::symbols::{known_objects, unknown_symbols};
 use super::{
     Ablation, AdaptConfig, AdaptError, Outcome, Target, Trace, TraceEvent, Verdict, ViolationInfo, WorldModel,
 };
@@ -172,7 +173,8 @@ pub fn resolves(violation: &ViolationInfo, applied: &AppliedPatch, report: &Repo
 
 fn describe(problem: &Problem, procedure: &[Operator]) -> String {
     match problem {
-        Problem::Unparsable { error } => format!("The reply could not be parsed: {error}."),
+        Problem::Unparsable { error } => format!("The reply could not be read: {error}."),
+        Problem::UnknownSymbols { unknown } => super::world_model::describe_unknown(unknown),
         Problem::MultiplePatches { count } => format!(
             "The reply held {count} SEARCH/REPLACE blocks; exactly one is required. Nothing was applied."
         ),
@@ -317,6 +319,20 @@ pub async fn explore<R: Reasoner>(
                 return Err(Problem::MultiplePatches {
                     count: r.patches.len(),
                 });
+            }
+            let inserted: Vec<&Operator> = r.patches[0].replace.iter().collect();
+            // Names: the scene's, the initial state's, and those the procedure already uses
+            // (a patch may keep an action on an object the target no longer needs).
+            let objects = (!target.scene_names.is_empty()).then(|| {
+                known_objects(
+                    &target.scene_names,
+                    [&target.init],
+                    procedure.iter().flat_map(|op| op.constants()),
+                )
+            });
+            let unknown = unknown_symbols(&inserted, &target.task.vocabulary, objects.as_deref());
+            if !unknown.is_empty() {
+                return Err(Problem::UnknownSymbols { unknown });
             }
             let applied = apply_patch(&procedure, &r.patches[0], near)
                 .map_err(|error| Problem::PatchDidNotApply { error })?;

@@ -25,6 +25,7 @@
 
 mod explore;
 mod reasoner;
+mod symbols;
 mod world_model;
 
 pub use explore::{ExplorationResult, explore, identify, resolves};
@@ -32,15 +33,18 @@ pub use reasoner::{
     Feedback, InductionRequest, PatchRequest, Problem, Reasoner, ReasonerError, ReasonerErrorKind,
     TaskContext, ViolationKind,
 };
+pub use symbols::{SymbolProblem, UnknownSymbol, known_objects, unknown_symbols};
 pub use world_model::{WorldModel, check_transition, construct_world_model};
 
 use serde::{Deserialize, Serialize};
 
+use crate::embodiment::Embodiment;
 use crate::exec::{Report, UnmetPrecondition};
 use crate::formula::Formula;
 use crate::operator::Operator;
 use crate::predicates::Vocabulary;
 use crate::state::State;
+use crate::symbol::Symbol;
 use crate::text::{InductionReply, RefinementReply};
 
 /// How strictly an induced operator must reproduce the demonstrated transition.
@@ -159,6 +163,14 @@ impl Default for AdaptConfig {
 /// made true. Embodiment atoms are excluded, so a finger→vacuum change cannot make the goal
 /// unreachable; atoms true from the start and never changed are scene context, not goals.
 /// The result is a conjunction sorted by text (`(and)` if nothing qualifies).
+///
+/// When the demonstration ends with the end effector at rest, the goal also says so: for
+/// each end effector's holding predicate the vocabulary has (`GripperHolding`,
+/// `VacuumAttached`) and the last state does not hold, `(forall (?x - thing) (not (P ?x)))`
+/// follows the atoms. The goal checks require every object let go, so a procedure that
+/// carries the last object over its box and never releases it is a goal violation for the
+/// loop to fix, not a success that fails in execution. Both end effectors are named, so
+/// the goal means the same after a finger→vacuum change.
 pub fn derive_goal(states: &[State], vocabulary: &Vocabulary) -> Formula {
     let Some(last) = states.last() else {
         return Formula::And(Vec::new());
@@ -167,13 +179,25 @@ pub fn derive_goal(states: &[State], vocabulary: &Vocabulary) -> Formula {
     for w in states.windows(2) {
         made_true.extend(w[0].diff(&w[1]).added);
     }
-    let goal: Vec<Formula> = last
+    let mut goal: Vec<Formula> = last
         .sorted_by_text()
         .into_iter()
         .filter(|a| vocabulary.is_physics(a.pred()) && made_true.contains(a))
         .map(|a| Formula::atom(*a))
         .collect();
+    for embodiment in [Embodiment::Finger, Embodiment::Vacuum] {
+        let holding = Symbol::new(embodiment.holding_predicate());
+        if vocabulary.get(holding).is_some() && !last.iter().any(|a| a.pred() == holding) {
+            goal.push(nothing_held(holding));
+        }
+    }
     Formula::And(goal)
+}
+
+/// `(forall (?x - thing) (not (P ?x)))`.
+fn nothing_held(holding: Symbol) -> Formula {
+    crate::text::parse_formula(&format!("(forall (?x - thing) (not ({holding} ?x)))"))
+        .expect("a well-formed formula over a vocabulary name")
 }
 
 /// The demonstration as the loop needs it.
@@ -192,6 +216,11 @@ pub struct Target {
     pub init: State,
     /// The target task (objects, tier).
     pub task: TaskContext,
+    /// Every name the target scene has: its objects, their parts (lids, handles, drawers)
+    /// and `floor`. A patch may only name these. Empty when unknown: names are then not
+    /// checked (predicates still are).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub scene_names: Vec<Symbol>,
 }
 
 /// One recorded event of a run.

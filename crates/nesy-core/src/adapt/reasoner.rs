@@ -66,6 +66,11 @@ pub enum Problem {
         /// The parse error.
         error: ParseError,
     },
+    /// The reply parsed but names predicates (or arities) or objects the task does not have.
+    UnknownSymbols {
+        /// Each unknown name once, in order, with the nearest known one.
+        unknown: Vec<super::UnknownSymbol>,
+    },
     /// The operator could not be grounded (e.g. a quantifier over an unknown type).
     Ungroundable {
         /// The grounding error.
@@ -100,6 +105,17 @@ pub enum Problem {
         /// Unmet preconditions (or goal literals) after the patch.
         unmet: Vec<UnmetPrecondition>,
     },
+}
+
+impl Problem {
+    /// True when the reply could not be read (it did not parse, used unknown names, or held
+    /// several patches): nothing about it was verified. The prompts word the two apart.
+    pub fn is_unreadable(&self) -> bool {
+        matches!(
+            self,
+            Problem::Unparsable { .. } | Problem::UnknownSymbols { .. } | Problem::MultiplePatches { .. }
+        )
+    }
 }
 
 /// A request to induce the operator of one demonstrated transition s_t → s_{t+1}.

@@ -179,6 +179,9 @@ fn target() -> Target {
     Target {
         init: state(&["(GripperOpen)", "(OnTopOf orange floor)", "(Closed hinge_lid)"]),
         task: task(),
+        scene_names: ["floor", "orange", "hinge_body", "hinge_lid", "hinge_handle"]
+            .map(Symbol::new)
+            .to_vec(),
     }
 }
 
@@ -201,7 +204,10 @@ fn world_model_reprediction_with_feedback() {
     assert!(wm.is_verified());
     assert_eq!(wm.procedure.len(), 4);
     assert_eq!(wm.procedure[0].name, "MoveGripperToSurroundOrange");
-    assert_eq!(wm.goal.to_string(), "(and (InsideOf orange hinge_body))");
+    assert_eq!(
+        wm.goal.to_string(),
+        "(and (InsideOf orange hinge_body) (forall (?x - thing) (not (GripperHolding ?x))) (forall (?x - thing) (not (VacuumAttached ?x))))"
+    );
     // The second and third requests for transition 0 carry the verifier's feedback.
     assert_eq!(r.induction_requests[1].feedback.len(), 1);
     assert!(matches!(
@@ -311,7 +317,11 @@ fn exploration_rejects_bad_proposals_then_adapts() {
         &drop_block(),
         &format!(
             "{}\n\n{}",
-            block("Wiggle", &["(GripperHolding orange)"], &["(Wiggled)"]),
+            block(
+                "Wiggle",
+                &["(GripperHolding orange)"],
+                &["(GripperHolding orange)"]
+            ),
             drop_block()
         ),
     ));
@@ -388,7 +398,8 @@ fn removal_then_goal_violation_then_budget() {
         induction: good_inductions(),
         ..Default::default()
     };
-    // Removing the erroneous drop resolves that violation but leaves the goal unmet.
+    // Removing the erroneous drop resolves that violation but leaves the goal unmet: the
+    // orange is not in the box, and it is still held.
     r.patches.push_back(refinement(&drop_block(), ""));
     r.patches.push_back("still no patch".into());
     let config = AdaptConfig {
@@ -399,7 +410,7 @@ fn removal_then_goal_violation_then_budget() {
     assert_eq!(r.patch_requests[1].kind, ViolationKind::Goal);
     assert_eq!(
         r.patch_requests[1].unfulfilled_preconditions(),
-        "- (InsideOf orange hinge_body)"
+        "- (InsideOf orange hinge_body)\n- (forall (?x - thing) (not (GripperHolding ?x)))"
     );
     assert!(r.patch_requests[1].erroneous.is_none());
     let Outcome::Unresolved {
@@ -453,7 +464,11 @@ fn ablations_change_what_is_checked_and_shown() {
         &drop_block(),
         &format!(
             "{}\n\n{}",
-            block("Wiggle", &["(GripperHolding orange)"], &["(Wiggled)"]),
+            block(
+                "Wiggle",
+                &["(GripperHolding orange)"],
+                &["(GripperHolding orange)"]
+            ),
             drop_block()
         ),
     );
@@ -520,6 +535,7 @@ fn consistent_target_needs_no_patch_and_budget_table() {
     let same = Target {
         init: demo().states[0].clone(),
         task: task(),
+        scene_names: Vec::new(),
     };
     let a = pollster::block_on(run(&mut r, &demo(), &same, &AdaptConfig::default())).unwrap();
     assert!(matches!(a.outcome, Outcome::Adapted { iterations: 0, .. }));
@@ -551,7 +567,11 @@ fn goal_excludes_embodiment_atoms() {
     )
     .unwrap();
     let g = derive_goal(&[s0, s1, s2], &v);
-    assert_eq!(g.to_string(), "(and (Gathered a) (InsideOf a box))");
+    // The last state holds `a`, so only the vacuum's "nothing attached" joins the goal.
+    assert_eq!(
+        g.to_string(),
+        "(and (Gathered a) (InsideOf a box) (forall (?x - thing) (not (VacuumAttached ?x))))"
+    );
 }
 
 #[test]
@@ -575,5 +595,73 @@ fn an_unreadable_transition_is_numbered_from_one_like_the_reasoners_errors() {
         err.to_string()
             .starts_with("no parsable operator for transition 1 "),
         "{err}"
+    );
+}
+
+#[test]
+fn misspelt_names_are_refused_with_the_nearest_known_one_and_re_asked() {
+    // A vacuous precondition over a predicate that does not exist would verify: it is
+    // refused as unreadable instead, and the second reply is the good one.
+    let mut r = Scripted::default();
+    r.induction.push_back(induction_reply(
+        APPROACH.0,
+        &[
+            "(GripperOpen)",
+            "(forall (?y - thing) (not (gripper_holding ?y)))",
+        ],
+        APPROACH.2,
+    ));
+    r.induction.extend(good_inductions());
+    let mut trace = Trace::default();
+    let wm = pollster::block_on(construct_world_model(
+        &mut r,
+        &demo(),
+        &AdaptConfig::default(),
+        &mut trace,
+    ))
+    .unwrap();
+    assert!(wm.is_verified());
+    let fb = &r.induction_requests[1].feedback[0];
+    assert!(fb.problem.is_unreadable());
+    assert!(
+        fb.message
+            .contains("`gripper_holding` is not a predicate; did you mean `GripperHolding`?"),
+        "{}",
+        fb.message
+    );
+
+    // A patch that names an object the target does not have goes back the same way.
+    let mut r = Scripted {
+        induction: good_inductions(),
+        ..Default::default()
+    };
+    r.patches.push_back(refinement(
+        &drop_block(),
+        &format!(
+            "{}\n\n{}",
+            block(
+                "PushHingeLidOpenWithHeldOrange",
+                &["(GripperHolding orange)", "(Closed hinge_lidd)"],
+                &["(Open hinge_lid)", "(not (Closed hinge_lid))"],
+            ),
+            drop_block()
+        ),
+    ));
+    r.patches.push_back(refinement(
+        &drop_block(),
+        &format!("{}\n\n{}", open_lid_block(), drop_block()),
+    ));
+    let adaptation = pollster::block_on(run(&mut r, &demo(), &target(), &AdaptConfig::default())).unwrap();
+    assert!(
+        matches!(adaptation.outcome, Outcome::Adapted { .. }),
+        "{:?}",
+        adaptation.outcome
+    );
+    let fb = &r.patch_requests[1].feedback[0];
+    assert!(
+        fb.message
+            .contains("`hinge_lidd` is not an object of this task; did you mean `hinge_lid`?"),
+        "{}",
+        fb.message
     );
 }

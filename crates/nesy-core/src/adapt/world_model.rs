@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::reasoner::{Feedback, InductionRequest, Problem, Reasoner};
+use super::symbols::{UnknownSymbol, known_objects, unknown_symbols};
 use super::{
     AdaptConfig, AdaptError, Demonstration, Trace, TraceEvent, TransitionCheck, Verdict, derive_goal,
 };
@@ -82,6 +83,15 @@ pub fn check_transition(
     }
 }
 
+/// The prose for a reply whose names the task does not know (induction and patches alike).
+pub(super) fn describe_unknown(unknown: &[UnknownSymbol]) -> String {
+    let list: Vec<String> = unknown.iter().map(|u| format!("- {u}")).collect();
+    format!(
+        "The reply could not be read: it uses names this task does not have.\n{}\nUse only the predicates defined above, with their arguments, and the listed objects.",
+        list.join("\n")
+    )
+}
+
 /// The prose the next induction prompt shows for a rejected attempt.
 fn describe(problem: &Problem) -> String {
     let atoms = |v: &[crate::atom::Atom]| {
@@ -90,7 +100,8 @@ fn describe(problem: &Problem) -> String {
         s.join("\n")
     };
     match problem {
-        Problem::Unparsable { error } => format!("The reply could not be parsed: {error}."),
+        Problem::Unparsable { error } => format!("The reply could not be read: {error}."),
+        Problem::UnknownSymbols { unknown } => describe_unknown(unknown),
         Problem::Ungroundable { error } => format!("The operator could not be grounded: {error}."),
         Problem::PreconditionsUnmet { unmet } => {
             format!(
@@ -133,6 +144,7 @@ pub async fn construct_world_model<R: Reasoner>(
     let tries = config.induction_tries.max(1);
     let mut procedure = Vec::with_capacity(demo.states.len() - 1);
     let mut unverified_steps = Vec::new();
+    let demo_objects = known_objects(&demo.task.objects, &demo.states, []);
     for (step, pair) in demo.states.windows(2).enumerate() {
         let (prev, next) = (&pair[0], &pair[1]);
         let mut feedback: Vec<Feedback> = Vec::new();
@@ -152,15 +164,28 @@ pub async fn construct_world_model<R: Reasoner>(
             let parsed = parse_induction_reply(&reply);
             let problem = match &parsed {
                 Err(error) => Some(Problem::Unparsable { error: error.clone() }),
-                Ok(_) if !config.ablation.world_model => None,
-                Ok(r) => check_transition(
-                    prev,
-                    next,
-                    &r.operator,
-                    &demo.task.objects,
-                    config.transition_check,
-                )
-                .err(),
+                Ok(r) => {
+                    // Names are read before anything is verified, with or without the check.
+                    let unknown = unknown_symbols(
+                        &[&r.operator],
+                        &demo.task.vocabulary,
+                        Some(demo_objects.as_slice()),
+                    );
+                    if !unknown.is_empty() {
+                        Some(Problem::UnknownSymbols { unknown })
+                    } else if !config.ablation.world_model {
+                        None
+                    } else {
+                        check_transition(
+                            prev,
+                            next,
+                            &r.operator,
+                            &demo.task.objects,
+                            config.transition_check,
+                        )
+                        .err()
+                    }
+                }
             };
             let verdict = match &problem {
                 None => Verdict::Accepted {

@@ -1,6 +1,7 @@
 # nesy's static checks of a policy's source. Runs inside the embedded interpreter, before
 # the audit hook is armed, on the parsed AST; the policy's code is never executed here.
 import ast
+import difflib
 from _string import formatter_parser
 
 # Names the policy may not use at all (in addition to every name starting with "_").
@@ -21,6 +22,14 @@ DENIED_ATTRIBUTES = frozenset({
 })
 
 ALLOWED_MODULES = frozenset({"math", "numpy", "robot"})
+
+# Set by nesy when the runtime is prepared (interpreter.rs): every name a policy's globals
+# hold before it runs (the curated builtins, the robot API functions, `robot`, `np`), and
+# each API function's parameters as ((name, required), ...) with its rendered signature.
+KNOWN_GLOBALS = frozenset()
+API_PARAMETERS = {}
+# The public names of each importable module, which `from M import *` binds.
+STAR_EXPORTS = {}
 
 
 class Checker(ast.NodeVisitor):
@@ -155,6 +164,111 @@ class Checker(ast.NodeVisitor):
         self.generic_visit(node)
 
 
+class Bindings(ast.NodeVisitor):
+    """Every name the program binds anywhere (any scope): assignments, loop and `with`
+    targets, definitions, parameters, imports, `except ... as`, `global`, match captures."""
+
+    def __init__(self):
+        self.names = set()
+
+    def visit_Name(self, node):
+        if isinstance(node.ctx, (ast.Store, ast.Del)):
+            self.names.add(node.id)
+
+    def visit_FunctionDef(self, node):
+        self.names.add(node.name)
+        self.generic_visit(node)
+
+    visit_AsyncFunctionDef = visit_FunctionDef
+    visit_ClassDef = visit_FunctionDef
+
+    def visit_arg(self, node):
+        self.names.add(node.arg)
+
+    def visit_ImportFrom(self, node):
+        for alias in node.names:
+            if alias.name == "*":
+                self.names.update(STAR_EXPORTS.get(node.module, ()))
+            else:
+                self.names.add(alias.asname or alias.name)
+
+    def visit_alias(self, node):
+        # `import a.b` binds `a`; (ImportFrom's aliases are handled above).
+        self.names.add(node.asname or node.name.split(".")[0])
+
+    def visit_ExceptHandler(self, node):
+        if node.name:
+            self.names.add(node.name)
+        self.generic_visit(node)
+
+    def visit_Global(self, node):
+        self.names.update(node.names)
+
+    visit_Nonlocal = visit_Global
+
+    def visit_MatchAs(self, node):
+        if node.name:
+            self.names.add(node.name)
+        self.generic_visit(node)
+
+    def visit_MatchStar(self, node):
+        if node.name:
+            self.names.add(node.name)
+
+    def visit_MatchMapping(self, node):
+        if node.rest:
+            self.names.add(node.rest)
+        self.generic_visit(node)
+
+
+def api_call_problem(node):
+    """Why a call of a robot API function cannot bind to its parameters, or None. Calls
+    with *args or **kwargs are left to the run time."""
+    params, rendered = API_PARAMETERS[node.func.id]
+    if any(isinstance(a, ast.Starred) for a in node.args) or any(k.arg is None for k in node.keywords):
+        return None
+    names = [name for name, _required in params]
+    given = len(node.args)
+    if given > len(params):
+        return f"{node.func.id}() takes at most {len(params)} argument(s) ({given} given); signature: {rendered}"
+    for keyword in node.keywords:
+        if keyword.arg not in names:
+            return f"{node.func.id}() has no parameter {keyword.arg!r}; signature: {rendered}"
+        if names.index(keyword.arg) < given:
+            return f"{node.func.id}() got two values for {keyword.arg!r}; signature: {rendered}"
+    passed = set(names[:given]) | {k.arg for k in node.keywords}
+    for name, required in params:
+        if required and name not in passed:
+            return f"{node.func.id}() is missing its argument {name!r}; signature: {rendered}"
+    return None
+
+
+def name_findings(tree):
+    """Names the program reads that nothing defines (each would be a NameError once the
+    robot has already moved), and robot API calls whose arguments do not fit."""
+    bindings = Bindings()
+    bindings.visit(tree)
+    known = KNOWN_GLOBALS | bindings.names
+    findings = []
+    reported = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load):
+            # Underscore names are refused by the Checker already.
+            if node.id in known or node.id.startswith("_") or node.id in reported:
+                continue
+            reported.add(node.id)
+            close = difflib.get_close_matches(node.id, sorted(known), n=1, cutoff=0.7)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            findings.append((node.lineno, node.col_offset + 1,
+                             f"name {node.id!r} is not defined: not a robot API function, an available builtin or a name the program assigns{hint}"))
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+              and node.func.id in API_PARAMETERS and node.func.id not in bindings.names):
+            problem = api_call_problem(node)
+            if problem:
+                findings.append((node.lineno, node.col_offset + 1, problem))
+    return findings
+
+
 def check(source):
     """Returns a list of (line, column, message); empty if the source may run."""
     # CPython 3.11 refuses a null byte with ValueError, 3.12 and later with SyntaxError and
@@ -177,6 +291,7 @@ def check(source):
     checker = Checker()
     try:
         checker.visit(tree)
+        names = name_findings(tree)
     except RecursionError:
         return [(1, 1, "invalid source: nested too deeply to check")]
-    return sorted(checker.findings)
+    return sorted(checker.findings + names)

@@ -203,6 +203,46 @@ pub(crate) fn prepared(py: Python<'_>) -> Result<&Prepared, InitError> {
         .map_err(Clone::clone)
 }
 
+/// The names a policy's module globals hold besides the curated builtins and the robot API
+/// functions; `runner::execute` sets exactly these.
+pub(crate) const POLICY_GLOBALS: [&str; 4] = ["__builtins__", "__name__", "robot", "np"];
+
+/// Gives the static checker what the policy's globals will hold (`KNOWN_GLOBALS`) and the
+/// robot API's parameters (`API_PARAMETERS`), so it can refuse undefined names and API calls
+/// whose arguments cannot bind before anything runs.
+fn tell_checker_the_globals(
+    py: Python<'_>,
+    checker: &Bound<'_, PyModule>,
+    importable: [(&str, &Bound<'_, PyModule>); 3],
+) -> PyResult<()> {
+    let mut known: Vec<&str> = builtins::ALLOWED_BUILTINS.to_vec();
+    known.push("__import__");
+    known.extend(POLICY_GLOBALS);
+    known.extend(robot_module::SIGNATURES.iter().map(|s| s.name));
+    checker.setattr("KNOWN_GLOBALS", pyo3::types::PyFrozenSet::new(py, &known)?)?;
+    let parameters = PyDict::new(py);
+    for sig in robot_module::SIGNATURES {
+        let params: Vec<(&str, bool)> = sig
+            .params
+            .iter()
+            .map(|(name, default)| (*name, default.is_none()))
+            .collect();
+        parameters.set_item(sig.name, (params, sig.render()))?;
+    }
+    checker.setattr("API_PARAMETERS", parameters)?;
+    let exports = PyDict::new(py);
+    for (name, module) in importable {
+        let public: Vec<String> = module
+            .dir()?
+            .iter()
+            .filter_map(|n| n.extract::<String>().ok())
+            .filter(|n| !n.starts_with('_'))
+            .collect();
+        exports.set_item(name, pyo3::types::PyFrozenSet::new(py, &public)?)?;
+    }
+    checker.setattr("STAR_EXPORTS", exports)
+}
+
 fn prepare(py: Python<'_>) -> PyResult<Prepared> {
     let robot = py.import("robot")?;
     let math = py.import("math")?;
@@ -225,6 +265,11 @@ fn prepare(py: Python<'_>) -> PyResult<Prepared> {
     builtins::register_module(py, "numpy", numpy.as_any())?;
     robot_module::set_array_constructor(py, numpy.getattr("array")?.unbind());
     budget::set_violation_type(py.get_type::<robot_module::SandboxViolation>().as_ptr());
+    tell_checker_the_globals(
+        py,
+        &checker_module,
+        [("robot", &robot), ("math", &math), ("numpy", &numpy)],
+    )?;
     let mut api = Vec::with_capacity(robot_module::SIGNATURES.len());
     for sig in robot_module::SIGNATURES {
         api.push((sig.name, robot.getattr(sig.name)?.unbind()));

@@ -159,16 +159,17 @@ fn is_python(tag: &str) -> bool {
 /// How many robot API calls a program makes (occurrences of `name(`).
 pub fn count_api_calls(code: &str) -> usize {
     api_docs::all_functions()
-        .map(|name| {
-            code.match_indices(name)
-                .filter(|(at, _)| {
-                    let before = code[..*at].chars().next_back();
-                    let after = code[at + name.len()..].trim_start().starts_with('(');
-                    after && !before.is_some_and(|c| c.is_alphanumeric() || c == '_')
-                })
-                .count()
-        })
+        .map(|name| call_offsets(code, name).count())
         .sum()
+}
+
+/// Byte offsets in `text` where `name(` is written as a call: not the tail of a longer name.
+pub(crate) fn call_offsets<'a>(text: &'a str, name: &'a str) -> impl Iterator<Item = usize> + 'a {
+    text.match_indices(name).map(|(at, _)| at).filter(move |&at| {
+        let before = text[..at].chars().next_back();
+        let after = text[at + name.len()..].trim_start().starts_with('(');
+        after && !before.is_some_and(|c| c.is_alphanumeric() || c == '_')
+    })
 }
 
 /// Takes the program out of a reply (see the module documentation for the rules).

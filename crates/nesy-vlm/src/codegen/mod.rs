@@ -12,7 +12,7 @@ pub use extract::{CodeBlock, ExtractError, ExtractedCode, StrippedImport, count_
 use crate::client::VlmClient;
 use crate::context::{CodeGenerationContext, Embodiment, VlmTask};
 use crate::error::VlmError;
-use crate::prompts::{CodeGenerationPrompt, PromptError, Prompts, action_names};
+use crate::prompts::{CodeGenerationPrompt, PromptError, Prompts, action_names, api_docs};
 use crate::request::{ChatRequest, Message};
 use crate::settings::CallSettings;
 
@@ -46,6 +46,9 @@ pub struct PolicySource {
     pub stripped: Vec<StrippedImport>,
     /// Whether the extended prompt was used.
     pub extended: bool,
+    /// Earlier replies of this call that could not be used, each re-asked with its problem.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rejected: Vec<RejectedProgram>,
 }
 
 /// Why code generation failed.
@@ -57,15 +60,87 @@ pub enum CodegenError {
     /// A prompt template failed (a defect of nesy's own files).
     #[error(transparent)]
     Prompt(#[from] PromptError),
-    /// The reply holds no usable program.
-    #[error("code generation reply holds no program: {error}")]
+    /// The checks before execution could not run (the embedded interpreter failed to start).
+    #[error("checking the generated program: {0}")]
+    Check(#[from] nesy_policy::InitError),
+    /// No reply within the budget held a usable program; every reply and why it was not used.
+    #[error(
+        "code generation gave no usable program in {} attempt(s); the last {}",
+        attempts.len(),
+        attempts.last().map_or_else(String::new, |a| a.problem.to_string())
+    )]
     NoProgram {
-        /// What was wrong.
-        error: ExtractError,
-        /// The reply.
-        reply: String,
+        /// The replies, in order, each with its problem.
+        attempts: Vec<RejectedProgram>,
     },
 }
+
+/// A code-generation reply that was not used, and why.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RejectedProgram {
+    /// The reply (for a truncated one, the text before the cap).
+    pub reply: String,
+    /// Why it was not used.
+    pub problem: ProgramProblem,
+}
+
+/// Why a code-generation reply cannot be run.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ProgramProblem {
+    /// No program could be taken out of the reply.
+    #[error("reply could not be read: {error}")]
+    Unreadable {
+        /// What was wrong.
+        error: ExtractError,
+    },
+    /// The reply stopped at the token cap.
+    #[error("reply was cut off at the token cap ({})", cap.map_or_else(|| "the backend's default".to_string(), |c| format!("{c} tokens")))]
+    Truncated {
+        /// The request's cap, if it set one.
+        cap: Option<u32>,
+    },
+    /// The program's code block was never closed: the reply was cut off.
+    #[error("program was cut off: its code block opened on line {line} of the reply is never closed")]
+    Unterminated {
+        /// 1-based line of the opening fence.
+        line: usize,
+    },
+    /// The checks before execution refused the program.
+    #[error("program was refused before running: {}", findings.join("; "))]
+    Refused {
+        /// `line:column: message`, one per finding.
+        findings: Vec<String>,
+    },
+}
+
+impl ProgramProblem {
+    /// The message that goes back to the model with the re-ask.
+    pub fn feedback(&self) -> String {
+        let ask = "Reply with the whole corrected program in one ```python code block.";
+        match self {
+            ProgramProblem::Truncated { .. } => format!(
+                "Your {self}. Answer more briefly: the complete program in one ```python code block, without explanation."
+            ),
+            ProgramProblem::Unterminated { .. } => {
+                format!("Your {self}. {ask} Close the block with ``` on its own line.")
+            }
+            ProgramProblem::Unreadable { .. } => format!("Your {self}. {ask}"),
+            ProgramProblem::Refused { findings } => format!(
+                "Your program was refused before running, and the robot has not moved:\n{}\nUse only the robot API functions listed above for this end effector, Python's builtins, and names the program defines. {ask}",
+                findings
+                    .iter()
+                    .map(|f| format!("- line {f}"))
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            ),
+        }
+    }
+}
+
+/// How many replies code generation asks for at most: the first and two re-asks, each with
+/// the reason the previous reply could not be used.
+pub const CODEGEN_ATTEMPTS: usize = 3;
 
 impl CodegenError {
     /// The reasoner failure this is: the call's own kind, a defect of the request, or a
@@ -75,6 +150,7 @@ impl CodegenError {
         match self {
             CodegenError::Vlm(e) => e.reasoner_kind(),
             CodegenError::Prompt(_) => Kind::Request,
+            CodegenError::Check(_) => Kind::Request,
             CodegenError::NoProgram { .. } => Kind::Reply,
         }
     }
@@ -116,28 +192,114 @@ pub fn build_request(
     Ok((settings.apply(chat), extended))
 }
 
-/// Asks the model for a program and extracts it from the reply.
+/// Asks the model for a program, takes it out of the reply and checks it before anything
+/// runs: the code block must be closed, the sandbox's static checks (which refuse names
+/// nothing defines and robot API calls whose arguments do not bind) must pass, and no
+/// function of the other end effector may be called. A reply that fails goes back to the
+/// model with the reason, up to [`CODEGEN_ATTEMPTS`] replies in all; a reply cut off at the
+/// token cap is re-asked the same way, asking for a briefer answer.
 pub async fn generate_code(
     client: &VlmClient,
     prompts: &Prompts,
     request: &CodeGenerationRequest,
     settings: &CallSettings,
 ) -> Result<PolicySource, CodegenError> {
-    let (chat, extended) = build_request(prompts, request, settings)?;
-    let reply = client.chat(chat).await?.text;
-    match extract_code(&reply) {
-        Ok(extracted) => {
-            for s in &extracted.stripped {
-                tracing::info!(line = s.line, statement = %s.text, "removed an import from the generated program: {}", s.reason);
+    let (mut chat, extended) = build_request(prompts, request, settings)?;
+    let mut rejected: Vec<RejectedProgram> = Vec::new();
+    for _ in 0..CODEGEN_ATTEMPTS {
+        let (reply, checked) = match client.chat(chat.clone()).await {
+            Ok(response) => {
+                let checked = usable_program(&response.text, request.embodiment)?;
+                (response.text, checked)
             }
-            Ok(PolicySource {
-                code: extracted.code,
-                reply,
-                block: extracted.block,
-                stripped: extracted.stripped,
-                extended,
-            })
+            Err(VlmError::Truncated { partial_text, .. }) => (
+                partial_text,
+                Err(ProgramProblem::Truncated {
+                    cap: chat.max_output_tokens,
+                }),
+            ),
+            Err(other) => return Err(other.into()),
+        };
+        match checked {
+            Ok(extracted) => {
+                for s in &extracted.stripped {
+                    tracing::info!(line = s.line, statement = %s.text, "removed an import from the generated program: {}", s.reason);
+                }
+                return Ok(PolicySource {
+                    code: extracted.code,
+                    reply,
+                    block: extracted.block,
+                    stripped: extracted.stripped,
+                    extended,
+                    rejected,
+                });
+            }
+            Err(problem) => {
+                tracing::info!(
+                    attempt = rejected.len() + 1,
+                    "generated program not used: {problem}"
+                );
+                chat = chat
+                    .message(Message::assistant(reply.clone()))
+                    .message(Message::user_text(problem.feedback()));
+                rejected.push(RejectedProgram { reply, problem });
+            }
         }
-        Err(error) => Err(CodegenError::NoProgram { error, reply }),
     }
+    Err(CodegenError::NoProgram { attempts: rejected })
+}
+
+/// The program of `reply` if it may run on `embodiment`; otherwise why not. `Err` of the
+/// outer result only when the checks themselves cannot run.
+pub fn usable_program(
+    reply: &str,
+    embodiment: Embodiment,
+) -> Result<Result<ExtractedCode, ProgramProblem>, nesy_policy::InitError> {
+    let extracted = match extract_code(reply) {
+        Ok(extracted) => extracted,
+        Err(error) => return Ok(Err(ProgramProblem::Unreadable { error })),
+    };
+    if !extracted.block.terminated {
+        return Ok(Err(ProgramProblem::Unterminated {
+            line: extracted.block.line,
+        }));
+    }
+    let mut findings: Vec<(u32, u32, String)> = nesy_policy::check_source(&extracted.code)?
+        .into_iter()
+        .map(|v| (v.line, v.column, v.message))
+        .collect();
+    findings.extend(other_end_effector_calls(&extracted.code, embodiment));
+    findings.sort();
+    if findings.is_empty() {
+        Ok(Ok(extracted))
+    } else {
+        Ok(Err(ProgramProblem::Refused {
+            findings: findings
+                .into_iter()
+                .map(|(line, column, message)| format!("{line}:{column}: {message}"))
+                .collect(),
+        }))
+    }
+}
+
+/// Calls of functions the target's end effector does not have (the simulator would refuse
+/// them after the robot had already moved), as `(line, column, message)`.
+fn other_end_effector_calls(code: &str, embodiment: Embodiment) -> Vec<(u32, u32, String)> {
+    let (foreign, own): (&[&str], &str) = match embodiment {
+        Embodiment::Finger => (&api_docs::VACUUM_FUNCTIONS, "a finger gripper"),
+        Embodiment::Vacuum => (&api_docs::FINGER_ONLY_FUNCTIONS, "a vacuum suction tool"),
+    };
+    let mut found = Vec::new();
+    for (index, line) in code.lines().enumerate() {
+        for name in foreign {
+            if let Some(at) = extract::call_offsets(line, name).next() {
+                found.push((
+                    index as u32 + 1,
+                    line[..at].chars().count() as u32 + 1,
+                    format!("{name}() is not available: this robot has {own}"),
+                ));
+            }
+        }
+    }
+    found
 }

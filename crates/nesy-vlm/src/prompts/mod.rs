@@ -391,7 +391,11 @@ impl Prompts {
     pub fn induction_feedback(&self, feedback: &Feedback) -> Result<String, PromptError> {
         self.render(
             "induction.feedback.j2",
-            serde_json::json!({ "attempt": feedback.attempt + 1, "message": feedback.message.trim() }),
+            serde_json::json!({
+                "attempt": feedback.attempt + 1,
+                "message": feedback.message.trim(),
+                "unreadable": feedback.problem.is_unreadable(),
+            }),
         )
     }
 
@@ -426,7 +430,11 @@ impl Prompts {
     pub fn refinement_feedback(&self, feedback: &Feedback) -> Result<String, PromptError> {
         self.render(
             "refinement.feedback.j2",
-            serde_json::json!({ "attempt": feedback.attempt + 1, "message": feedback.message.trim() }),
+            serde_json::json!({
+                "attempt": feedback.attempt + 1,
+                "message": feedback.message.trim(),
+                "unreadable": feedback.problem.is_unreadable(),
+            }),
         )
     }
 

@@ -70,6 +70,7 @@ pub fn target() -> Target {
             "(OnTopOf hinge_body floor)",
         ]),
         task: task(Tier::Full),
+        scene_names: Vec::new(),
     }
 }
 
