@@ -10,6 +10,7 @@ cd "$(dirname "$0")/../fuzz"
 secs=${1:-60}
 shift || true
 targets=("$@")
+set -- "${targets[@]}"
 [ ${#targets[@]} -gt 0 ] || mapfile -t targets < <(sed -n 's/^name = "\(.*\)"$/\1/p' Cargo.toml | grep -v '^nesy-fuzz$')
 
 seed() { # seed TARGET FILE...
@@ -28,7 +29,11 @@ seed policy_source seeds/policy_source/*
 seed pddl ../fixtures/pddl/*/*.pddl ../assets/pddl/*.pddl ../fixtures/planning/*.pddl
 seed plan ../fixtures/pddl/*/*.plan
 
-cargo +nightly fuzz build --release "${targets[@]}" >&2
+if [ $# -eq 0 ]; then
+  cargo +nightly fuzz build --release >&2
+else
+  for t in "${targets[@]}"; do cargo +nightly fuzz build --release "$t" >&2; done
+fi
 echo "| target | seconds | runs | corpus files | result |"
 echo "|---|---|---|---|---|"
 for t in "${targets[@]}"; do

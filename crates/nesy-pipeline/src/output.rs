@@ -192,6 +192,19 @@ fn inductions(adaptation: &Adaptation) -> Vec<serde_json::Value> {
         .collect()
 }
 
+/// The code-generation replies that were re-asked, each with its problem and the reply.
+fn write_rejected_programs(md: &mut String, rejected: &[nesy_vlm::codegen::RejectedProgram]) {
+    for (i, r) in rejected.iter().enumerate() {
+        let _ = writeln!(
+            md,
+            "Reply {} was not used ({}):\n\n````text\n{}\n````\n",
+            i + 1,
+            r.problem,
+            r.reply.trim_end()
+        );
+    }
+}
+
 /// How many induction calls the run made, and how many replies were rejected or unreadable.
 pub fn induction_counts(adaptation: &Adaptation) -> InductionCounts {
     let mut counts = InductionCounts::default();
@@ -423,9 +436,13 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
                 "`policy.py`, from {how}:\n\n```python\n{}\n```\n",
                 p.code.trim_end()
             );
+            write_rejected_programs(&mut md, &p.rejected);
         }
         (None, Some(e)) => {
             let _ = writeln!(md, "Code synthesis failed: {e}\n");
+            if let crate::SynthError::NoProgram { replies, .. } = e {
+                write_rejected_programs(&mut md, replies);
+            }
         }
         (None, None) => {
             let _ = writeln!(

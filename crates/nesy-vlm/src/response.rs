@@ -96,6 +96,9 @@ struct WireChoice {
 struct WireMessage {
     content: Option<serde_json::Value>,
     refusal: Option<String>,
+    /// vLLM's and DeepSeek's field for a reasoning model's thinking (some servers put the
+    /// whole answer there and leave `content` null).
+    reasoning_content: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -170,12 +173,23 @@ pub(crate) fn parse_completion(
         cached_prompt_tokens: u.prompt_tokens_details.and_then(|d| d.cached_tokens).unwrap_or(0),
     });
     let finish_reason = FinishReason::from_wire(choice.finish_reason.as_deref());
-    let (content, refusal) = match choice.message {
-        Some(message) => (message.content, message.refusal),
-        None => (None, None),
+    let (content, refusal, reasoning) = match choice.message {
+        Some(message) => (message.content, message.refusal, message.reasoning_content),
+        None => (None, None, None),
     };
-    let text = content_text(content.as_ref())
+    let mut text = content_text(content.as_ref())
         .ok_or_else(|| invalid("`choices[0].message.content` is neither text nor text parts".into()))?;
+    // A server that leaves `content` empty and puts the answer in `reasoning_content`: the
+    // reply's reader decides whether it holds an answer (and re-asks if not).
+    if text.trim().is_empty()
+        && let Some(reasoning) = reasoning.filter(|r| !r.trim().is_empty())
+    {
+        tracing::warn!(
+            chars = reasoning.len(),
+            "the reply's content is empty or null; reading its reasoning_content instead"
+        );
+        text = reasoning;
+    }
     let parsed = ParsedCompletion {
         text: text.clone(),
         finish_reason: finish_reason.clone(),
@@ -230,6 +244,18 @@ mod tests {
         assert_eq!(parsed.text, "hi");
         assert_eq!(parsed.usage, None);
         assert!(error.is_none());
+    }
+
+    #[test]
+    fn an_answer_left_in_reasoning_content_is_read_when_content_is_null() {
+        let body = br#"{"choices":[{"message":{"content":null,"reasoning_content":"- (GripperOpen)"},"finish_reason":"stop"}]}"#;
+        assert_eq!(
+            parse_completion(200, body, None).unwrap().0.text,
+            "- (GripperOpen)"
+        );
+        // With an answer in `content`, the reasoning stays out of it.
+        let body = br#"{"choices":[{"message":{"content":"None","reasoning_content":"thinking"},"finish_reason":"stop"}]}"#;
+        assert_eq!(parse_completion(200, body, None).unwrap().0.text, "None");
     }
 
     #[test]

@@ -6,7 +6,7 @@
 use nesy_core::atom::Atom;
 use nesy_core::predicates::{Tier, Vocabulary};
 use nesy_core::state::State;
-use nesy_core::text::{ParseError, parse_state_list};
+use nesy_core::text::{ParseError, normalize_reply, parse_state_list};
 use serde::{Deserialize, Serialize};
 
 use crate::client::VlmClient;
@@ -93,15 +93,19 @@ pub enum TranslateError {
     /// A prompt template failed (a defect of nesy's own files).
     #[error(transparent)]
     Prompt(#[from] PromptError),
-    /// The reply is not a state list.
-    #[error("state translation reply for {view_set} is not a state list: {error}")]
+    /// No reply within the budget could be read as a state list.
+    #[error(
+        "state translation for {view_set}: no reply in {attempts} could be read as a state list; the last: {error}"
+    )]
     Parse {
         /// Which views.
         view_set: String,
-        /// The parse error, with line and column in the reply.
+        /// The last parse error, with line and column in the (normalised) reply.
         error: ParseError,
-        /// The reply.
+        /// The last reply.
         reply: String,
+        /// Replies asked for.
+        attempts: usize,
     },
 }
 
@@ -184,21 +188,47 @@ pub fn check_atoms(
     (State::from_atoms(accepted), rejected)
 }
 
-/// Asks the model for the scene's atoms and returns the known atoms plus the accepted
-/// predictions.
+/// How many replies one state translation asks for at most: the first and two re-asks, each
+/// with the reason the previous reply could not be read.
+pub const TRANSLATION_ATTEMPTS: usize = 3;
+
+/// Asks the model for the atoms of one view set, reads the reply (after
+/// [`nesy_core::text::normalize_reply`]) as a state list, and keeps the atoms the vocabulary,
+/// the tier and the objects allow. A reply that is not a state list goes back to the model
+/// with the parse error, up to [`TRANSLATION_ATTEMPTS`] replies; only then is it
+/// [`TranslateError::Parse`].
 pub async fn translate_state(
     client: &VlmClient,
     prompts: &Prompts,
     request: &StateTranslationRequest,
     settings: &CallSettings,
 ) -> Result<TranslatedState, TranslateError> {
-    let chat = build_request(prompts, request, settings)?;
-    let reply = client.chat(chat).await?.text;
-    let parsed = parse_state_list(&reply).map_err(|error| TranslateError::Parse {
-        view_set: request.view_set.clone(),
-        error,
-        reply: reply.clone(),
-    })?;
+    let mut chat = build_request(prompts, request, settings)?;
+    let mut attempt = 0;
+    let (reply, parsed) = loop {
+        attempt += 1;
+        let reply = client.chat(chat.clone()).await?.text;
+        match parse_state_list(&normalize_reply(&reply)) {
+            Ok(parsed) => break (reply, parsed),
+            Err(error) if attempt < TRANSLATION_ATTEMPTS => {
+                tracing::info!(view_set = %request.view_set, attempt, "state translation reply could not be read: {error}");
+                let feedback = format!(
+                    "Your reply could not be read as a state list: {error}. Answer with the true atoms only, one per line as `- (Predicate arg ...)`, or `None`, and nothing else."
+                );
+                chat = chat
+                    .message(Message::assistant(reply))
+                    .message(Message::user_text(feedback));
+            }
+            Err(error) => {
+                return Err(TranslateError::Parse {
+                    view_set: request.view_set.clone(),
+                    error,
+                    reply,
+                    attempts: attempt,
+                });
+            }
+        }
+    };
     let (predicted, rejected) = check_atoms(&parsed, &request.vocabulary, request.tier, &request.objects);
     for r in &rejected {
         tracing::warn!(view_set = %request.view_set, atom = %r.atom, rejection = ?r.rejection, "rejected a predicted atom");

@@ -304,7 +304,19 @@ async fn the_loop_recovers_from_a_rejected_operator_and_a_non_matching_patch() {
 
 #[tokio::test]
 async fn state_translation_adds_checked_atoms_to_the_known_ones() {
-    let transport = Scripted::with(&[("translate", &[scenario::TRANSLATION, "I see a table."])]);
+    let table = "I see a table.";
+    let drifted = "Combining all three views:\n<think>the lid looks shut</think>\n\u{2013} `(Closed hinge_lid)`\n\u{2022} (OnTopOf apple floor)\n\u{2013} (OnTopOf hinge_body floor)";
+    let transport = Scripted::with(&[(
+        "translate",
+        &[
+            scenario::TRANSLATION,
+            table,
+            table,
+            table,
+            "Here they are.",
+            drifted,
+        ],
+    )]);
     let reasoner = VlmReasoner::new(client(transport.clone())).unwrap();
     let png = |seed| Image::png(common::png(16, seed)).unwrap();
     let request = StateTranslationRequest {
@@ -335,15 +347,29 @@ async fn state_translation_adds_checked_atoms_to_the_known_ones() {
     // The ground truth never reaches the wire.
     assert!(!sent.body.to_string().contains("Closed hinge_lid"));
 
+    // Prose is re-asked with the parse error; when the budget runs out the error says so.
     match reasoner.translate_state(&request).await {
-        Err(TranslateError::Parse { error, reply, .. }) => {
-            assert_eq!(reply, "I see a table.");
+        Err(TranslateError::Parse {
+            error,
+            reply,
+            attempts,
+            ..
+        }) => {
+            assert_eq!(reply, table);
             assert_eq!(error.line, 1);
+            assert_eq!(attempts, nesy_vlm::translate::TRANSLATION_ATTEMPTS);
         }
         other => panic!("{other:?}"),
     }
+    let sent = transport.requests("translate");
+    let reask = text_of(&messages(&sent[2])[3]);
+    assert!(reask.contains("could not be read as a state list"), "{reask}");
+    // Typographic drift (a preamble, a think section, en-dash bullets, inline code) reads
+    // after one re-ask of a reply with no list at all.
+    let translated = reasoner.translate_state(&request).await.unwrap();
+    assert_eq!(translated.state, scenario::target().init);
     let usage = reasoner.client().usage();
-    assert_eq!(usage.by_purpose["translate"].calls, 2);
+    assert_eq!(usage.by_purpose["translate"].calls, 1 + 3 + 2);
 }
 
 /// A program in a python block, as a model would answer.

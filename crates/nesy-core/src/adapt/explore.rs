@@ -12,7 +12,7 @@ use crate::formula::Formula;
 use crate::operator::Operator;
 use crate::patch::{AppliedPatch, apply_patch};
 use crate::state::State;
-use crate::text::{RefinementReply, parse_refinement_reply};
+use crate::text::{RefinementReply, normalize_reply, parse_refinement_reply};
 use crate::types::Universe;
 
 /// The universe the loop verifies over: every object of the target's initial state, the
@@ -303,7 +303,7 @@ pub async fn explore<R: Reasoner>(
         let this_iteration = iteration;
         iteration += 1;
 
-        let parsed = parse_refinement_reply(&reply);
+        let parsed = parse_refinement_reply(&normalize_reply(&reply));
         let near = visible
             .failing_step
             .unwrap_or(if visible.kind == ViolationKind::Goal {

@@ -12,7 +12,7 @@ use crate::formula::Formula;
 use crate::operator::Operator;
 use crate::state::State;
 use crate::symbol::Symbol;
-use crate::text::parse_induction_reply;
+use crate::text::{normalize_reply, parse_induction_reply};
 
 /// The verified symbolic world model W of a demonstration.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -161,7 +161,7 @@ pub async fn construct_world_model<R: Reasoner>(
                 feedback: feedback.clone(),
             };
             let reply = reasoner.induce_operator(&request).await?;
-            let parsed = parse_induction_reply(&reply);
+            let parsed = parse_induction_reply(&normalize_reply(&reply));
             let problem = match &parsed {
                 Err(error) => Some(Problem::Unparsable { error: error.clone() }),
                 Ok(r) => {

@@ -21,6 +21,7 @@ mod action_block;
 mod direct;
 mod induction;
 pub(crate) mod lines;
+mod normalize;
 mod refinement;
 pub(crate) mod sexpr;
 mod state_list;
@@ -29,6 +30,7 @@ pub(crate) mod syntax;
 pub use action_block::{parse_action_block, parse_procedure};
 pub use induction::{InductionReply, parse_induction_reply};
 pub use lines::normalize_action_name;
+pub use normalize::normalize_reply;
 pub use refinement::{RefinementReply, parse_refinement_reply};
 pub use state_list::parse_state_list;
 

@@ -61,6 +61,17 @@ pub fn parse_state_list(text: &str) -> Result<State, ParseError> {
                         Some(a) => atoms.push(a),
                         None => return Err(conv.err(e.span.start, ParseErrorKind::Syntax, "a ground atom")),
                     },
+                    // `(and (A) (B))` lists the same atoms as two lines would.
+                    Formula::And(parts)
+                        if parts
+                            .iter()
+                            .all(|p| matches!(p, Formula::Atom(a) if a.as_atom().is_some())) =>
+                    {
+                        atoms.extend(parts.iter().filter_map(|p| match p {
+                            Formula::Atom(a) => a.as_atom(),
+                            _ => None,
+                        }));
+                    }
                     _ => {
                         return Err(conv.err(
                             e.span.start,
@@ -97,6 +108,9 @@ mod tests {
         assert!(s.contains(&Atom::new("Closed", &["hinge_lid"])));
         assert_eq!(parse_state_list("None").unwrap(), State::new());
         assert_eq!(parse_state_list("- None").unwrap(), State::new());
+        // A conjunction of atoms is the same list.
+        let s = parse_state_list("(and (GripperOpen) (Closed hinge_lid))").unwrap();
+        assert_eq!(s.len(), 2);
     }
 
     #[test]
