@@ -174,3 +174,34 @@ fn a_replay_writes_the_usage_report_the_environment_asks_for() {
         "{usage}"
     );
 }
+
+#[test]
+fn a_run_that_stops_before_an_outcome_leaves_failure_json() {
+    // Another demo's cassette: the first induction request is a miss.
+    let out = common::scratch();
+    let (code, _, stderr) = adapt(
+        &[
+            "--demo",
+            DEMO,
+            "--target",
+            TARGET,
+            "--vlm",
+            "replay:fixtures/cassettes/adapt-composite_medium.json",
+        ],
+        out.path(),
+    );
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("failure.json records why"), "{stderr}");
+    let failure: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.path().join("failure.json")).unwrap()).unwrap();
+    assert_eq!(failure["status"], "failed");
+    assert_eq!(failure["failure"], "replay");
+    assert!(
+        failure["error"]
+            .as_str()
+            .unwrap()
+            .contains("operator induction for transition 1"),
+        "{failure}"
+    );
+    assert!(out.path().join("target_scene.json").is_file());
+}

@@ -11,11 +11,12 @@
 //! | `target_{top,front,back}[_marked].png` | the rendered target views |
 //! | `report.md` | a readable summary embedding the target views |
 //! | `summary.json` | what `--json` prints |
+//! | `failure.json` | only for a run that stopped before an outcome: the error, naming the call, and its failure kind (with `target_scene.json`) |
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use nesy_core::adapt::{Adaptation, Outcome, TraceEvent, Verdict};
+use nesy_core::adapt::{Adaptation, Outcome, ReasonerErrorKind, TraceEvent, Verdict};
 use nesy_core::format_procedure;
 use serde::Serialize;
 use serde_json::json;
@@ -40,6 +41,49 @@ pub const TARGET_SCENE_FILE: &str = "target_scene.json";
 pub const REPORT_FILE: &str = "report.md";
 /// `summary.json`.
 pub const SUMMARY_FILE: &str = "summary.json";
+/// `failure.json`: written instead of the usual outputs when a run stops before it has an
+/// outcome (a model call whose re-ask budget ran out, a transport failure, a cassette miss).
+pub const FAILURE_FILE: &str = "failure.json";
+
+/// What `failure.json` holds.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunFailure<'a> {
+    /// Always `failed`.
+    pub status: &'static str,
+    /// The error, with the call that failed (`operator induction for transition 3 (attempt
+    /// 2): ...`, `state translation for target/initial: ...`).
+    pub error: String,
+    /// The reasoner failure kind, when a model call failed (`transport`, `reply`, `replay`, ...).
+    pub failure: Option<ReasonerErrorKind>,
+    /// The target scene as given.
+    pub target: &'a Path,
+}
+
+/// Writes `failure.json` and the target scene into `dir` for a run that stopped with
+/// `error` before it had an outcome, so no failed run leaves an empty directory. Errors of
+/// bad input (the demo, the scene, the settings) write nothing: they happen before the run.
+pub fn write_failure(
+    dir: &Path,
+    target: &TargetInput,
+    error: &PipelineError,
+) -> Result<Option<PathBuf>, PipelineError> {
+    if error.is_bad_input() {
+        return Ok(None);
+    }
+    std::fs::create_dir_all(dir).map_err(|e| PipelineError::write(dir, e))?;
+    write(&dir.join(TARGET_SCENE_FILE), &target.scene.to_json_pretty())?;
+    let path = dir.join(FAILURE_FILE);
+    write_json(
+        &path,
+        &RunFailure {
+            status: "failed",
+            error: error.to_string(),
+            failure: error.reasoner_kind(),
+            target: &target.path,
+        },
+    )?;
+    Ok(Some(path))
+}
 
 /// Writes a file, naming it on failure.
 pub fn write(path: &Path, contents: &str) -> Result<(), PipelineError> {

@@ -98,7 +98,20 @@ pub fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
         .enable_all()
         .build()
         .context("starting the async runtime")?;
-    let run = runtime.block_on(pipeline::run(&demo, &target, client, &options, progress.clone()))?;
+    let run = match runtime.block_on(pipeline::run(&demo, &target, client, &options, progress.clone())) {
+        Ok(run) => run,
+        Err(error) => {
+            progress.stage("");
+            // A run that stops before it has an outcome still leaves its record behind.
+            if let Ok(Some(path)) = pipeline::output::write_failure(&options.out_dir, &target, &error) {
+                eprintln!(
+                    "nesy adapt: the run stopped before an outcome; {} records why",
+                    path.display()
+                );
+            }
+            return Err(error.into());
+        }
+    };
     progress.stage("writing the outputs");
     pipeline::output::write_all(&run, &target, &run.out_dir)?;
     progress.stage("");
