@@ -17,7 +17,9 @@ seed() { # seed TARGET FILE...
   local dir="corpus/$1"
   shift
   mkdir -p "$dir"
-  for f in "$@"; do [ -f "$f" ] && cp "$f" "$dir/" ; done
+  for f in "$@"; do
+    if [ -f "$f" ]; then cp "$f" "$dir/"; fi
+  done
 }
 seed scene ../fixtures/scenes/*.json
 seed scenario_config ../fixtures/benchmark/*.json

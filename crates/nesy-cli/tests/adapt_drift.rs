@@ -262,18 +262,6 @@ fn styles() -> Vec<Style> {
     ]
 }
 
-fn message_text(message: &Value) -> String {
-    match &message["content"] {
-        Value::String(s) => s.clone(),
-        Value::Array(parts) => parts
-            .iter()
-            .filter_map(|p| p["text"].as_str())
-            .collect::<Vec<_>>()
-            .join("\n"),
-        _ => String::new(),
-    }
-}
-
 fn respond(reply: Reply) -> ResponseTemplate {
     ResponseTemplate::new(200).set_body_json(json!({
         "id": "chatcmpl-drift",
@@ -302,12 +290,12 @@ impl Respond for Drifting {
     fn respond(&self, request: &Request) -> ResponseTemplate {
         let body: Value = serde_json::from_slice(&request.body).expect("JSON body");
         let messages = body["messages"].as_array().cloned().unwrap_or_default();
-        let system = message_text(&messages[0]);
+        let system = common::message_text(&messages[0]);
         let mut seen = self.seen.lock().unwrap();
         if system.starts_with("You work out which robot action") {
             seen.induce.push(messages.clone());
             // The first request of all is drifted; re-asks (more than two messages) are clean.
-            let user = message_text(&messages[1]);
+            let user = common::message_text(&messages[1]);
             let clean = common::operator_from_diff(&user, seen.induce.len());
             if self.call == Call::Induction && seen.induce.len() == 1 {
                 respond((self.drift)(&clean))
@@ -372,7 +360,10 @@ async fn every_drifted_or_wrong_reply_is_read_or_re_asked_over_http() {
             Call::Codegen => &seen.codegen,
         };
         // A re-ask is a request with the earlier reply and the reason after it.
-        let reask = requests.iter().find(|m| m.len() > 2).map(|m| message_text(&m[3]));
+        let reask = requests
+            .iter()
+            .find(|m| m.len() > 2)
+            .map(|m| common::message_text(&m[3]));
         let problem = if output.status.code() != Some(0) || !stdout.contains("SUCCEEDED") {
             Some(format!(
                 "did not succeed (exit {:?}):\n{stdout}\n{stderr}",

@@ -27,18 +27,6 @@ struct Scripted {
     seen: Arc<Mutex<Seen>>,
 }
 
-fn message_text(message: &Value) -> String {
-    match &message["content"] {
-        Value::String(s) => s.clone(),
-        Value::Array(parts) => parts
-            .iter()
-            .filter_map(|p| p["text"].as_str())
-            .collect::<Vec<_>>()
-            .join("\n"),
-        _ => String::new(),
-    }
-}
-
 fn completion(text: &str) -> ResponseTemplate {
     ResponseTemplate::new(200).set_body_json(json!({
         "id": "chatcmpl-mock",
@@ -52,10 +40,10 @@ fn completion(text: &str) -> ResponseTemplate {
 impl Respond for Scripted {
     fn respond(&self, request: &Request) -> ResponseTemplate {
         let body: Value = serde_json::from_slice(&request.body).expect("JSON body");
-        let system = message_text(&body["messages"][0]);
+        let system = common::message_text(&body["messages"][0]);
         let mut seen = self.seen.lock().unwrap();
         if system.starts_with("You work out which robot action") {
-            let user = message_text(&body["messages"][1]);
+            let user = common::message_text(&body["messages"][1]);
             seen.induce.push(body.clone());
             completion(&common::operator_from_diff(&user, seen.induce.len()))
         } else if system.starts_with("You write Python programs") {

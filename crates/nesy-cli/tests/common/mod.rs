@@ -96,3 +96,17 @@ pub fn operator_from_diff(user: &str, n: usize) -> String {
         "Comparing the two states, I can see what changed.\n\n* Prediction Rationale:\n- The atoms listed as removed held before the step.\n\n* Predicted Action:\nAction Semantic:\n- Demo step {n}\nPrecondition:\n{pre}\nEffect:\n{eff}\n"
     )
 }
+
+/// The text of a chat message as a server receives it: a string, or the text parts of a
+/// multi-part content joined by newlines.
+pub fn message_text(message: &serde_json::Value) -> String {
+    match &message["content"] {
+        serde_json::Value::String(s) => s.clone(),
+        serde_json::Value::Array(parts) => parts
+            .iter()
+            .filter_map(|p| p["text"].as_str())
+            .collect::<Vec<_>>()
+            .join("\n"),
+        _ => String::new(),
+    }
+}

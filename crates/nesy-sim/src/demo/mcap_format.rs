@@ -364,6 +364,55 @@ fn record_limit(file_len: usize) -> usize {
     file_len.saturating_mul(16).max(64 << 20)
 }
 
+/// MCAP opcodes of the records a demo is read from: Schema, Channel, Message, Metadata.
+const RECORDS_READ: [u8; 4] = [0x03, 0x04, 0x05, 0x0c];
+
+/// The first length-prefixed field of a Schema, Channel or Metadata record (the MCAP layout)
+/// whose length runs past the end of the record, named for the error; `None` if all fit.
+fn oversized_length(opcode: u8, data: &[u8]) -> Option<&'static str> {
+    /// Reads a little-endian u32 length at `at` and skips that many bytes; `None` if either
+    /// runs past `end`.
+    fn skip_prefixed(data: &[u8], at: usize, end: usize) -> Option<usize> {
+        let len = u32::from_le_bytes(data.get(at..at + 4)?.try_into().ok()?) as usize;
+        let next = (at + 4).checked_add(len)?;
+        (next <= end).then_some(next)
+    }
+    /// A map: a u32 byte length, then string key/value pairs inside it.
+    fn skip_string_map(data: &[u8], at: usize, end: usize) -> Option<usize> {
+        let map_end = skip_prefixed(data, at, end)?;
+        let mut entry = at + 4;
+        while entry < map_end {
+            entry = skip_prefixed(data, entry, map_end)?;
+            entry = skip_prefixed(data, entry, map_end)?;
+        }
+        Some(map_end)
+    }
+    let end = data.len();
+    let ok = match opcode {
+        // id u16, name, encoding, data.
+        0x03 => skip_prefixed(data, 2, end)
+            .and_then(|at| skip_prefixed(data, at, end))
+            .and_then(|at| skip_prefixed(data, at, end))
+            .is_some(),
+        // id u16, schema id u16, topic, message encoding, metadata map.
+        0x04 => skip_prefixed(data, 4, end)
+            .and_then(|at| skip_prefixed(data, at, end))
+            .and_then(|at| skip_string_map(data, at, end))
+            .is_some(),
+        // name, metadata map.
+        0x0c => skip_prefixed(data, 0, end)
+            .and_then(|at| skip_string_map(data, at, end))
+            .is_some(),
+        // Message: fixed header, then the payload to the end.
+        _ => true,
+    };
+    (!ok).then_some(match opcode {
+        0x03 => "a Schema record",
+        0x04 => "a Channel record",
+        _ => "a Metadata record",
+    })
+}
+
 fn scan(bytes: &[u8], path: &Path) -> Result<Records, DemoError> {
     let mcap_err = |source| DemoError::Mcap {
         path: path.to_owned(),
@@ -386,6 +435,20 @@ fn scan(bytes: &[u8], path: &Path) -> Result<Records, DemoError> {
                 rest = &rest[n..];
             }
             LinearReadEvent::Record { data, opcode } => {
+                // Only the records a demo is read from are parsed, and only once every length
+                // inside them fits the record: the mcap crate reserves a string's claimed
+                // length before reading it, so a corrupt 4 GB length was a 4 GB allocation.
+                if !RECORDS_READ.contains(&opcode) {
+                    continue;
+                }
+                if let Some(field) = oversized_length(opcode, data) {
+                    return Err(DemoError::invalid(
+                        path,
+                        field,
+                        "a length that fits inside its record",
+                        "a length past the record's end",
+                    ));
+                }
                 match mcap::parse_record(opcode, data).map_err(mcap_err)? {
                     Record::Schema { header, data: _ } => {
                         records.schemas.insert(header.id, header.name);
@@ -672,4 +735,49 @@ pub fn channel_summary(bytes: &[u8], path: &Path) -> Result<BTreeMap<String, usi
         }
     }
     Ok(counts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `len` as a little-endian u32 length prefix followed by `body`.
+    fn prefixed(len: u32, body: &[u8]) -> Vec<u8> {
+        let mut out = len.to_le_bytes().to_vec();
+        out.extend_from_slice(body);
+        out
+    }
+
+    #[test]
+    fn lengths_past_the_record_are_caught_before_parsing() {
+        // Metadata: a name, then an empty map.
+        let mut good = prefixed(4, b"demo");
+        good.extend(prefixed(0, b""));
+        assert_eq!(oversized_length(0x0c, &good), None);
+        // A name claiming 4 GB: refused without allocating it.
+        let mut bad = prefixed(0xfc00_0000, b"demo");
+        bad.extend(prefixed(0, b""));
+        assert_eq!(oversized_length(0x0c, &bad), Some("a Metadata record"));
+        // A map entry whose value runs past the map.
+        let mut entry = prefixed(1, b"k");
+        entry.extend(prefixed(99, b"v"));
+        let mut map_bad = prefixed(4, b"demo");
+        map_bad.extend(prefixed(entry.len() as u32, &entry));
+        assert_eq!(oversized_length(0x0c, &map_bad), Some("a Metadata record"));
+        // A Channel's topic past the end.
+        let mut channel = vec![1, 0, 1, 0];
+        channel.extend(prefixed(0xffff_ffff, b""));
+        assert_eq!(oversized_length(0x04, &channel), Some("a Channel record"));
+    }
+
+    #[test]
+    fn a_header_with_a_corrupt_length_is_an_error_not_an_allocation() {
+        // Magic, then a Header record whose profile claims 4 GB.
+        let mut bytes = b"\x89MCAP0\r\n".to_vec();
+        let body = prefixed(0xfc00_0000, b"x");
+        bytes.push(0x01);
+        bytes.extend((body.len() as u64).to_le_bytes());
+        bytes.extend(body);
+        assert!(read_mcap_bytes(&bytes, Path::new("bad.mcap")).is_err());
+    }
 }
