@@ -115,20 +115,17 @@ pub async fn synthesize(
                 .await;
             let source = match result {
                 Ok(source) => source,
-                Err(CodegenError::NoProgram { attempts }) => {
-                    let message = CodegenError::NoProgram {
-                        attempts: attempts.clone(),
-                    }
-                    .to_string();
-                    return Err(SynthError::NoProgram {
-                        message,
-                        replies: attempts,
-                    });
-                }
-                Err(e) => {
-                    return Err(SynthError::Call {
-                        message: e.to_string(),
-                        failure: e.reasoner_kind(),
+                Err(error) => {
+                    let message = error.to_string();
+                    return Err(match error {
+                        CodegenError::NoProgram { attempts } => SynthError::NoProgram {
+                            message,
+                            replies: attempts,
+                        },
+                        other => SynthError::Call {
+                            message,
+                            failure: other.reasoner_kind(),
+                        },
                     });
                 }
             };

@@ -1,7 +1,7 @@
 //! Counterfactual identification (Eq. 6) and exploration with verified patches (Eq. 7–8).
 
 use super::reasoner::{Feedback, PatchRequest, Problem, Reasoner, ReasonerErrorKind, ViolationKind};
-use super::symbols::{known_objects, unknown_symbols};
+use super::symbols::{describe_unknown, known_objects, unknown_symbols};
 use super::{
     Ablation, AdaptConfig, AdaptError, Outcome, Target, Trace, TraceEvent, Verdict, ViolationInfo, WorldModel,
 };
@@ -174,7 +174,7 @@ pub fn resolves(violation: &ViolationInfo, applied: &AppliedPatch, report: &Repo
 fn describe(problem: &Problem, procedure: &[Operator]) -> String {
     match problem {
         Problem::Unparsable { error } => format!("The reply could not be read: {error}."),
-        Problem::UnknownSymbols { unknown } => super::world_model::describe_unknown(unknown),
+        Problem::UnknownSymbols { unknown } => describe_unknown(unknown),
         Problem::MultiplePatches { count } => format!(
             "The reply held {count} SEARCH/REPLACE blocks; exactly one is required. Nothing was applied."
         ),

@@ -131,6 +131,15 @@ pub fn unknown_symbols(
     found
 }
 
+/// The prose for a reply whose names the task does not know (induction and patches alike).
+pub(super) fn describe_unknown(unknown: &[UnknownSymbol]) -> String {
+    let list: Vec<String> = unknown.iter().map(|u| format!("- {u}")).collect();
+    format!(
+        "The reply could not be read: it uses names this task does not have.\n{}\nUse only the predicates defined above, with their arguments, and the listed objects.",
+        list.join("\n")
+    )
+}
+
 /// The object names a reply may use: the task's objects and every name its states mention
 /// (fixtures and parts such as `floor`, `hinge_lid` or a drawer handle are in the states but
 /// not always in the object list), plus `extra` (the constants of the procedure a patch

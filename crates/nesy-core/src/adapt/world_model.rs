@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::reasoner::{Feedback, InductionRequest, Problem, Reasoner};
-use super::symbols::{UnknownSymbol, known_objects, unknown_symbols};
+use super::symbols::{describe_unknown, known_objects, unknown_symbols};
 use super::{
     AdaptConfig, AdaptError, Demonstration, Trace, TraceEvent, TransitionCheck, Verdict, derive_goal,
 };
@@ -81,15 +81,6 @@ pub fn check_transition(
     } else {
         Err(Problem::EffectMismatch { missing, unexpected })
     }
-}
-
-/// The prose for a reply whose names the task does not know (induction and patches alike).
-pub(super) fn describe_unknown(unknown: &[UnknownSymbol]) -> String {
-    let list: Vec<String> = unknown.iter().map(|u| format!("- {u}")).collect();
-    format!(
-        "The reply could not be read: it uses names this task does not have.\n{}\nUse only the predicates defined above, with their arguments, and the listed objects.",
-        list.join("\n")
-    )
 }
 
 /// The prose the next induction prompt shows for a rejected attempt.

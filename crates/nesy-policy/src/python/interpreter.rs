@@ -215,10 +215,15 @@ fn tell_checker_the_globals(
     checker: &Bound<'_, PyModule>,
     importable: [(&str, &Bound<'_, PyModule>); 3],
 ) -> PyResult<()> {
-    let mut known: Vec<&str> = builtins::ALLOWED_BUILTINS.to_vec();
-    known.push("__import__");
-    known.extend(POLICY_GLOBALS);
-    known.extend(robot_module::SIGNATURES.iter().map(|s| s.name));
+    // The curated builtins' own keys (so `__import__` and every allowed name come from the one
+    // list that builds them), the module globals, and the API functions.
+    let mut known: Vec<String> = builtins::curated(py)?
+        .keys()
+        .iter()
+        .map(|k| k.extract::<String>())
+        .collect::<PyResult<_>>()?;
+    known.extend(POLICY_GLOBALS.iter().map(|s| s.to_string()));
+    known.extend(robot_module::SIGNATURES.iter().map(|s| s.name.to_string()));
     checker.setattr("KNOWN_GLOBALS", pyo3::types::PyFrozenSet::new(py, &known)?)?;
     let parameters = PyDict::new(py);
     for sig in robot_module::SIGNATURES {
