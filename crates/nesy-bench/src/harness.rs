@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use nesy_core::benchmark::Complexity;
+use nesy_core::benchmark::{Complexity, Factor};
 use nesy_core::format_procedure;
 use nesy_pipeline::{
     AdaptOptions, CodegenMode, DemoInput, DemoKeyframes, StateSource, SynthError, SynthesisRequest,
@@ -696,9 +696,9 @@ async fn make_code(
     let started = Instant::now();
     let target = &inputs.target;
     let instruction = target.instruction(&inputs.demo);
-    let procedure = match &specified.spec {
-        Specification::Procedure { procedure, .. } => procedure.clone(),
-        Specification::Plan { .. } => Vec::new(),
+    let (procedure, plan) = match &specified.spec {
+        Specification::Procedure { procedure, .. } => (procedure.clone(), Vec::new()),
+        Specification::Plan { steps } => (Vec::new(), steps.clone()),
     };
     match specified.codegen {
         CodegenMode::Template => {
@@ -725,8 +725,12 @@ async fn make_code(
                 instruction,
                 objects: target.objects.clone(),
                 procedure,
+                plan,
                 embodiment: inputs.setting.target_embodiment,
-                extended: inputs.setting.source_embodiment != inputs.setting.target_embodiment,
+                // The authors' rule: the extended prompt for the embodiment factors and for
+                // Combination (whose scenarios may change the end effector).
+                extended: matches!(inputs.setting.factor, Factor::Grip | Factor::Vacu | Factor::Comb)
+                    || inputs.setting.source_embodiment != inputs.setting.target_embodiment,
             };
             let source = reasoner.generate_code(&request).await.map_err(|e| {
                 let failure = MethodFailure::from_reasoner(e.reasoner_kind(), e.to_string());

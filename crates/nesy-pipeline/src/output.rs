@@ -398,9 +398,10 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
         StateSource::Vlm {
             translated,
             rejected_atoms,
+            reasked_replies,
             agreement,
         } => format!(
-            "VLM state translation ({translated} states, {rejected_atoms} atoms rejected{})",
+            "VLM state translation ({translated} states, {reasked_replies} replies re-asked, {rejected_atoms} atoms outside the tier left out{})",
             agreement
                 .map(|a| format!(", F1 {:.2} against ground truth", a.f1))
                 .unwrap_or_default()

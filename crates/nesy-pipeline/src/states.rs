@@ -43,8 +43,11 @@ pub enum StateSource {
     Vlm {
         /// States translated (keyframes + the target).
         translated: usize,
-        /// Predicted atoms rejected (unknown predicate or object, wrong arity, not in tier).
+        /// Predicted atoms of real predicates outside the prompt's tier, left out.
         rejected_atoms: usize,
+        /// Replies that could not be used (not a state list, names the task does not have,
+        /// cut off, null content) and were re-asked.
+        reasked_replies: usize,
         /// Micro-averaged precision/recall/F1 against ground truth, where it was known.
         agreement: Option<Agreement>,
     },
@@ -206,10 +209,12 @@ pub async fn symbolic_states(
     let results: Vec<_> = results.into_iter().flatten().collect();
 
     let mut rejected_atoms = 0;
+    let mut reasked_replies = 0;
     let (mut tp, mut predicted, mut actual) = (0usize, 0usize, 0usize);
     let mut states = Vec::with_capacity(total);
     for (request, translated) in &results {
         rejected_atoms += translated.rejected.len();
+        reasked_replies += translated.reasked.len();
         if let Some(truth) = &request.ground_truth {
             predicted += translated.state.len();
             actual += truth.len();
@@ -245,6 +250,7 @@ pub async fn symbolic_states(
         source: StateSource::Vlm {
             translated: total,
             rejected_atoms,
+            reasked_replies,
             agreement,
         },
         vlm_time: started.elapsed(),

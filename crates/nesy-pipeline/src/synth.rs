@@ -109,6 +109,7 @@ pub async fn synthesize(
                     instruction: request.instruction.clone(),
                     objects: request.objects.clone(),
                     procedure: request.procedure.clone(),
+                    plan: Vec::new(),
                     embodiment: request.target,
                     extended: request.source != request.target,
                 })

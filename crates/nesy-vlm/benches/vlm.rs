@@ -303,6 +303,7 @@ fn prompts(c: &mut Criterion) {
         instruction: "Put the fruits in the hinge box.".into(),
         objects: scenario::OBJECTS.iter().map(|o| o.to_string()).collect(),
         procedure: adaptation.outcome.procedure().to_vec(),
+        plan: Vec::new(),
         embodiment: nesy_vlm::Embodiment::Vacuum,
         extended: true,
     };

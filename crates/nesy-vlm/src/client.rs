@@ -31,6 +31,7 @@ struct Inner {
     retry: RetryPolicy,
     concurrency: Semaphore,
     max_concurrency: usize,
+    max_images_per_request: Option<usize>,
     prices: PriceTable,
     usage: Mutex<RunUsage>,
     /// The configured key, redacted from every provider error by its exact text.
@@ -151,6 +152,7 @@ impl VlmClient {
                 retry: config.retry,
                 concurrency: Semaphore::new(max_concurrency),
                 max_concurrency,
+                max_images_per_request: config.max_images_per_request,
                 prices: config.prices.clone(),
                 usage: Mutex::new(RunUsage::default()),
                 api_key: config.api_key.clone(),
@@ -186,6 +188,12 @@ impl VlmClient {
             return Err(VlmError::InvalidRequest(
                 "a chat request needs at least one message".into(),
             ));
+        }
+        if let Some(limit) = self.inner.max_images_per_request {
+            let images = request.image_count();
+            if images > limit {
+                return Err(VlmError::TooManyImages { images, limit });
+            }
         }
         let wire = self.wire_request(&request);
         let started = Instant::now();
@@ -308,6 +316,7 @@ impl VlmClient {
                     latency: started.elapsed(),
                     attempts,
                     origin: response.origin,
+                    content_was_null: parsed.content_was_null,
                 };
                 (Ok(chat), usage)
             }

@@ -149,6 +149,10 @@ pub struct VlmConfig {
     pub retry: RetryPolicy,
     /// Calls in flight at once.
     pub max_concurrency: usize,
+    /// The most images the endpoint accepts in one request (`None`: no limit is known).
+    /// A request over it is refused before it is sent ([`crate::VlmError::TooManyImages`]),
+    /// as vLLM's `--limit-mm-per-prompt` or a provider's cap would refuse it.
+    pub max_images_per_request: Option<usize>,
     /// Cassette, if any.
     pub cassette: Option<CassetteSettings>,
     /// Prices for cost accounting.
@@ -173,6 +177,7 @@ impl VlmConfig {
             timeouts: Timeouts::default(),
             retry: RetryPolicy::default(),
             max_concurrency: 8,
+            max_images_per_request: None,
             cassette: None,
             prices: PriceTable::default(),
         }
@@ -417,6 +422,16 @@ impl Sources<'_> {
             }
             config.max_concurrency = limit;
         }
+        if let Some(limit) = self.setting(
+            flags.max_images,
+            "NESY_VLM_MAX_IMAGES",
+            file.max_images_per_request,
+        )? {
+            if limit == 0 {
+                return Err(invalid("max_images_per_request", "must be at least 1"));
+            }
+            config.max_images_per_request = Some(limit);
+        }
         Ok(())
     }
 
@@ -586,6 +601,9 @@ pub struct ConfigOverrides {
     /// Calls in flight at once [env: NESY_VLM_MAX_CONCURRENCY].
     #[cfg_attr(feature = "clap", arg(long = "vlm-max-concurrency", value_name = "N"))]
     pub max_concurrency: Option<usize>,
+    /// The most images the endpoint accepts in one request [env: NESY_VLM_MAX_IMAGES].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-max-images", value_name = "N"))]
+    pub max_images: Option<usize>,
     /// Attempts per call, the first included [env: NESY_VLM_MAX_ATTEMPTS].
     #[cfg_attr(feature = "clap", arg(long = "vlm-max-attempts", value_name = "N"))]
     pub max_attempts: Option<u32>,
@@ -619,6 +637,7 @@ struct FileConfig {
     temperature: Option<f32>,
     image_detail: Option<ImageDetail>,
     max_concurrency: Option<usize>,
+    max_images_per_request: Option<usize>,
     azure: Option<FileAzure>,
     timeouts: Option<FileTimeouts>,
     retry: Option<FileRetry>,

@@ -19,6 +19,17 @@ pub enum VlmError {
     /// The request cannot be sent as built (for example an image that is not PNG/JPEG).
     #[error("invalid request: {0}")]
     InvalidRequest(String),
+    /// The request holds more images than the endpoint accepts
+    /// ([`crate::VlmConfig::max_images_per_request`]); it was not sent.
+    #[error(
+        "the request holds {images} images, more than the {limit} this endpoint accepts per request (max_images_per_request); it was not sent"
+    )]
+    TooManyImages {
+        /// Images in the request.
+        images: usize,
+        /// The configured limit.
+        limit: usize,
+    },
     /// The transport failed without an HTTP response (timeout, refused connection, cut body).
     #[error("{error} (after {attempts} attempt(s))")]
     Transport {
@@ -108,6 +119,7 @@ impl VlmError {
         use nesy_core::adapt::ReasonerErrorKind as Kind;
         match self {
             Self::Config(_) | Self::InvalidRequest(_) => Kind::Request,
+            Self::TooManyImages { .. } => Kind::Refused,
             Self::Transport {
                 error: TransportError::Declined(_),
                 ..

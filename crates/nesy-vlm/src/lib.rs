@@ -86,6 +86,7 @@ pub mod oracle;
 pub mod profile;
 pub mod prompts;
 pub mod reasoner;
+pub mod reply;
 pub mod request;
 pub mod response;
 pub mod retry;

@@ -14,6 +14,7 @@ use crate::context::{Embodiment, InductionContext, PatchContext, VlmTask};
 use crate::error::VlmError;
 use crate::keyframes::{KeyframeImages, NoKeyframes};
 use crate::prompts::{PromptError, Prompts};
+use crate::reply::{self, AskError, CALL_ATTEMPTS, CallProblem};
 use crate::request::{ChatRequest, Message, Part};
 use crate::settings::PurposeSettings;
 use crate::translate::{self, StateTranslationRequest, TranslateError, TranslatedState};
@@ -167,6 +168,10 @@ impl VlmReasoner {
         codegen::generate_code(&self.client, self.prompts, request, &self.settings.codegen).await
     }
 
+    /// Sends an induction or patch request through the shared [`reply`](crate::reply)
+    /// policy: a reply cut off at the token cap or with null content is re-asked here (up
+    /// to [`CALL_ATTEMPTS`] replies), and any text that arrives whole goes to nesy-core,
+    /// which parses it and re-asks within its own budget.
     async fn send(
         &self,
         what: &str,
@@ -174,9 +179,26 @@ impl VlmReasoner {
     ) -> Result<String, ReasonerError> {
         let chat =
             chat.map_err(|e| ReasonerError::new(ReasonerErrorKind::Request, format!("{what}: {e}")))?;
-        match self.client.chat(chat).await {
-            Ok(response) => Ok(response.text),
-            Err(error) => Err(reasoner_error(what, &error)),
+        let answer = reply::ask_until_usable(&self.client, chat, CALL_ATTEMPTS, what, |text| {
+            Ok::<_, std::convert::Infallible>(Ok::<_, CallProblem>(text.to_string()))
+        })
+        .await;
+        match answer {
+            Ok(answer) => Ok(answer.value),
+            Err(AskError::Vlm(error)) => Err(reasoner_error(what, &error)),
+            Err(AskError::Reader(never)) => match never {},
+            Err(AskError::Exhausted(attempts)) => Err(ReasonerError::new(
+                ReasonerErrorKind::Reply,
+                format!(
+                    "{what}: no usable reply in {} attempt(s): {}",
+                    attempts.len(),
+                    attempts
+                        .iter()
+                        .map(|a| a.problem.to_string())
+                        .collect::<Vec<_>>()
+                        .join("; then ")
+                ),
+            )),
         }
     }
 }

@@ -334,6 +334,15 @@ impl ChatRequest {
         Self::default()
     }
 
+    /// The number of image parts over all messages.
+    pub fn image_count(&self) -> usize {
+        self.messages
+            .iter()
+            .flat_map(|m| &m.parts)
+            .filter(|p| matches!(p, Part::Image(_)))
+            .count()
+    }
+
     /// Appends a message.
     pub fn message(mut self, message: Message) -> Self {
         self.messages.push(message);

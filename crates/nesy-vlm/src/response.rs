@@ -74,6 +74,10 @@ pub struct ChatResponse {
     pub attempts: u32,
     /// Where the answer came from: a live server, a cassette, an offline responder.
     pub origin: Origin,
+    /// The message's `content` was null (or absent) and no `reasoning_content` held text,
+    /// so [`text`](Self::text) is empty because the server sent nothing, not an empty
+    /// string. The reply readers name this in the re-ask.
+    pub content_was_null: bool,
 }
 
 #[derive(Deserialize)]
@@ -128,6 +132,7 @@ pub(crate) struct ParsedCompletion {
     pub usage: Option<Usage>,
     pub model: Option<String>,
     pub response_id: Option<String>,
+    pub content_was_null: bool,
 }
 
 /// Parses a 2xx body. `Ok` holds the parsed completion *and* the typed error it amounts to
@@ -177,6 +182,7 @@ pub(crate) fn parse_completion(
         Some(message) => (message.content, message.refusal, message.reasoning_content),
         None => (None, None, None),
     };
+    let mut content_was_null = matches!(content, None | Some(serde_json::Value::Null));
     let mut text = content_text(content.as_ref())
         .ok_or_else(|| invalid("`choices[0].message.content` is neither text nor text parts".into()))?;
     // A server that leaves `content` empty and puts the answer in `reasoning_content`: the
@@ -189,13 +195,16 @@ pub(crate) fn parse_completion(
             "the reply's content is empty or null; reading its reasoning_content instead"
         );
         text = reasoning;
+        content_was_null = false;
     }
+    let content_was_null = content_was_null && text.is_empty();
     let parsed = ParsedCompletion {
         text: text.clone(),
         finish_reason: finish_reason.clone(),
         usage,
         model: wire.model,
         response_id: wire.id,
+        content_was_null,
     };
     let request_id = request_id.map(str::to_string);
     let error = if let Some(reason) = refusal.filter(|r| !r.trim().is_empty()) {

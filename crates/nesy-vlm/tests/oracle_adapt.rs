@@ -141,6 +141,7 @@ async fn adapt_and_execute(case: &Case, noise: OracleNoise, budget: usize) -> Ru
                 instruction: target_scene.instruction.clone(),
                 objects: target_objects.iter().map(|o| o.to_string()).collect(),
                 procedure: procedure.clone(),
+                plan: Vec::new(),
                 embodiment: case.target,
                 extended: cross,
             })

@@ -354,6 +354,7 @@ fn codegen_request(embodiment: Embodiment, extended: bool) -> ChatRequest {
         instruction: "Put the fruits in the hinge box.".into(),
         objects: scenario::OBJECTS.iter().map(|o| o.to_string()).collect(),
         procedure: adapted,
+        plan: Vec::new(),
         embodiment,
         extended,
     };

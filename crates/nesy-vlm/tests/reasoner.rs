@@ -12,6 +12,7 @@ use std::sync::{Arc, Mutex};
 use common::scenario;
 use nesy_core::adapt::{Outcome, Problem, TraceEvent, Verdict, run};
 use nesy_core::predicates::{Tier, Vocabulary};
+use nesy_vlm::translate::TranslationProblem;
 use nesy_vlm::{
     BackendKind, BoxFuture, CodeGenerationRequest, CodegenError, Embodiment, Image, Origin,
     StateTranslationRequest, TranslateError, Transport, TransportError, Views, VlmClient, VlmReasoner,
@@ -20,6 +21,8 @@ use nesy_vlm::{
 
 /// The prefix that makes [`Scripted`] answer with `finish_reason: length`.
 const TRUNCATED: &str = "<length>";
+/// The reply that makes [`Scripted`] answer with a null `content`.
+const NULL_CONTENT: &str = "<null>";
 
 /// Answers each purpose from its own queue of replies and keeps every request.
 #[derive(Debug, Default)]
@@ -71,6 +74,11 @@ impl Transport for Scripted {
                 Some(partial) => {
                     let mut body = common::completion(partial);
                     body["choices"][0]["finish_reason"] = "length".into();
+                    body
+                }
+                None if reply == NULL_CONTENT => {
+                    let mut body = common::completion("");
+                    body["choices"][0]["message"]["content"] = serde_json::Value::Null;
                     body
                 }
                 None => common::completion(&reply),
@@ -254,6 +262,7 @@ async fn the_loop_recovers_from_a_rejected_operator_and_a_non_matching_patch() {
         instruction: "Put the fruits in the hinge box.".into(),
         objects: scenario::OBJECTS.iter().map(|o| o.to_string()).collect(),
         procedure: procedure.clone(),
+        plan: Vec::new(),
         embodiment: Embodiment::Finger,
         extended: false,
     };
@@ -303,18 +312,105 @@ async fn the_loop_recovers_from_a_rejected_operator_and_a_non_matching_patch() {
 }
 
 #[tokio::test]
+async fn cut_off_and_empty_induction_and_patch_replies_are_re_asked_before_the_loop_reads_them() {
+    let cut = |text: &str| format!("{TRUNCATED}{}", &text[..text.len() / 2]);
+    let approach_cut = cut(scenario::APPROACH);
+    let patch_cut = cut(scenario::PATCH);
+    let transport = Scripted::with(&[
+        (
+            "induce",
+            &[
+                &approach_cut,
+                scenario::APPROACH,
+                NULL_CONTENT,
+                scenario::GRASP,
+                scenario::CARRY,
+                scenario::DROP,
+            ],
+        ),
+        ("patch", &[&patch_cut, scenario::PATCH]),
+    ]);
+    let mut reasoner = VlmReasoner::new(client(transport.clone()))
+        .unwrap()
+        .with_keyframes(scenario::keyframes())
+        .with_embodiments(Embodiment::Finger, Embodiment::Finger);
+    let adaptation = run(
+        &mut reasoner,
+        &scenario::demo(),
+        &scenario::target(),
+        &scenario::config(),
+    )
+    .await
+    .unwrap();
+    assert!(
+        matches!(adaptation.outcome, Outcome::Adapted { iterations: 1, .. }),
+        "{:#?}",
+        adaptation.outcome
+    );
+    // Each re-ask carries the cut-off or empty reply and says what was wrong with it; the
+    // loop itself saw only whole replies (no induction was rejected).
+    let induce = transport.requests("induce");
+    assert_eq!(induce.len(), 6);
+    let reask = text_of(&messages(&induce[1])[3]);
+    assert!(
+        reask.contains("cut off at the token cap") && reask.contains("Answer more briefly"),
+        "{reask}"
+    );
+    let reask = text_of(&messages(&induce[3])[3]);
+    assert!(reask.contains("`content` was null"), "{reask}");
+    assert!(!adaptation.trace.events.iter().any(|e| matches!(
+        e,
+        TraceEvent::Induction {
+            verdict: Verdict::Rejected { .. },
+            ..
+        }
+    )));
+    let patch = transport.requests("patch");
+    assert_eq!(patch.len(), 2);
+    assert!(text_of(&messages(&patch[1])[3]).contains("cut off at the token cap"));
+
+    // When the re-ask is cut off too, the call fails as a reply problem naming the call.
+    let transport = Scripted::with(&[("induce", &[&approach_cut, &approach_cut])]);
+    let mut reasoner = VlmReasoner::new(client(transport.clone()))
+        .unwrap()
+        .with_keyframes(scenario::keyframes());
+    let error = match run(
+        &mut reasoner,
+        &scenario::demo(),
+        &scenario::target(),
+        &scenario::config(),
+    )
+    .await
+    {
+        Err(error) => error.to_string(),
+        Ok(adaptation) => format!("{:?}", adaptation.outcome),
+    };
+    assert!(
+        error.contains("operator induction for transition 1")
+            && error.contains("no usable reply in 2 attempt(s)"),
+        "{error}"
+    );
+}
+
+#[tokio::test]
 async fn state_translation_adds_checked_atoms_to_the_known_ones() {
     let table = "I see a table.";
     let drifted = "Combining all three views:\n<think>the lid looks shut</think>\n\u{2013} `(Closed hinge_lid)`\n\u{2022} (OnTopOf apple floor)\n\u{2013} (OnTopOf hinge_body floor)";
+    let clean = scenario::TRANSLATION.replace("- (OnTopOf banana floor)\n", "");
+    let cut_off = format!("{TRUNCATED}- (OnTopOf apple floor)\n- (Clo");
     let transport = Scripted::with(&[(
         "translate",
         &[
             scenario::TRANSLATION,
+            &clean,
             table,
             table,
             table,
             "Here they are.",
             drifted,
+            NULL_CONTENT,
+            &cut_off,
+            &clean,
         ],
     )]);
     let reasoner = VlmReasoner::new(client(transport.clone())).unwrap();
@@ -333,43 +429,61 @@ async fn state_translation_adds_checked_atoms_to_the_known_ones() {
         },
         ground_truth: Some(scenario::target().init),
     };
+    // An object the scene does not have is not dropped quietly: the reply is re-asked with
+    // the name, and the corrected reply is used.
     let translated = reasoner.translate_state(&request).await.unwrap();
     assert_eq!(translated.state, scenario::target().init);
-    assert_eq!(translated.rejected.len(), 1);
-    assert_eq!(translated.rejected[0].atom.to_string(), "(OnTopOf banana floor)");
-    let sent = &transport.requests("translate")[0];
-    assert_eq!(image_count(&messages(sent)[1]), 3);
-    let VlmTask::StateTranslation(context) = VlmTask::from_task_context(sent.task.as_ref().unwrap()).unwrap()
+    assert!(translated.rejected.is_empty());
+    assert_eq!(translated.reasked.len(), 1);
+    let sent = transport.requests("translate");
+    let reask = text_of(&messages(&sent[1])[3]);
+    assert!(
+        reask.contains("`banana` is not an object of this task"),
+        "{reask}"
+    );
+    assert_eq!(image_count(&messages(&sent[0])[1]), 3);
+    let VlmTask::StateTranslation(context) =
+        VlmTask::from_task_context(sent[0].task.as_ref().unwrap()).unwrap()
     else {
         panic!("a state translation context");
     };
     assert_eq!(context.ground_truth, Some(scenario::target().init));
     // The ground truth never reaches the wire.
-    assert!(!sent.body.to_string().contains("Closed hinge_lid"));
+    assert!(!sent[0].body.to_string().contains("Closed hinge_lid"));
 
     // Prose is re-asked with the parse error; when the budget runs out the error says so.
     match reasoner.translate_state(&request).await {
-        Err(TranslateError::Parse {
-            error,
-            reply,
-            attempts,
-            ..
-        }) => {
-            assert_eq!(reply, table);
-            assert_eq!(error.line, 1);
-            assert_eq!(attempts, nesy_vlm::translate::TRANSLATION_ATTEMPTS);
+        Err(TranslateError::NoState { attempts, .. }) => {
+            assert_eq!(attempts.len(), nesy_vlm::translate::TRANSLATION_ATTEMPTS);
+            let last = attempts.last().unwrap();
+            assert_eq!(last.reply, table);
+            match &last.problem {
+                TranslationProblem::Unreadable { error } => assert_eq!(error.line, 1),
+                other => panic!("{other:?}"),
+            }
         }
         other => panic!("{other:?}"),
     }
     let sent = transport.requests("translate");
-    let reask = text_of(&messages(&sent[2])[3]);
+    let reask = text_of(&messages(&sent[4])[3]);
     assert!(reask.contains("could not be read as a state list"), "{reask}");
     // Typographic drift (a preamble, a think section, en-dash bullets, inline code) reads
     // after one re-ask of a reply with no list at all.
     let translated = reasoner.translate_state(&request).await.unwrap();
     assert_eq!(translated.state, scenario::target().init);
+    // A null content and a reply cut off at the cap are re-asked, each named as what it is.
+    let translated = reasoner.translate_state(&request).await.unwrap();
+    assert_eq!(translated.state, scenario::target().init);
+    let problems: Vec<String> = translated.reasked.iter().map(|r| r.problem.to_string()).collect();
+    assert_eq!(problems.len(), 2, "{problems:?}");
+    assert!(problems[0].contains("`content` was null"), "{problems:?}");
+    assert!(problems[1].contains("cut off at the token cap"), "{problems:?}");
+    let sent = transport.requests("translate");
+    let last = messages(sent.last().unwrap());
+    assert!(text_of(&last[3]).contains("`content` was null"));
+    assert!(text_of(&last[5]).contains("Answer more briefly"));
     let usage = reasoner.client().usage();
-    assert_eq!(usage.by_purpose["translate"].calls, 1 + 3 + 2);
+    assert_eq!(usage.by_purpose["translate"].calls, 2 + 3 + 2 + 3);
 }
 
 /// A program in a python block, as a model would answer.
@@ -414,6 +528,7 @@ async fn plausible_but_wrong_programs_are_re_asked_before_anything_runs() {
             instruction: "Place the cube in the box.".into(),
             objects: vec!["red_cube".into(), "box".into()],
             procedure: Vec::new(),
+            plan: Vec::new(),
             embodiment: Embodiment::Finger,
             extended: false,
         };
@@ -437,4 +552,32 @@ async fn plausible_but_wrong_programs_are_re_asked_before_anything_runs() {
         let feedback = text_of(&turns[3]);
         assert!(feedback.contains(expected), "{what}: {feedback}");
     }
+}
+
+#[tokio::test]
+async fn a_request_over_the_image_limit_is_refused_before_it_is_sent() {
+    let transport = Scripted::with(&[("describe", &["never sent"])]);
+    let mut config = common::config(BackendKind::OpenAi, "gpt-5", "http://127.0.0.1:9");
+    config.max_images_per_request = Some(2);
+    let client = VlmClient::with_transport(&config, transport.clone());
+    let image = Image::png(common::png(16, 1)).unwrap();
+    let parts = vec![
+        nesy_vlm::Part::text("three views"),
+        nesy_vlm::Part::Image(image.clone()),
+        nesy_vlm::Part::Image(image.clone()),
+        nesy_vlm::Part::Image(image),
+    ];
+    let chat = nesy_vlm::ChatRequest::new()
+        .purpose("describe")
+        .message(nesy_vlm::Message::user(parts));
+    match client.chat(chat).await {
+        Err(error @ nesy_vlm::VlmError::TooManyImages { images: 3, limit: 2 }) => {
+            assert_eq!(
+                error.reasoner_kind(),
+                nesy_core::adapt::ReasonerErrorKind::Refused
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(transport.requests("describe").is_empty());
 }

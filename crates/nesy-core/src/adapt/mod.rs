@@ -33,7 +33,7 @@ pub use reasoner::{
     Feedback, InductionRequest, PatchRequest, Problem, Reasoner, ReasonerError, ReasonerErrorKind,
     TaskContext, ViolationKind,
 };
-pub use symbols::{SymbolProblem, UnknownSymbol, known_objects, unknown_symbols};
+pub use symbols::{SymbolProblem, UnknownSymbol, known_objects, unknown_atom_symbols, unknown_symbols};
 pub use world_model::{WorldModel, check_transition, construct_world_model};
 
 use serde::{Deserialize, Serialize};

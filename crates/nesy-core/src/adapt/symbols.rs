@@ -11,6 +11,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::atom::Atom;
 use crate::operator::Operator;
 use crate::predicates::Vocabulary;
 use crate::symbol::Symbol;
@@ -86,49 +87,125 @@ pub fn unknown_symbols(
     vocabulary: &Vocabulary,
     objects: Option<&[Symbol]>,
 ) -> Vec<UnknownSymbol> {
-    let mut found: Vec<UnknownSymbol> = Vec::new();
-    let mut push = |symbol: UnknownSymbol| {
-        if !found
+    let mut names = NameCheck::new(vocabulary, objects);
+    for operator in operators {
+        for pattern in operator.patterns() {
+            names.predicate(pattern.pred, pattern.args.len());
+        }
+        for constant in operator.constants() {
+            names.object(constant);
+        }
+    }
+    names.found
+}
+
+/// The names in `atoms` (a state list, such as a state translation's reply) that
+/// `vocabulary` and `objects` do not know, each once, in the order they first appear: the
+/// same rules as [`unknown_symbols`], applied to ground atoms.
+///
+/// ```
+/// use nesy_core::adapt::unknown_atom_symbols;
+/// use nesy_core::predicates::Vocabulary;
+/// use nesy_core::text::parse_state_list;
+/// use nesy_core::Symbol;
+///
+/// let atoms = parse_state_list("- (Ontop red_cube floor)\n- (GripperOpen red_cube)").unwrap();
+/// let objects = [Symbol::new("red_cube"), Symbol::new("floor")];
+/// let unknown = unknown_atom_symbols(atoms.iter(), &Vocabulary::new(), &objects);
+/// let messages: Vec<String> = unknown.iter().map(|u| u.to_string()).collect();
+/// assert_eq!(
+///     messages,
+///     [
+///         "`Ontop` is not a predicate; did you mean `OnTopOf`?",
+///         "`GripperOpen` takes 0 argument(s), not 1",
+///     ]
+/// );
+/// ```
+pub fn unknown_atom_symbols<'a>(
+    atoms: impl IntoIterator<Item = &'a Atom>,
+    vocabulary: &Vocabulary,
+    objects: &[Symbol],
+) -> Vec<UnknownSymbol> {
+    let mut names = NameCheck::new(vocabulary, Some(objects));
+    for atom in atoms {
+        names.predicate(atom.pred(), atom.args().len());
+        for arg in atom.args() {
+            names.object(*arg);
+        }
+    }
+    names.found
+}
+
+/// Collects the unknown names of a reply, each once.
+struct NameCheck<'a> {
+    vocabulary: &'a Vocabulary,
+    predicate_names: Vec<&'a str>,
+    /// `None`: objects are not checked.
+    objects: Option<&'a [Symbol]>,
+    found: Vec<UnknownSymbol>,
+}
+
+impl<'a> NameCheck<'a> {
+    fn new(vocabulary: &'a Vocabulary, objects: Option<&'a [Symbol]>) -> Self {
+        NameCheck {
+            vocabulary,
+            predicate_names: vocabulary.predicates().iter().map(|p| p.name.as_str()).collect(),
+            objects,
+            found: Vec::new(),
+        }
+    }
+
+    fn push(&mut self, symbol: UnknownSymbol) {
+        if !self
+            .found
             .iter()
             .any(|f| f.name == symbol.name && f.kind == symbol.kind)
         {
-            found.push(symbol);
+            self.found.push(symbol);
         }
-    };
-    let predicate_names: Vec<&str> = vocabulary.predicates().iter().map(|p| p.name.as_str()).collect();
-    let object_names: Vec<&str> = objects.unwrap_or_default().iter().map(|o| o.as_str()).collect();
-    for operator in operators {
-        for pattern in operator.patterns() {
-            let name = pattern.pred.as_str();
-            match vocabulary.get(pattern.pred) {
-                None => push(UnknownSymbol {
+    }
+
+    /// A use of predicate `pred` with `arguments` arguments.
+    fn predicate(&mut self, pred: Symbol, arguments: usize) {
+        let name = pred.as_str();
+        match self.vocabulary.get(pred) {
+            None => {
+                let suggestion = nearest(name, &self.predicate_names);
+                self.push(UnknownSymbol {
                     kind: SymbolProblem::UnknownPredicate,
                     name: name.to_string(),
-                    suggestion: nearest(name, &predicate_names),
-                }),
-                Some(p) if p.arity != pattern.args.len() => push(UnknownSymbol {
+                    suggestion,
+                });
+            }
+            Some(p) if p.arity != arguments => {
+                let expected = p.arity;
+                self.push(UnknownSymbol {
                     kind: SymbolProblem::WrongArity {
-                        expected: p.arity,
-                        found: pattern.args.len(),
+                        expected,
+                        found: arguments,
                     },
                     name: name.to_string(),
                     suggestion: None,
-                }),
-                Some(_) => {}
-            }
-        }
-        let Some(objects) = objects else { continue };
-        for constant in operator.constants() {
-            if !objects.contains(&constant) {
-                push(UnknownSymbol {
-                    kind: SymbolProblem::UnknownObject,
-                    name: constant.to_string(),
-                    suggestion: nearest(constant.as_str(), &object_names),
                 });
             }
+            Some(_) => {}
         }
     }
-    found
+
+    /// A use of object constant `object`.
+    fn object(&mut self, object: Symbol) {
+        let Some(objects) = self.objects else { return };
+        if objects.contains(&object) {
+            return;
+        }
+        let object_names: Vec<&str> = objects.iter().map(|o| o.as_str()).collect();
+        let suggestion = nearest(object.as_str(), &object_names);
+        self.push(UnknownSymbol {
+            kind: SymbolProblem::UnknownObject,
+            name: object.to_string(),
+            suggestion,
+        });
+    }
 }
 
 /// The prose for a reply whose names the task does not know (induction and patches alike).

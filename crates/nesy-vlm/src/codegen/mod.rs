@@ -13,6 +13,7 @@ use crate::client::VlmClient;
 use crate::context::{CodeGenerationContext, Embodiment, VlmTask};
 use crate::error::VlmError;
 use crate::prompts::{CodeGenerationPrompt, PromptError, Prompts, action_names, api_docs};
+use crate::reply::{self, AskError, Rejected, ReplyProblem};
 use crate::request::{ChatRequest, Message};
 use crate::settings::CallSettings;
 
@@ -25,6 +26,10 @@ pub struct CodeGenerationRequest {
     pub objects: Vec<String>,
     /// The adapted, verified procedure; its action names become the demonstration summary.
     pub procedure: Vec<Operator>,
+    /// A natural-language plan (a baseline's specification); when it is not empty, its steps
+    /// are the demonstration summary instead of the procedure's action names.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub plan: Vec<String>,
     /// The target robot's end effector.
     pub embodiment: Embodiment,
     /// Use the extended prompt (both end effectors documented). The pipeline sets it when
@@ -95,11 +100,14 @@ pub enum ProgramProblem {
         error: ExtractError,
     },
     /// The reply stopped at the token cap.
-    #[error("reply was cut off at the token cap ({})", cap.map_or_else(|| "the backend's default".to_string(), |c| format!("{c} tokens")))]
+    #[error("{}", reply::truncation_text(*cap))]
     Truncated {
         /// The request's cap, if it set one.
         cap: Option<u32>,
     },
+    /// The reply's `content` was null and no `reasoning_content` held text.
+    #[error("{}", reply::NULL_CONTENT_TEXT)]
+    NullContent,
     /// The program's code block was never closed: the reply was cut off.
     #[error("program was cut off: its code block opened on line {line} of the reply is never closed")]
     Unterminated {
@@ -114,9 +122,16 @@ pub enum ProgramProblem {
     },
 }
 
-impl ProgramProblem {
-    /// The message that goes back to the model with the re-ask.
-    pub fn feedback(&self) -> String {
+impl ReplyProblem for ProgramProblem {
+    fn truncated(cap: Option<u32>) -> Self {
+        ProgramProblem::Truncated { cap }
+    }
+
+    fn null_content() -> Self {
+        ProgramProblem::NullContent
+    }
+
+    fn feedback(&self) -> String {
         let ask = "Reply with the whole corrected program in one ```python code block.";
         match self {
             ProgramProblem::Truncated { .. } => format!(
@@ -125,7 +140,7 @@ impl ProgramProblem {
             ProgramProblem::Unterminated { .. } => {
                 format!("Your {self}. {ask} Close the block with ``` on its own line.")
             }
-            ProgramProblem::Unreadable { .. } => format!("Your {self}. {ask}"),
+            ProgramProblem::Unreadable { .. } | ProgramProblem::NullContent => format!("Your {self}. {ask}"),
             ProgramProblem::Refused { findings } => format!(
                 "Your program was refused before running, and the robot has not moved:\n{}\nUse only the robot API functions listed above for this end effector, Python's builtins, and names the program defines. {ask}",
                 findings
@@ -162,7 +177,11 @@ pub fn build_request(
     request: &CodeGenerationRequest,
     settings: &CallSettings,
 ) -> Result<(ChatRequest, bool), PromptError> {
-    let names = action_names(&request.procedure);
+    let names = if request.plan.is_empty() {
+        action_names(&request.procedure)
+    } else {
+        request.plan.clone()
+    };
     let prompt = CodeGenerationPrompt {
         instruction: &request.instruction,
         objects: &request.objects,
@@ -196,57 +215,48 @@ pub fn build_request(
 /// runs: the code block must be closed, the sandbox's static checks (which refuse names
 /// nothing defines and robot API calls whose arguments do not bind) must pass, and no
 /// function of the other end effector may be called. A reply that fails goes back to the
-/// model with the reason, up to [`CODEGEN_ATTEMPTS`] replies in all; a reply cut off at the
-/// token cap is re-asked the same way, asking for a briefer answer.
+/// model with the reason, up to [`CODEGEN_ATTEMPTS`] replies in all, through the shared
+/// [`reply`](crate::reply) policy (a reply cut off at the token cap asks for a briefer
+/// answer; one with null content says so).
 pub async fn generate_code(
     client: &VlmClient,
     prompts: &Prompts,
     request: &CodeGenerationRequest,
     settings: &CallSettings,
 ) -> Result<PolicySource, CodegenError> {
-    let (mut chat, extended) = build_request(prompts, request, settings)?;
-    let mut rejected: Vec<RejectedProgram> = Vec::new();
-    for _ in 0..CODEGEN_ATTEMPTS {
-        let (reply, checked) = match client.chat(chat.clone()).await {
-            Ok(response) => {
-                let checked = usable_program(&response.text, request.embodiment)?;
-                (response.text, checked)
-            }
-            Err(VlmError::Truncated { partial_text, .. }) => (
-                partial_text,
-                Err(ProgramProblem::Truncated {
-                    cap: chat.max_output_tokens,
-                }),
-            ),
-            Err(other) => return Err(other.into()),
-        };
-        match checked {
-            Ok(extracted) => {
-                for s in &extracted.stripped {
-                    tracing::info!(line = s.line, statement = %s.text, "removed an import from the generated program: {}", s.reason);
-                }
-                return Ok(PolicySource {
-                    code: extracted.code,
-                    reply,
-                    block: extracted.block,
-                    stripped: extracted.stripped,
-                    extended,
-                    rejected,
-                });
-            }
-            Err(problem) => {
-                tracing::info!(
-                    attempt = rejected.len() + 1,
-                    "generated program not used: {problem}"
-                );
-                chat = chat
-                    .message(Message::assistant(reply.clone()))
-                    .message(Message::user_text(problem.feedback()));
-                rejected.push(RejectedProgram { reply, problem });
-            }
+    let (chat, extended) = build_request(prompts, request, settings)?;
+    let answer = reply::ask_until_usable(client, chat, CODEGEN_ATTEMPTS, "code generation", |text| {
+        usable_program(text, request.embodiment)
+    })
+    .await
+    .map_err(|error| match error {
+        AskError::Vlm(e) => CodegenError::Vlm(e),
+        AskError::Reader(e) => CodegenError::Check(e),
+        AskError::Exhausted(attempts) => CodegenError::NoProgram {
+            attempts: attempts.into_iter().map(RejectedProgram::from).collect(),
+        },
+    })?;
+    let extracted = answer.value;
+    for s in &extracted.stripped {
+        tracing::info!(line = s.line, statement = %s.text, "removed an import from the generated program: {}", s.reason);
+    }
+    Ok(PolicySource {
+        code: extracted.code,
+        reply: answer.reply,
+        block: extracted.block,
+        stripped: extracted.stripped,
+        extended,
+        rejected: answer.rejected.into_iter().map(RejectedProgram::from).collect(),
+    })
+}
+
+impl From<Rejected<ProgramProblem>> for RejectedProgram {
+    fn from(rejected: Rejected<ProgramProblem>) -> Self {
+        RejectedProgram {
+            reply: rejected.reply,
+            problem: rejected.problem,
         }
     }
-    Err(CodegenError::NoProgram { attempts: rejected })
 }
 
 /// The program of `reply` if it may run on `embodiment`; otherwise why not. `Err` of the

@@ -28,6 +28,11 @@ use crate::context::Embodiment;
 pub use examples::{CodeExample, InductionExample, StateExample};
 
 /// A template file: its name (as templates refer to each other) and its text.
+/// The physical constraints every planning prompt states (one `- ` line each), shared by
+/// NeSyCR's induction prompt and the baselines' prompts so that every method is told the
+/// same. Templates see it as `{{ physical_constraints }}`.
+pub const PHYSICAL_CONSTRAINTS: &str = include_str!("../../prompts/physical_constraints.txt");
+
 const TEMPLATES: &[(&str, &str)] = &[
     (
         "induction.system.j2",
@@ -244,6 +249,7 @@ impl Prompts {
         env.set_syntax(syntax);
         env.set_undefined_behavior(UndefinedBehavior::Strict);
         env.set_auto_escape_callback(|_| AutoEscape::None);
+        env.add_global("physical_constraints", PHYSICAL_CONSTRAINTS.trim_end());
         for (name, text) in TEMPLATES {
             env.add_template(name, text)
                 .map_err(|error| PromptError::Template { name, error })?;
@@ -282,6 +288,7 @@ impl Prompts {
         for (name, text) in TEMPLATES {
             add(name, text);
         }
+        add("physical_constraints.txt", PHYSICAL_CONSTRAINTS);
         for files in [
             examples::INDUCTION_FILES,
             examples::STATE_FILES,
