@@ -67,6 +67,20 @@ pub fn unit_load(unit: &Unit, keyframes: u64, budget: u64) -> Load {
                 images_max: transitions * tries * IMAGES_PER_INDUCTION + t_images,
             }
         }
+        "demo2code" | "gpt4v-robotics" => {
+            let shape = if unit.variant.method == "demo2code" {
+                nesy_baselines::demo2code::shape(keyframes)
+            } else {
+                nesy_baselines::gpt4v::shape(keyframes)
+            };
+            // One code-generation call follows the flow's own calls.
+            Load {
+                calls_min: shape.calls_min + 1,
+                calls_max: shape.calls_max + 1,
+                images_min: shape.images_min,
+                images_max: shape.images_max,
+            }
+        }
         "code-as-policies" => Load {
             calls_min: 1,
             calls_max: 1,

@@ -72,13 +72,18 @@ impl Variant {
 
     /// Parses a comma-separated list of variants. Commas inside a setting's value are not
     /// supported; noise settings use `,` and therefore `;` between knobs (see
-    /// [`Variant::option`]).
+    /// [`Variant::option`]). The item `all` stands for [`crate::methods::table_methods`].
     pub fn parse_list(text: &str) -> Result<Vec<Variant>, BenchError> {
-        let variants: Vec<Variant> = text
-            .split(',')
-            .filter(|s| !s.trim().is_empty())
-            .map(Variant::parse)
-            .collect::<Result<_, _>>()?;
+        let mut variants: Vec<Variant> = Vec::new();
+        for item in text.split(',').filter(|s| !s.trim().is_empty()) {
+            if item.trim() == "all" {
+                for name in crate::methods::table_methods() {
+                    variants.push(Variant::parse(name)?);
+                }
+            } else {
+                variants.push(Variant::parse(item)?);
+            }
+        }
         if variants.is_empty() {
             return Err(BenchError::Usage(
                 "no variant given (e.g. --methods nesycr,imitation)".into(),
@@ -153,6 +158,12 @@ mod tests {
         let noisy = Variant::parse("nesycr+noise=drop=0.1;flip=0.05").unwrap();
         assert_eq!(noisy.option("noise"), Some("drop=0.1;flip=0.05"));
         assert!(Variant::parse("").is_err());
+        let all: Vec<String> = Variant::parse_list("all,imitation")
+            .unwrap()
+            .iter()
+            .map(|v| v.id())
+            .collect();
+        assert_eq!(all, ["nesycr", "demo2code", "gpt4v-robotics", "imitation"]);
         assert!(Variant::parse("nesycr+bad").is_err());
         assert!(Variant::parse("nesycr+a=1+a=2").is_err());
         assert_eq!(Variant::parse_list("nesycr, imitation").unwrap().len(), 2);

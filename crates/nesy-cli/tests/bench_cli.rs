@@ -178,6 +178,8 @@ fn methods_plan_and_bad_input() {
     for m in [
         "nesycr",
         "nesycr-released",
+        "demo2code",
+        "gpt4v-robotics",
         "code-as-policies",
         "imitation",
         "replan",

@@ -242,6 +242,15 @@ impl TargetInput {
 
     /// The marked views as the VLM sees them.
     pub fn marked_views(&self) -> Result<Views, PipelineError> {
+        self.views_of(true)
+    }
+
+    /// The views as rendered, without labels (the baselines show both).
+    pub fn raw_views(&self) -> Result<Views, PipelineError> {
+        self.views_of(false)
+    }
+
+    fn views_of(&self, marked: bool) -> Result<Views, PipelineError> {
         let find = |name: &str| -> Result<Image, PipelineError> {
             let bad = |message: String| PipelineError::Target {
                 path: self.path.clone(),
@@ -252,7 +261,8 @@ impl TargetInput {
                 .iter()
                 .find(|v| v.camera == name)
                 .ok_or_else(|| bad(format!("the renderer produced no {name} view")))?;
-            Image::png(view.marked.to_png()).map_err(|e| bad(format!("the {name} view: {e}")))
+            let image = if marked { &view.marked } else { &view.image };
+            Image::png(image.to_png()).map_err(|e| bad(format!("the {name} view: {e}")))
         };
         Ok(Views {
             top: find("top")?,

@@ -7,6 +7,7 @@
 //! adaptation, replanning, world model, symbolic tool), whether it is a method or a
 //! model-free control, and what an offline run of it means.
 
+mod baselines;
 mod code_as_policies;
 mod imitation;
 pub(crate) mod nesycr;
@@ -25,6 +26,7 @@ use crate::error::BenchError;
 use crate::record::UnitStatus;
 use crate::variant::Variant;
 
+pub use baselines::{Baseline, BaselineKind};
 pub use code_as_policies::CodeAsPolicies;
 pub use imitation::Imitation;
 pub use nesycr::NeSyCr;
@@ -225,10 +227,23 @@ pub fn registry() -> Vec<Arc<dyn Method>> {
     vec![
         Arc::new(NeSyCr::full()),
         Arc::new(NeSyCr::released()),
+        Arc::new(Baseline::demo2code()),
+        Arc::new(Baseline::gpt4v_robotics()),
         Arc::new(CodeAsPolicies),
         Arc::new(Imitation),
         Arc::new(Replan),
     ]
+}
+
+/// What `all` in a method list stands for: NeSyCR and every baseline of the paper's Table 1
+/// that is implemented, in table order (not the authors' released loop, not the controls).
+pub fn table_methods() -> Vec<&'static str> {
+    registry()
+        .iter()
+        .map(|m| m.info())
+        .filter(|i| i.role == Role::Method && i.name != "nesycr-released")
+        .map(|i| i.name)
+        .collect()
 }
 
 /// The method of a name.

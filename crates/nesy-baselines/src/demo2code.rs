@@ -1,0 +1,144 @@
+//! Demo2Code, adapted to a target scene as the paper runs it: one observation call per
+//! keyframe (the keyframe's ground-truth state and six images in, one `- ` observation
+//! out), then one action-planning call that gets the observations, the target's state and
+//! images and the predicates, and answers with the numbered plan for the target.
+
+use futures::future::try_join_all;
+use nesy_vlm::VlmClient;
+use serde::Serialize;
+
+use crate::inputs::{BaselineInputs, Keyframe};
+use crate::parse::{ordered_list, unordered_list};
+use crate::prompts::{BaselinePrompts, bullets, numbered, state_lines};
+use crate::stage::{Stage, StageRecord};
+use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
+
+/// The purpose label of the observation calls.
+pub const OBSERVE: &str = "d2c.observe";
+/// The purpose label of the action-planning call.
+pub const ACTIONS: &str = "d2c.actions";
+
+#[derive(Serialize)]
+struct ObserveVars<'a> {
+    instruction: &'a str,
+    objects: String,
+    object_state: String,
+}
+
+#[derive(Serialize)]
+struct ActionsVars<'a> {
+    predicates: String,
+    instruction: &'a str,
+    objects: String,
+    object_state: String,
+    observations: String,
+}
+
+/// Runs Demo2Code on `inputs`: the observations (concurrently, as the client's concurrency
+/// allows), then the plan.
+pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<BaselinePlan, BaselineError> {
+    let prompts = BaselinePrompts::builtin()?;
+    let (observations, mut stages) = observe_all(client, prompts, inputs).await?;
+    let (system, user) = prompts.render(
+        "demo2code.actions",
+        &ActionsVars {
+            predicates: inputs.vocabulary.render_definitions(inputs.planning_tier()),
+            instruction: &inputs.instruction,
+            objects: bullets(inputs.target_objects.iter().cloned()),
+            object_state: state_lines(&inputs.target_state),
+            observations: numbered(&observations),
+        },
+    )?;
+    let mut parts = vec![nesy_vlm::Part::text(user)];
+    parts.extend(inputs.target_views.parts("scene"));
+    let (steps, record) = Stage {
+        purpose: ACTIONS,
+        system,
+        parts,
+        expected: "Write the plan as a numbered list, one action per line: \"1. ...\".",
+        fidelity: inputs.fidelity,
+        client,
+    }
+    .ask(|reply| {
+        let steps = ordered_list(reply);
+        if steps.is_empty() {
+            Err("it has no numbered list (lines \"1. ...\")".to_string())
+        } else {
+            Ok(steps)
+        }
+    })
+    .await?;
+    stages.push(record);
+    Ok(BaselinePlan {
+        steps,
+        stages,
+        deviations: deviations(inputs),
+    })
+}
+
+/// One observation per keyframe, in keyframe order, with their stage records.
+pub(crate) async fn observe_all(
+    client: &VlmClient,
+    prompts: &BaselinePrompts,
+    inputs: &BaselineInputs,
+) -> Result<(Vec<String>, Vec<StageRecord>), BaselineError> {
+    let calls = inputs
+        .keyframes
+        .iter()
+        .map(|keyframe| observe(client, prompts, inputs, keyframe));
+    Ok(try_join_all(calls).await?.into_iter().unzip())
+}
+
+async fn observe(
+    client: &VlmClient,
+    prompts: &BaselinePrompts,
+    inputs: &BaselineInputs,
+    keyframe: &Keyframe,
+) -> Result<(String, StageRecord), BaselineError> {
+    let (system, user) = prompts.render(
+        "demo2code.observe",
+        &ObserveVars {
+            instruction: &inputs.instruction,
+            objects: bullets(inputs.source_objects.iter().cloned()),
+            object_state: state_lines(&keyframe.state),
+        },
+    )?;
+    let mut parts = vec![nesy_vlm::Part::text(user)];
+    parts.extend(keyframe.views.parts("scene"));
+    Stage {
+        purpose: OBSERVE,
+        system,
+        parts,
+        expected: "Give the observation as one line that starts with \"- \".",
+        fidelity: inputs.fidelity,
+        client,
+    }
+    .ask(|reply| {
+        // The authors take the first `- ` line.
+        unordered_list(reply)
+            .into_iter()
+            .next()
+            .ok_or_else(|| "it has no line starting with \"- \"".to_string())
+    })
+    .await
+}
+
+fn deviations(inputs: &BaselineInputs) -> Vec<String> {
+    match inputs.fidelity {
+        crate::Fidelity::Authors => Vec::new(),
+        crate::Fidelity::Repaired => {
+            vec!["a reply without its answer is re-asked with the reason (the authors' parser raises)".into()]
+        }
+    }
+}
+
+/// The calls and images of one scenario with `keyframes` keyframes, before code generation.
+pub fn shape(keyframes: u64) -> RequestShape {
+    RequestShape {
+        calls_min: keyframes + 1,
+        calls_max: keyframes + 1,
+        images_min: (keyframes + 1) * IMAGES_PER_SCENE,
+        images_max: (keyframes + 1) * IMAGES_PER_SCENE,
+        largest_request_images: IMAGES_PER_SCENE,
+    }
+}

@@ -1,0 +1,102 @@
+//! What every baseline sees of one episode.
+
+use nesy_core::predicates::{Tier, Vocabulary};
+use nesy_core::state::State;
+use nesy_vlm::{Part, Views};
+use serde::Serialize;
+
+/// The six images of one scene: the top, front and back views, as rendered and with the
+/// object names written next to the objects.
+#[derive(Debug, Clone)]
+pub struct SixViews {
+    /// The views as rendered.
+    pub raw: Views,
+    /// The same views with object labels.
+    pub marked: Views,
+}
+
+impl SixViews {
+    /// The six images as request parts, each after its own caption (`"{scene} top"`,
+    /// `"{scene} top (with object labels)"`, …), as the authors attach them.
+    pub fn parts(&self, scene: &str) -> Vec<Part> {
+        let mut parts = Vec::with_capacity(12);
+        for ((name, raw), (_, marked)) in self.raw.named().into_iter().zip(self.marked.named()) {
+            parts.push(Part::text(format!("{scene} {name}")));
+            parts.push(Part::Image(raw.clone()));
+            parts.push(Part::text(format!("{scene} {name} (with object labels)")));
+            parts.push(Part::Image(marked.clone()));
+        }
+        parts
+    }
+}
+
+/// One keyframe of the demonstration.
+#[derive(Debug, Clone)]
+pub struct Keyframe {
+    /// The ground-truth state at the keyframe.
+    pub state: State,
+    /// Its six images.
+    pub views: SixViews,
+}
+
+/// How closely a flow follows the authors' code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Fidelity {
+    /// The authors' behaviour, quirks included; a reply whose answer cannot be found ends
+    /// the flow.
+    #[default]
+    Authors,
+    /// The quirks fixed, and unreadable replies re-asked with the reason; every difference
+    /// is listed in [`crate::BaselinePlan::deviations`].
+    Repaired,
+}
+
+impl Fidelity {
+    /// `authors` or `repaired`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Fidelity::Authors => "authors",
+            Fidelity::Repaired => "repaired",
+        }
+    }
+}
+
+/// Everything a baseline sees of one episode: the same information NeSyCR gets.
+#[derive(Debug, Clone)]
+pub struct BaselineInputs {
+    /// The task instruction.
+    pub instruction: String,
+    /// The demonstration scene's objects, in order.
+    pub source_objects: Vec<String>,
+    /// The demonstration's keyframes, in order.
+    pub keyframes: Vec<Keyframe>,
+    /// The target scene's objects, in order.
+    pub target_objects: Vec<String>,
+    /// The target's ground-truth initial state.
+    pub target_state: State,
+    /// The target's six images.
+    pub target_views: SixViews,
+    /// The predicates, for the tier texts.
+    pub vocabulary: Vocabulary,
+    /// Whether the target's state carries end-effector atoms (the authors' `ee_set`: the
+    /// end effector changes, or the factor is Combination); it selects the `extended` tier
+    /// over `full` where a flow shows predicates.
+    pub end_effector_in_state: bool,
+    /// The refinement budget of the scenario (10/15/20/30), for flows with loops.
+    pub budget: usize,
+    /// How closely to follow the authors.
+    pub fidelity: Fidelity,
+}
+
+impl BaselineInputs {
+    /// The tier a flow shows as "the predicates": `extended` when the end effector is part
+    /// of the state, else `full` (the authors' choice).
+    pub fn planning_tier(&self) -> Tier {
+        if self.end_effector_in_state {
+            Tier::Extended
+        } else {
+            Tier::Full
+        }
+    }
+}

@@ -1,0 +1,69 @@
+//! The paper's baselines as call flows over the VLM client. Each flow takes the same episode
+//! inputs NeSyCR gets ([`BaselineInputs`]: the ground-truth states as text, the plain and
+//! labelled views of every keyframe and of the target, the objects and the predicate tiers)
+//! and returns a natural-language plan ([`BaselinePlan`]) for the shared code-generation
+//! tail, with a record of every stage's reply.
+//!
+//! The flows follow the authors' re-implementations stage by stage, with prompts in this
+//! project's own words that keep the authors' slots and output markers:
+//! - [`demo2code`]: one observation call per keyframe, then one action-planning call
+//!   that adapts the observations to the target scene;
+//! - [`gpt4v`] (GPT4V-Robotics): one domain-description call with every keyframe's six
+//!   views, then one planning call on the target.
+//!
+//! Nothing here is symbolic: these baselines plan in text, and nothing checks the plan
+//! before code generation.
+//!
+//! Replies are untrusted. A cut-off reply or one with null content is re-asked once, as for
+//! every call of the project ([`nesy_vlm::reply`]). A reply whose answer cannot be found
+//! (no `- ` line, no numbered list, no code block) ends the flow as
+//! [`BaselineError::Unreadable`] with the reply kept, which is the authors' behaviour (their
+//! parsers raise and the episode fails); in [`Fidelity::Repaired`] it is re-asked with the
+//! reason first, up to [`REPAIRED_ATTEMPTS`] replies.
+
+pub mod demo2code;
+mod error;
+pub mod gpt4v;
+mod inputs;
+pub mod parse;
+mod prompts;
+mod stage;
+
+pub use error::BaselineError;
+pub use inputs::{BaselineInputs, Fidelity, Keyframe, SixViews};
+pub use prompts::{BaselinePrompts, PromptError};
+pub use stage::{REPAIRED_ATTEMPTS, StageProblem, StageRecord};
+
+use serde::Serialize;
+
+/// What a baseline produced: the plan for code generation, and how it got there.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BaselinePlan {
+    /// The plan's steps, in order (the demonstration summary of the code prompt).
+    pub steps: Vec<String>,
+    /// Every stage's call, in order.
+    pub stages: Vec<StageRecord>,
+    /// Where this run departs from the authors' implementation, in words (empty when it
+    /// does not).
+    pub deviations: Vec<String>,
+}
+
+/// The model calls and images one scenario costs a flow, before code generation: exact for
+/// fixed stages, the most for loops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct RequestShape {
+    /// Calls, fewest.
+    pub calls_min: u64,
+    /// Calls, most.
+    pub calls_max: u64,
+    /// Images over all calls, fewest.
+    pub images_min: u64,
+    /// Images over all calls, most.
+    pub images_max: u64,
+    /// Images in the largest single request (what an endpoint's per-request limit meets).
+    pub largest_request_images: u64,
+}
+
+/// Images per scene in every baseline call that shows one: the top, front and back views,
+/// plain and labelled.
+pub const IMAGES_PER_SCENE: u64 = 6;

@@ -1,0 +1,150 @@
+//! The baselines' prompt templates (`prompts/*.j2`, embedded), rendered with minijinja.
+//! Every template sees `physical_constraints`, the same list NeSyCR's prompts state.
+
+use std::sync::OnceLock;
+
+use minijinja::{AutoEscape, Environment, UndefinedBehavior};
+use serde::Serialize;
+
+/// `(name, text)` of every template.
+const TEMPLATES: &[(&str, &str)] = &[
+    (
+        "demo2code.observe.system",
+        include_str!("../prompts/demo2code.observe.system.j2"),
+    ),
+    (
+        "demo2code.observe.user",
+        include_str!("../prompts/demo2code.observe.user.j2"),
+    ),
+    (
+        "demo2code.actions.system",
+        include_str!("../prompts/demo2code.actions.system.j2"),
+    ),
+    (
+        "demo2code.actions.user",
+        include_str!("../prompts/demo2code.actions.user.j2"),
+    ),
+    (
+        "gpt4v.describe.system",
+        include_str!("../prompts/gpt4v.describe.system.j2"),
+    ),
+    (
+        "gpt4v.describe.user",
+        include_str!("../prompts/gpt4v.describe.user.j2"),
+    ),
+    (
+        "gpt4v.plan.system",
+        include_str!("../prompts/gpt4v.plan.system.j2"),
+    ),
+    ("gpt4v.plan.user", include_str!("../prompts/gpt4v.plan.user.j2")),
+];
+
+/// A template failed to compile or render (a defect of this crate's files).
+#[derive(Debug, thiserror::Error)]
+#[error("baseline prompt template {name}: {error}")]
+pub struct PromptError {
+    /// The template.
+    pub name: String,
+    /// What minijinja said.
+    #[source]
+    pub error: minijinja::Error,
+}
+
+/// The compiled templates.
+pub struct BaselinePrompts {
+    env: Environment<'static>,
+}
+
+impl std::fmt::Debug for BaselinePrompts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("BaselinePrompts")
+            .field(
+                "templates",
+                &TEMPLATES.iter().map(|(n, _)| *n).collect::<Vec<_>>(),
+            )
+            .finish()
+    }
+}
+
+impl BaselinePrompts {
+    /// The process-wide instance, compiled on first use.
+    pub fn builtin() -> Result<&'static BaselinePrompts, PromptError> {
+        static PROMPTS: OnceLock<BaselinePrompts> = OnceLock::new();
+        if let Some(prompts) = PROMPTS.get() {
+            return Ok(prompts);
+        }
+        let loaded = BaselinePrompts::load()?;
+        Ok(PROMPTS.get_or_init(|| loaded))
+    }
+
+    fn load() -> Result<BaselinePrompts, PromptError> {
+        let error = |name: &str| {
+            let name = name.to_string();
+            move |error| PromptError { name, error }
+        };
+        let mut env = Environment::new();
+        let syntax = minijinja::syntax::SyntaxConfig::builder()
+            .trim_blocks(true)
+            .lstrip_blocks(true)
+            .keep_trailing_newline(false)
+            .build()
+            .map_err(error("(syntax configuration)"))?;
+        env.set_syntax(syntax);
+        env.set_undefined_behavior(UndefinedBehavior::Strict);
+        env.set_auto_escape_callback(|_| AutoEscape::None);
+        env.add_global(
+            "physical_constraints",
+            nesy_vlm::prompts::PHYSICAL_CONSTRAINTS.trim_end(),
+        );
+        for (name, text) in TEMPLATES {
+            env.add_template(name, text).map_err(error(name))?;
+        }
+        Ok(BaselinePrompts { env })
+    }
+
+    /// Renders `{stage}.system` and `{stage}.user` with `vars`.
+    pub fn render(&self, stage: &str, vars: &impl Serialize) -> Result<(String, String), PromptError> {
+        let one = |part: &str| {
+            let name = format!("{stage}.{part}");
+            self.env
+                .get_template(&name)
+                .and_then(|t| t.render(minijinja::value::Serde(vars)))
+                .map_err(|error| PromptError { name, error })
+        };
+        Ok((one("system")?, one("user")?))
+    }
+
+    /// The template names, for listings and tests.
+    pub fn template_names() -> impl Iterator<Item = &'static str> {
+        TEMPLATES.iter().map(|(n, _)| *n)
+    }
+}
+
+/// `- item` lines, or `None` for an empty list.
+pub(crate) fn bullets<I: IntoIterator<Item = String>>(items: I) -> String {
+    let lines: Vec<String> = items.into_iter().map(|l| format!("- {l}")).collect();
+    if lines.is_empty() {
+        "None".to_string()
+    } else {
+        lines.join("\n")
+    }
+}
+
+/// `1. item` lines, or `None` for an empty list.
+pub(crate) fn numbered<'a, I: IntoIterator<Item = &'a String>>(items: I) -> String {
+    let lines: Vec<String> = items
+        .into_iter()
+        .enumerate()
+        .map(|(i, l)| format!("{}. {l}", i + 1))
+        .collect();
+    if lines.is_empty() {
+        "None".to_string()
+    } else {
+        lines.join("\n")
+    }
+}
+
+/// A state as `- atom` lines, sorted.
+pub(crate) fn state_lines(state: &nesy_core::state::State) -> String {
+    bullets(state.sorted_by_text().into_iter().map(|a| a.to_string()))
+}

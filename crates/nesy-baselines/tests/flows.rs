@@ -1,0 +1,394 @@
+//! Each baseline's whole flow against a scripted responder that answers by purpose: every
+//! stage is called with the inputs the authors give it, the plan comes out of the last
+//! reply, and a reply without its answer is a typed failure (authors) or re-asked (repaired).
+
+use std::collections::{BTreeMap, VecDeque};
+use std::sync::{Arc, Mutex};
+
+use nesy_baselines::{BaselineError, BaselineInputs, Fidelity, Keyframe, SixViews, demo2code, gpt4v};
+use nesy_core::predicates::Vocabulary;
+use nesy_core::state::State;
+use nesy_vlm::{
+    BackendKind, BoxFuture, Image, Origin, Transport, TransportError, Views, VlmClient, VlmConfig, VlmError,
+    WireRequest, WireResponse,
+};
+use serde_json::{Value, json};
+
+/// The prefix that makes [`Scripted`] answer with `finish_reason: length`.
+const TRUNCATED: &str = "<length>";
+
+/// Answers each purpose from its own queue and keeps every request.
+#[derive(Debug, Default)]
+struct Scripted {
+    replies: Mutex<BTreeMap<String, VecDeque<String>>>,
+    seen: Mutex<Vec<WireRequest>>,
+}
+
+impl Scripted {
+    fn with(replies: &[(&str, &[&str])]) -> Arc<Self> {
+        Arc::new(Scripted {
+            replies: Mutex::new(
+                replies
+                    .iter()
+                    .map(|(p, texts)| (p.to_string(), texts.iter().map(|t| t.to_string()).collect()))
+                    .collect(),
+            ),
+            seen: Mutex::default(),
+        })
+    }
+
+    fn requests(&self, purpose: &str) -> Vec<WireRequest> {
+        let seen = self.seen.lock().unwrap();
+        seen.iter()
+            .filter(|r| r.purpose.as_deref() == Some(purpose))
+            .cloned()
+            .collect()
+    }
+}
+
+impl Transport for Scripted {
+    fn send<'a>(&'a self, request: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
+        Box::pin(async move {
+            self.seen.lock().unwrap().push(request.clone());
+            let purpose = request.purpose.clone().unwrap_or_default();
+            let reply = self
+                .replies
+                .lock()
+                .unwrap()
+                .get_mut(&purpose)
+                .and_then(VecDeque::pop_front)
+                .ok_or_else(|| TransportError::Failed {
+                    message: format!("no reply left for {purpose:?}"),
+                    retryable: false,
+                })?;
+            let (text, finish) = match reply.strip_prefix(TRUNCATED) {
+                Some(partial) => (partial.to_string(), "length"),
+                None => (reply, "stop"),
+            };
+            let body = json!({
+                "id": "chatcmpl-scripted", "model": "scripted",
+                "choices": [{"index": 0, "message": {"role": "assistant", "content": text}, "finish_reason": finish}],
+                "usage": {"prompt_tokens": 10, "completion_tokens": 5}
+            });
+            Ok(WireResponse::new(
+                200,
+                serde_json::to_vec(&body).unwrap(),
+                Origin::Offline,
+            ))
+        })
+    }
+
+    fn label(&self) -> String {
+        "scripted".into()
+    }
+}
+
+fn client(transport: Arc<Scripted>, max_images: Option<usize>) -> VlmClient {
+    let mut config = VlmConfig::new(BackendKind::OpenAi, "gpt-5");
+    config.base_url = "http://127.0.0.1:9".into();
+    config.max_images_per_request = max_images;
+    // One call at a time, so replies are taken in keyframe order.
+    config.max_concurrency = 1;
+    VlmClient::with_transport(&config, transport)
+}
+
+fn png(seed: u8) -> Image {
+    let mut out = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut out, 2, 2);
+        encoder.set_color(png::ColorType::Rgb);
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_image_data(&[seed; 12]).unwrap();
+    }
+    Image::png(out).unwrap()
+}
+
+fn six(seed: u8) -> SixViews {
+    let views = |s: u8| Views {
+        top: png(s),
+        front: png(s + 1),
+        back: png(s + 2),
+    };
+    SixViews {
+        raw: views(seed),
+        marked: views(seed + 3),
+    }
+}
+
+fn state(atoms: &[&str]) -> State {
+    State::from_atoms(atoms.iter().map(|a| a.parse().unwrap()))
+}
+
+/// A three-keyframe pick-and-place demo; the target has a cube stacked on the red one.
+fn inputs(fidelity: Fidelity) -> BaselineInputs {
+    BaselineInputs {
+        instruction: "Put the red cube in the box.".into(),
+        source_objects: vec!["red_cube".into(), "box".into(), "floor".into()],
+        keyframes: vec![
+            Keyframe {
+                state: state(&["(GripperOpen)", "(OnTopOf red_cube floor)"]),
+                views: six(1),
+            },
+            Keyframe {
+                state: state(&["(GripperClosed)", "(GripperHolding red_cube)"]),
+                views: six(10),
+            },
+            Keyframe {
+                state: state(&["(GripperOpen)", "(InsideOf red_cube box)"]),
+                views: six(20),
+            },
+        ],
+        target_objects: vec![
+            "red_cube".into(),
+            "blue_cube".into(),
+            "box".into(),
+            "floor".into(),
+        ],
+        target_state: state(&[
+            "(GripperOpen)",
+            "(OnTopOf red_cube floor)",
+            "(OnTopOf blue_cube red_cube)",
+        ]),
+        target_views: six(40),
+        vocabulary: Vocabulary::new(),
+        end_effector_in_state: false,
+        budget: 10,
+        fidelity,
+    }
+}
+
+fn messages(request: &WireRequest) -> &Vec<Value> {
+    request.body["messages"].as_array().unwrap()
+}
+
+fn text_of(message: &Value) -> String {
+    match &message["content"] {
+        Value::String(s) => s.clone(),
+        Value::Array(parts) => parts
+            .iter()
+            .filter_map(|p| p["text"].as_str())
+            .collect::<Vec<_>>()
+            .join("\n"),
+        _ => String::new(),
+    }
+}
+
+fn images(message: &Value) -> usize {
+    message["content"].as_array().map_or(0, |parts| {
+        parts.iter().filter(|p| p["type"] == "image_url").count()
+    })
+}
+
+const OBSERVATIONS: [&str; 3] = [
+    "The cube rests on the table.\n- The open gripper is empty; the red cube lies on the table.",
+    "**Observation:**\n\u{2022} The gripper holds the red cube.",
+    "- The red cube is in the box and the gripper is open.\n- (a second line is not used)",
+];
+
+const PLAN: &str = "The blue cube covers the red one, so it goes first.\n\n1. **Grasp** the blue cube.\n2. Put the blue cube on the table.\n3. Grasp the red cube.\n4. Drop the red cube into the box.\n\nThis keeps to the demonstration otherwise.";
+
+#[test]
+fn demo2code_observes_every_keyframe_then_plans_for_the_target() {
+    let transport = Scripted::with(&[(demo2code::OBSERVE, &OBSERVATIONS), (demo2code::ACTIONS, &[PLAN])]);
+    let plan = pollster::block_on(demo2code::run(
+        &client(transport.clone(), None),
+        &inputs(Fidelity::Authors),
+    ))
+    .unwrap();
+    assert_eq!(
+        plan.steps,
+        [
+            "Grasp the blue cube.",
+            "Put the blue cube on the table.",
+            "Grasp the red cube.",
+            "Drop the red cube into the box."
+        ]
+    );
+    assert!(plan.deviations.is_empty());
+    let purposes: Vec<&str> = plan.stages.iter().map(|s| s.purpose.as_str()).collect();
+    assert_eq!(
+        purposes,
+        ["d2c.observe", "d2c.observe", "d2c.observe", "d2c.actions"]
+    );
+    // Each observation call sees its keyframe's state and six captioned images.
+    let observe = transport.requests(demo2code::OBSERVE);
+    assert_eq!(observe.len(), 3);
+    let user = text_of(&messages(&observe[1])[1]);
+    assert!(user.contains("- (GripperHolding red_cube)"), "{user}");
+    assert!(user.contains("scene front (with object labels)"), "{user}");
+    assert!(observe.iter().all(|r| images(&messages(r)[1]) == 6));
+    // The planning call sees the numbered observations, the target's state and objects,
+    // the full tier's predicates and the target's six images; the physical constraints are
+    // NeSyCR's.
+    let actions = transport.requests(demo2code::ACTIONS);
+    let user = text_of(&messages(&actions[0])[1]);
+    assert!(
+        user.contains(
+            "1. The open gripper is empty; the red cube lies on the table.\n2. The gripper holds the red cube.\n3. The red cube is in the box and the gripper is open."
+        ),
+        "{user}"
+    );
+    assert!(user.contains("- (OnTopOf blue_cube red_cube)"), "{user}");
+    assert!(user.contains("- blue_cube"), "{user}");
+    assert!(user.contains("(Closed ?x)"), "{user}");
+    assert!(!user.contains("VacuumAttached"), "{user}");
+    assert_eq!(images(&messages(&actions[0])[1]), 6);
+    let system = text_of(&messages(&actions[0])[0]);
+    assert!(system.contains(nesy_vlm::prompts::PHYSICAL_CONSTRAINTS.lines().next().unwrap()));
+    assert!(
+        actions
+            .iter()
+            .chain(&observe)
+            .all(|r| r.body["reasoning_effort"] == "low")
+    );
+}
+
+#[test]
+fn an_observation_without_its_line_fails_as_the_authors_parser_does_or_is_re_asked() {
+    let prose = "I see a robot and a cube.";
+    // Authors: no re-ask; the unit fails with the reply kept.
+    let transport = Scripted::with(&[(demo2code::OBSERVE, &[OBSERVATIONS[0], prose, OBSERVATIONS[2]])]);
+    let error = pollster::block_on(demo2code::run(
+        &client(transport.clone(), None),
+        &inputs(Fidelity::Authors),
+    ))
+    .unwrap_err();
+    match &error {
+        BaselineError::Unreadable {
+            purpose,
+            reply,
+            attempts,
+            problem,
+        } => {
+            assert_eq!(purpose, "d2c.observe");
+            assert_eq!(reply, prose);
+            assert_eq!(*attempts, 1);
+            assert!(problem.contains("no line starting with"), "{problem}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(error.reasoner_kind(), nesy_core::adapt::ReasonerErrorKind::Reply);
+    assert!(transport.requests(demo2code::ACTIONS).is_empty());
+
+    // Repaired: the reply goes back with the reason, the corrected one is used.
+    let transport = Scripted::with(&[
+        (
+            demo2code::OBSERVE,
+            &[OBSERVATIONS[0], prose, OBSERVATIONS[1], OBSERVATIONS[2]],
+        ),
+        (demo2code::ACTIONS, &[PLAN]),
+    ]);
+    let plan = pollster::block_on(demo2code::run(
+        &client(transport.clone(), None),
+        &inputs(Fidelity::Repaired),
+    ))
+    .unwrap();
+    assert_eq!(plan.steps.len(), 4);
+    assert_eq!(plan.stages[1].reasked.len(), 1);
+    assert!(!plan.deviations.is_empty());
+    let observe = transport.requests(demo2code::OBSERVE);
+    let reask = messages(&observe[2]);
+    assert_eq!(reask.len(), 4);
+    assert_eq!(text_of(&reask[2]), prose);
+    assert!(
+        text_of(&reask[3]).contains("could not be read: it has no line starting with"),
+        "{}",
+        text_of(&reask[3])
+    );
+}
+
+#[test]
+fn a_plan_cut_off_at_the_token_cap_is_re_asked_in_either_mode() {
+    let cut = format!("{TRUNCATED}The blue cube covers the red one.\n1. Grasp the bl");
+    let transport = Scripted::with(&[
+        (demo2code::OBSERVE, &OBSERVATIONS),
+        (demo2code::ACTIONS, &[&cut, PLAN]),
+    ]);
+    let plan = pollster::block_on(demo2code::run(
+        &client(transport.clone(), None),
+        &inputs(Fidelity::Authors),
+    ))
+    .unwrap();
+    assert_eq!(plan.steps.len(), 4);
+    let actions = &plan.stages[3];
+    assert_eq!(actions.reasked.len(), 1);
+    assert!(
+        actions.reasked[0].contains("cut off at the token cap"),
+        "{:?}",
+        actions.reasked
+    );
+}
+
+const DESCRIPTION: &str = "Here is the analysis.\n\n```\nTask: put the red cube in the box.\nActions:\n1. Grasp the red cube.\n2. Drop it into the box.\n```\n";
+
+#[test]
+fn gpt4v_describes_the_whole_demonstration_in_one_request_then_plans() {
+    let transport = Scripted::with(&[(gpt4v::DESCRIBE, &[DESCRIPTION]), (gpt4v::PLAN, &[PLAN])]);
+    let mut inputs = inputs(Fidelity::Authors);
+    inputs.target_state = state(&["(GripperOpen)", "(OnTopOf blue_cube red_cube)", "(FingerGripper)"]);
+    let plan = pollster::block_on(gpt4v::run(&client(transport.clone(), None), &inputs)).unwrap();
+    assert_eq!(plan.steps.len(), 4);
+    let describe = transport.requests(gpt4v::DESCRIBE);
+    assert_eq!(describe.len(), 1);
+    let user = &messages(&describe[0])[1];
+    assert_eq!(images(user), 3 * 6);
+    let text = text_of(user);
+    assert!(
+        text.contains("2. (GripperClosed), (GripperHolding red_cube)"),
+        "{text}"
+    );
+    assert!(
+        text.contains("demo keyframe 3 back (with object labels)"),
+        "{text}"
+    );
+    // The plan sees the description's block, only the end-effector predicates and atoms,
+    // and the target's six images.
+    let plan_request = transport.requests(gpt4v::PLAN);
+    let user = &messages(&plan_request[0])[1];
+    assert_eq!(images(user), 6);
+    let text = text_of(user);
+    assert!(
+        text.contains("Demonstrated domain:\nTask: put the red cube in the box."),
+        "{text}"
+    );
+    assert!(!text.contains("Here is the analysis"), "{text}");
+    assert!(
+        text.contains("- (GripperOpen)\n- (FingerGripper)")
+            || text.contains("- (FingerGripper)\n- (GripperOpen)"),
+        "{text}"
+    );
+    assert!(!text.contains("(OnTopOf blue_cube red_cube)"), "{text}");
+    assert!(!text.contains("(OnTopOf ?a ?b)"), "{text}");
+}
+
+#[test]
+fn a_description_over_the_endpoints_image_limit_is_refused_before_sending() {
+    let transport = Scripted::with(&[(gpt4v::DESCRIBE, &[DESCRIPTION]), (gpt4v::PLAN, &[PLAN])]);
+    let error = pollster::block_on(gpt4v::run(
+        &client(transport.clone(), Some(12)),
+        &inputs(Fidelity::Authors),
+    ))
+    .unwrap_err();
+    match &error {
+        BaselineError::Call {
+            purpose,
+            error:
+                VlmError::TooManyImages {
+                    images: 18,
+                    limit: 12,
+                },
+        } => assert_eq!(purpose, "gpt4v.describe"),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        error.reasoner_kind(),
+        nesy_core::adapt::ReasonerErrorKind::Refused
+    );
+    assert!(transport.requests(gpt4v::DESCRIBE).is_empty());
+    assert_eq!(gpt4v::shape(3).largest_request_images, 18);
+    // A description without its block fails as the authors' reader does.
+    let transport = Scripted::with(&[(gpt4v::DESCRIBE, &["The robot picks the cube."])]);
+    let error =
+        pollster::block_on(gpt4v::run(&client(transport, None), &inputs(Fidelity::Authors))).unwrap_err();
+    assert!(error.to_string().contains("has no fenced block"), "{error}");
+}

@@ -1,0 +1,225 @@
+//! The paper's baselines as methods of the harness: each runs its call flow from
+//! nesy-baselines on the unit's demonstration and target, and hands its natural-language
+//! plan to the shared code-generation tail.
+//!
+//! None of them can be measured offline: their calls are global ("describe the
+//! demonstration", "write the plan for the target"), so a perfect answer would be the
+//! planner's plan, not the method's. The harness refuses them with the offline responder.
+
+use std::time::Instant;
+
+use futures::FutureExt as _;
+use futures::future::BoxFuture;
+use nesy_baselines::{BaselineError, BaselineInputs, BaselinePlan, Fidelity, Keyframe, SixViews};
+use nesy_core::predicates::Vocabulary;
+use nesy_pipeline::CodegenMode;
+use nesy_sim::demo::CameraName;
+use nesy_vlm::{Image, Views, VlmClient};
+
+use super::{
+    Classes, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified, UnitInputs,
+    check_keys,
+};
+use crate::error::BenchError;
+use crate::record::UnitStatus;
+use crate::variant::Variant;
+
+/// Which baseline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BaselineKind {
+    /// Demo2Code (adapted to the target at its last stage).
+    Demo2Code,
+    /// GPT4V-Robotics (the target given at planning time).
+    Gpt4vRobotics,
+}
+
+/// A baseline as a harness method.
+#[derive(Debug, Clone, Copy)]
+pub struct Baseline {
+    kind: BaselineKind,
+}
+
+const SETTINGS: &[&str] = &["fidelity=authors|repaired (the authors' behaviour, or their quirks fixed)"];
+
+impl Baseline {
+    /// Demo2Code.
+    pub fn demo2code() -> Baseline {
+        Baseline {
+            kind: BaselineKind::Demo2Code,
+        }
+    }
+
+    /// GPT4V-Robotics.
+    pub fn gpt4v_robotics() -> Baseline {
+        Baseline {
+            kind: BaselineKind::Gpt4vRobotics,
+        }
+    }
+
+    /// Which baseline this is.
+    pub fn kind(&self) -> BaselineKind {
+        self.kind
+    }
+
+    fn fidelity(variant: &Variant) -> Result<Fidelity, BenchError> {
+        match variant.option("fidelity") {
+            None | Some("authors") => Ok(Fidelity::Authors),
+            Some("repaired") => Ok(Fidelity::Repaired),
+            Some(other) => Err(BenchError::Usage(format!(
+                "variant {variant}: fidelity={other:?}; expected authors or repaired"
+            ))),
+        }
+    }
+}
+
+impl Method for Baseline {
+    fn info(&self) -> MethodInfo {
+        let (name, title, classes, summary) = match self.kind {
+            BaselineKind::Demo2Code => (
+                "demo2code",
+                "Demo2Code",
+                Classes {
+                    natively_code: true,
+                    ..Classes::default()
+                },
+                "one observation per keyframe, then one call that adapts them into the target's plan (no check)",
+            ),
+            BaselineKind::Gpt4vRobotics => (
+                "gpt4v-robotics",
+                "GPT4V-Robotics",
+                Classes {
+                    natively_code: true,
+                    explicit_adapt: true,
+                    replanning: true,
+                    ..Classes::default()
+                },
+                "one domain description from every keyframe's views at once, then one planning call on the target (no check)",
+            ),
+        };
+        MethodInfo {
+            name,
+            title,
+            role: Role::Method,
+            classes,
+            summary,
+            settings: SETTINGS,
+            offline: OfflineMeaning::NotMeaningful,
+        }
+    }
+
+    fn validate(&self, variant: &Variant) -> Result<(), BenchError> {
+        check_keys(variant, SETTINGS)?;
+        Baseline::fidelity(variant).map(|_| ())
+    }
+
+    fn specify<'a>(
+        &'a self,
+        inputs: &'a UnitInputs,
+        client: &'a VlmClient,
+    ) -> BoxFuture<'a, Result<Specified, MethodFailure>> {
+        async move {
+            let fidelity = Baseline::fidelity(&inputs.variant)
+                .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?;
+            let baseline_inputs = baseline_inputs(inputs, fidelity)?;
+            let started = Instant::now();
+            let plan = match self.kind {
+                BaselineKind::Demo2Code => nesy_baselines::demo2code::run(client, &baseline_inputs).await,
+                BaselineKind::Gpt4vRobotics => nesy_baselines::gpt4v::run(client, &baseline_inputs).await,
+            }
+            .map_err(baseline_failure)?;
+            Ok(specified(plan, started.elapsed().as_secs_f64()))
+        }
+        .boxed()
+    }
+}
+
+fn specified(plan: BaselinePlan, vlm_s: f64) -> Specified {
+    let mut notes: Vec<String> = plan
+        .deviations
+        .iter()
+        .map(|d| format!("deviation: {d}"))
+        .collect();
+    for stage in &plan.stages {
+        for problem in &stage.reasked {
+            notes.push(format!("{}: re-asked: {problem}", stage.purpose));
+        }
+    }
+    Specified {
+        spec: Specification::Plan { steps: plan.steps },
+        codegen: CodegenMode::Vlm,
+        adaptation: None,
+        iterations: None,
+        states: None,
+        symbolic_s: (0.0, 0.0),
+        vlm_s,
+        notes,
+    }
+}
+
+/// The unit's failure for a baseline error; an unreadable reply is kept in the message.
+fn baseline_failure(error: BaselineError) -> MethodFailure {
+    let mut message = error.to_string();
+    if let Some(reply) = error.reply() {
+        let excerpt: String = reply.chars().take(2000).collect();
+        message.push_str(&format!("\nthe reply:\n{excerpt}"));
+    }
+    MethodFailure::from_reasoner(error.reasoner_kind(), message)
+}
+
+/// What the baselines see of a unit: the demonstration's ground-truth states and six views
+/// per keyframe, and the target's.
+fn baseline_inputs(inputs: &UnitInputs, fidelity: Fidelity) -> Result<BaselineInputs, MethodFailure> {
+    let fail = |message: String| MethodFailure::new(UnitStatus::MethodError, message);
+    let demo = &inputs.demo.demo;
+    let mut keyframes = Vec::with_capacity(demo.keyframes.len());
+    for k in &demo.keyframes {
+        let state = k.state.clone().ok_or_else(|| {
+            fail(format!(
+                "keyframe {} has no ground-truth state; the baselines read the states as text",
+                k.index
+            ))
+        })?;
+        let view = |marked: bool| -> Result<Views, MethodFailure> {
+            let image = |camera: CameraName| {
+                let images = k.views.get(camera);
+                let bytes = if marked {
+                    images.marked_or_raw()
+                } else {
+                    &images.raw
+                };
+                Image::png(bytes.to_vec())
+                    .map_err(|e| fail(format!("keyframe {}: {} view: {e}", k.index, camera.as_str())))
+            };
+            Ok(Views {
+                top: image(CameraName::Top)?,
+                front: image(CameraName::Front)?,
+                back: image(CameraName::Back)?,
+            })
+        };
+        keyframes.push(Keyframe {
+            state,
+            views: SixViews {
+                raw: view(false)?,
+                marked: view(true)?,
+            },
+        });
+    }
+    let target = &inputs.target;
+    let target_views = SixViews {
+        raw: target.raw_views().map_err(|e| fail(e.to_string()))?,
+        marked: target.marked_views().map_err(|e| fail(e.to_string()))?,
+    };
+    Ok(BaselineInputs {
+        instruction: target.instruction(&inputs.demo),
+        source_objects: demo.metadata.objects.clone(),
+        keyframes,
+        target_objects: target.objects.clone(),
+        target_state: target.observed.clone(),
+        target_views,
+        vocabulary: Vocabulary::new(),
+        end_effector_in_state: inputs.setting.embodiment_in_state
+            || inputs.setting.factor == nesy_core::benchmark::Factor::Comb,
+        budget: inputs.setting.budget,
+        fidelity,
+    })
+}

@@ -1,0 +1,246 @@
+//! The baselines through `nesy bench run` over the live HTTP path, against a local server
+//! answering every stage with hand-written replies in a chatty model's style (preambles,
+//! bold headers, numbered lists, a closing remark) and one mistake each method must survive:
+//! Demo2Code's first plan is cut off at the token cap, GPT4V-Robotics' first description
+//! comes back with null content. Both are re-asked. The live run records one cassette per
+//! unit; replaying them offline twice gives the same records as the live run.
+//!
+//! These replies are not a model's: the scores say what this program does in the simulator,
+//! nothing about either method.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+
+use serde_json::{Value, json};
+use wiremock::matchers::{method, path};
+use wiremock::{Mock, MockServer, Request, Respond, ResponseTemplate};
+
+const SCENARIO: &str = "obst_low_00_s0";
+
+/// The program every code-generation call gets: a plausible first attempt that handles the
+/// cubes (highest first) and forgets the fruit.
+const PROGRAM: &str = r#"objects = get_obj_names()
+cubes = [name for name in objects if name.endswith("_cube")]
+box = get_obj_pos("toy_box")
+box_size = get_obj_size("toy_box")
+# Take stacked cubes from the top down.
+cubes.sort(key=lambda name: -get_obj_pos(name)[2])
+for cube in cubes:
+    height = get_obj_size(cube)[2]
+    move_gripper_to(cube, depth=height / 2)
+    close_gripper()
+    move_to_position([box[0], box[1], box[2] + box_size[2] + height])
+    open_gripper()"#;
+
+const PLAN: &str = "Comparing the demonstration with the new scene: the green cube now sits on the red cube, so it has to come off first.
+
+**Plan:**
+1. Move the gripper around the green cube.
+2. Close the gripper to grasp the green cube.
+3. Carry the green cube above the toy box and open the gripper.
+4. Move the gripper around the red cube.
+5. Close the gripper to grasp the red cube.
+6. Carry the red cube above the toy box and open the gripper.
+7. Put the fruits into the hinge box as in the demonstration.
+
+Let me know if the plan should be more detailed.";
+
+const DESCRIPTION: &str = "Sure. Here is my analysis of the demonstration.
+
+```text
+Task: put the cubes into the toy box and the fruits into the hinge box.
+Objects: the cubes and fruits are moved; toy_box and hinge_body are containers.
+Actions, in order:
+1. Grasp each cube from above and drop it into the toy box.
+2. Open the hinge lid by its handle before putting fruit in.
+3. Grasp each fruit and drop it into the hinge box.
+```
+
+The demonstration never stacks objects.";
+
+/// One reply in the wire format.
+fn completion(content: Option<&str>, finish: &str) -> ResponseTemplate {
+    ResponseTemplate::new(200).set_body_json(json!({
+        "id": "chatcmpl-baseline", "object": "chat.completion", "model": "mock-vlm",
+        "choices": [{"index": 0, "message": {"role": "assistant", "content": content}, "finish_reason": finish}],
+        "usage": {"prompt_tokens": 2000, "completion_tokens": 200}
+    }))
+}
+
+/// Answers each stage by its system prompt; counts the requests per stage.
+#[derive(Default)]
+struct HandWritten {
+    seen: Arc<Mutex<BTreeMap<&'static str, usize>>>,
+}
+
+impl Respond for HandWritten {
+    fn respond(&self, request: &Request) -> ResponseTemplate {
+        let body: Value = serde_json::from_slice(&request.body).expect("JSON body");
+        let messages = body["messages"].as_array().cloned().unwrap_or_default();
+        let system = common::message_text(&messages[0]);
+        let reask = messages.len() > 2;
+        let stage = [
+            (
+                "observe",
+                "You describe a robot demonstration one moment at a time.",
+            ),
+            ("actions", "You turn a robot demonstration into the action plan"),
+            (
+                "describe",
+                "You analyse a robot demonstration from its keyframes.",
+            ),
+            ("plan", "You plan robot actions for a new scene"),
+            ("code", "You write Python programs"),
+        ]
+        .into_iter()
+        .find(|(_, start)| system.starts_with(start))
+        .map(|(stage, _)| stage);
+        let Some(stage) = stage else {
+            return ResponseTemplate::new(400).set_body_string("unexpected request");
+        };
+        *self.seen.lock().unwrap().entry(stage).or_default() += 1;
+        match stage {
+            "observe" => {
+                let user = common::message_text(&messages[1]);
+                let atoms: Vec<&str> = user
+                    .split("Symbolic state at this keyframe:\n")
+                    .nth(1)
+                    .unwrap_or("")
+                    .lines()
+                    .take_while(|l| l.starts_with("- "))
+                    .map(|l| &l[2..])
+                    .collect();
+                let reply = format!(
+                    "Looking at the labelled views, the scene matches the listed state.\n\n**Observation:**\n- The scene shows {}.",
+                    atoms.join(", ")
+                );
+                completion(Some(&reply), "stop")
+            }
+            "actions" if !reask => completion(Some(&PLAN[..PLAN.len() / 3]), "length"),
+            "actions" | "plan" => completion(Some(PLAN), "stop"),
+            "describe" if !reask => completion(None, "stop"),
+            "describe" => completion(Some(DESCRIPTION), "stop"),
+            _ => completion(
+                Some(&format!(
+                    "Here is the program.\n\n```python\n{PROGRAM}\n```\n\nIt reads every position at run time."
+                )),
+                "stop",
+            ),
+        }
+    }
+}
+
+fn bench(run: &Path, demos: &Path, vlm: &str) -> std::process::Output {
+    let output = common::nesy(&[
+        "bench".into(),
+        "run".into(),
+        run.display().to_string(),
+        "--methods".into(),
+        "demo2code,gpt4v-robotics".into(),
+        "--scenarios".into(),
+        SCENARIO.into(),
+        "--vlm".into(),
+        vlm.into(),
+        "--vlm-model".into(),
+        "mock-vlm".into(),
+        "--demos".into(),
+        demos.display().to_string(),
+    ]);
+    assert_eq!(
+        output.status.code(),
+        Some(0),
+        "{}\n{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    output
+}
+
+/// The unit records of a run, by method, without the fields that measure time or place.
+fn records(run: &Path) -> BTreeMap<String, Value> {
+    let mut out = BTreeMap::new();
+    for entry in std::fs::read_dir(run.join("results")).unwrap().flatten() {
+        for line in std::fs::read_to_string(entry.path()).unwrap().lines() {
+            let mut record: Value = serde_json::from_str(line).unwrap();
+            for volatile in ["finished_at", "artifacts"] {
+                record.as_object_mut().unwrap().remove(volatile);
+            }
+            let effort = record["effort"].as_object_mut().unwrap();
+            effort.retain(|k, _| !k.ends_with("_s"));
+            out.insert(record["method"].as_str().unwrap().to_string(), record);
+        }
+    }
+    out
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn baselines_run_live_record_and_replay_to_the_same_records() {
+    let scratch = common::scratch();
+    let demos = scratch.path().join("demos");
+    let live = scratch.path().join("live");
+    let server = MockServer::start().await;
+    let responder = HandWritten::default();
+    let seen = responder.seen.clone();
+    Mock::given(method("POST"))
+        .and(path("/v1/chat/completions"))
+        .respond_with(responder)
+        .mount(&server)
+        .await;
+    let url = format!("{}/v1", server.uri());
+    let (live_dir, demos_dir) = (live.clone(), demos.clone());
+    tokio::task::spawn_blocking(move || bench(&live_dir, &demos_dir, &url))
+        .await
+        .unwrap();
+    let live_records = records(&live);
+    let seen = seen.lock().unwrap().clone();
+
+    let d2c = &live_records["demo2code"];
+    let keyframes = seen["observe"] as u64;
+    assert!(keyframes >= 3, "{seen:?}");
+    let by_purpose = &d2c["effort"]["calls_by_purpose"];
+    assert_eq!(by_purpose["d2c.observe"], keyframes);
+    // The cut-off plan and its re-ask.
+    assert_eq!(by_purpose["d2c.actions"], 2);
+    assert_eq!(d2c["spec"]["kind"], "plan");
+    assert_eq!(d2c["spec"]["steps"], 7);
+    let gpt4v = &live_records["gpt4v-robotics"];
+    let by_purpose = &gpt4v["effort"]["calls_by_purpose"];
+    // The null-content description and its re-ask, then the plan.
+    assert_eq!(by_purpose["gpt4v.describe"], 2);
+    assert_eq!(by_purpose["gpt4v.plan"], 1);
+    assert_eq!(
+        gpt4v["effort"]["images"].as_u64().unwrap(),
+        2 * keyframes * 6 + 6,
+        "{gpt4v}"
+    );
+    // The same program ran for both: it puts the cubes in the box and never the fruit.
+    for record in [d2c, gpt4v] {
+        assert_eq!(record["status"], "execution_failed", "{record}");
+        assert_eq!(record["scores"]["sr"], 0.0, "{record}");
+        assert_eq!(record["scores"]["gc"], 0.5, "{record}");
+    }
+
+    // Offline: the live run's cassettes replayed, twice, give the live records.
+    let cassettes = live.join("cassettes");
+    for name in ["replay-1", "replay-2"] {
+        let run = scratch.path().join(name);
+        let vlm = format!("replay:{}", cassettes.display());
+        let (run_dir, demos_dir) = (run.clone(), demos.clone());
+        tokio::task::spawn_blocking(move || bench(&run_dir, &demos_dir, &vlm))
+            .await
+            .unwrap();
+        let replayed = records(&run);
+        for (method, record) in &live_records {
+            let mut expected = record.clone();
+            let mut got = replayed[method].clone();
+            for r in [&mut expected, &mut got] {
+                r.as_object_mut().unwrap().remove("config_hash");
+                r["effort"].as_object_mut().unwrap().remove("cost_usd");
+            }
+            assert_eq!(got, expected, "{method}");
+        }
+    }
+}
