@@ -8,9 +8,9 @@ use nesy_vlm::VlmClient;
 use serde::Serialize;
 
 use crate::inputs::{BaselineInputs, Keyframe};
-use crate::parse::{ordered_list, unordered_list};
+use crate::parse::unordered_list;
 use crate::prompts::{BaselinePrompts, bullets, numbered, state_lines};
-use crate::stage::{Stage, StageRecord};
+use crate::stage::{Stage, StageRecord, target_plan};
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
 /// The purpose label of the observation calls.
@@ -38,8 +38,8 @@ struct ActionsVars<'a> {
 /// allows), then the plan.
 pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<BaselinePlan, BaselineError> {
     let prompts = BaselinePrompts::builtin()?;
-    let (observations, mut stages) = observe_all(client, prompts, inputs).await?;
-    let (system, user) = prompts.render(
+    let (observations, stages) = observe_all(client, prompts, inputs).await?;
+    let prompt = prompts.render(
         "demo2code.actions",
         &ActionsVars {
             predicates: inputs.vocabulary.render_definitions(inputs.planning_tier()),
@@ -49,31 +49,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
             observations: numbered(&observations),
         },
     )?;
-    let mut parts = vec![nesy_vlm::Part::text(user)];
-    parts.extend(inputs.target_views.parts("scene"));
-    let (steps, record) = Stage {
-        purpose: ACTIONS,
-        system,
-        parts,
-        expected: "Write the plan as a numbered list, one action per line: \"1. ...\".",
-        fidelity: inputs.fidelity,
-        client,
-    }
-    .ask(|reply| {
-        let steps = ordered_list(reply);
-        if steps.is_empty() {
-            Err("it has no numbered list (lines \"1. ...\")".to_string())
-        } else {
-            Ok(steps)
-        }
-    })
-    .await?;
-    stages.push(record);
-    Ok(BaselinePlan {
-        steps,
-        stages,
-        deviations: deviations(inputs),
-    })
+    target_plan(client, inputs, ACTIONS, prompt, stages).await
 }
 
 /// One observation per keyframe, in keyframe order, with their stage records.
@@ -121,15 +97,6 @@ async fn observe(
             .ok_or_else(|| "it has no line starting with \"- \"".to_string())
     })
     .await
-}
-
-fn deviations(inputs: &BaselineInputs) -> Vec<String> {
-    match inputs.fidelity {
-        crate::Fidelity::Authors => Vec::new(),
-        crate::Fidelity::Repaired => {
-            vec!["a reply without its answer is re-asked with the reason (the authors' parser raises)".into()]
-        }
-    }
 }
 
 /// The calls and images of one scenario with `keyframes` keyframes, before code generation.

@@ -14,9 +14,9 @@ use nesy_vlm::VlmClient;
 use serde::Serialize;
 
 use crate::inputs::BaselineInputs;
-use crate::parse::{first_block, ordered_list};
+use crate::parse::first_block;
 use crate::prompts::{BaselinePrompts, bullets, state_lines};
-use crate::stage::{Stage, StageRecord};
+use crate::stage::{Stage, StageRecord, target_plan};
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
 /// The purpose label of the domain-description call.
@@ -44,7 +44,7 @@ struct PlanVars<'a> {
 pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<BaselinePlan, BaselineError> {
     let prompts = BaselinePrompts::builtin()?;
     let (description, describe) = describe_domain(client, prompts, inputs).await?;
-    let (system, user) = prompts.render(
+    let prompt = prompts.render(
         "gpt4v.plan",
         &PlanVars {
             predicates: inputs.vocabulary.render_definitions(Tier::EndEffector),
@@ -54,35 +54,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
             end_effector_state: state_lines(&end_effector_atoms(inputs, &inputs.target_state)),
         },
     )?;
-    let mut parts = vec![nesy_vlm::Part::text(user)];
-    parts.extend(inputs.target_views.parts("scene"));
-    let (steps, plan) = Stage {
-        purpose: PLAN,
-        system,
-        parts,
-        expected: "Write the plan as a numbered list, one action per line: \"1. ...\".",
-        fidelity: inputs.fidelity,
-        client,
-    }
-    .ask(|reply| {
-        let steps = ordered_list(reply);
-        if steps.is_empty() {
-            Err("it has no numbered list (lines \"1. ...\")".to_string())
-        } else {
-            Ok(steps)
-        }
-    })
-    .await?;
-    Ok(BaselinePlan {
-        steps,
-        stages: vec![describe, plan],
-        deviations: match inputs.fidelity {
-            crate::Fidelity::Authors => Vec::new(),
-            crate::Fidelity::Repaired => vec![
-                "a reply without its answer is re-asked with the reason (the authors' parser raises)".into(),
-            ],
-        },
-    })
+    target_plan(client, inputs, PLAN, prompt, vec![describe]).await
 }
 
 /// The domain description (the first fenced block of the reply) from every keyframe's

@@ -3,7 +3,7 @@
 
 use std::sync::OnceLock;
 
-use minijinja::{AutoEscape, Environment, UndefinedBehavior};
+use minijinja::Environment;
 use serde::Serialize;
 
 /// `(name, text)` of every template.
@@ -82,20 +82,7 @@ impl BaselinePrompts {
             let name = name.to_string();
             move |error| PromptError { name, error }
         };
-        let mut env = Environment::new();
-        let syntax = minijinja::syntax::SyntaxConfig::builder()
-            .trim_blocks(true)
-            .lstrip_blocks(true)
-            .keep_trailing_newline(false)
-            .build()
-            .map_err(error("(syntax configuration)"))?;
-        env.set_syntax(syntax);
-        env.set_undefined_behavior(UndefinedBehavior::Strict);
-        env.set_auto_escape_callback(|_| AutoEscape::None);
-        env.add_global(
-            "physical_constraints",
-            nesy_vlm::prompts::PHYSICAL_CONSTRAINTS.trim_end(),
-        );
+        let mut env = nesy_vlm::prompts::template_environment().map_err(error("(syntax configuration)"))?;
         for (name, text) in TEMPLATES {
             env.add_template(name, text).map_err(error(name))?;
         }

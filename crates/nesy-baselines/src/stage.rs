@@ -150,3 +150,55 @@ impl Stage<'_> {
         }
     }
 }
+
+/// The last stage of a flow: the rendered prompt with the target's six images, read as a
+/// numbered plan; returns the plan with every stage's record (`earlier` and this one).
+pub(crate) async fn target_plan(
+    client: &VlmClient,
+    inputs: &crate::BaselineInputs,
+    purpose: &'static str,
+    (system, user): (String, String),
+    mut earlier: Vec<StageRecord>,
+) -> Result<crate::BaselinePlan, BaselineError> {
+    let mut parts = vec![Part::text(user)];
+    parts.extend(inputs.target_views.parts("scene"));
+    let (steps, record) = Stage {
+        purpose,
+        system,
+        parts,
+        expected: NUMBERED_PLAN,
+        fidelity: inputs.fidelity,
+        client,
+    }
+    .ask(numbered_plan)
+    .await?;
+    earlier.push(record);
+    Ok(crate::BaselinePlan {
+        steps,
+        stages: earlier,
+        deviations: common_deviations(inputs.fidelity),
+    })
+}
+
+/// What a planning stage asks for, said again in a re-ask.
+const NUMBERED_PLAN: &str = "Write the plan as a numbered list, one action per line: \"1. ...\".";
+
+/// A planning stage's reader: the numbered list of the reply, which must not be empty.
+fn numbered_plan(reply: &str) -> Result<Vec<String>, String> {
+    let steps = crate::parse::ordered_list(reply);
+    if steps.is_empty() {
+        Err("it has no numbered list (lines \"1. ...\")".to_string())
+    } else {
+        Ok(steps)
+    }
+}
+
+/// The deviations every flow has in a fidelity mode (the flows add their own).
+fn common_deviations(fidelity: Fidelity) -> Vec<String> {
+    match fidelity {
+        Fidelity::Authors => Vec::new(),
+        Fidelity::Repaired => {
+            vec!["a reply without its answer is re-asked with the reason (the authors' parser raises)".into()]
+        }
+    }
+}

@@ -33,6 +33,23 @@ pub use examples::{CodeExample, InductionExample, StateExample};
 /// same. Templates see it as `{{ physical_constraints }}`.
 pub const PHYSICAL_CONSTRAINTS: &str = include_str!("../../prompts/physical_constraints.txt");
 
+/// The template environment every prompt of the project is rendered in: block tags trim
+/// their newline, the trailing newline is dropped, an undefined variable is an error, nothing
+/// is escaped, and `physical_constraints` is defined. Templates are added by the caller.
+pub fn template_environment() -> Result<Environment<'static>, minijinja::Error> {
+    let mut env = Environment::new();
+    let syntax = minijinja::syntax::SyntaxConfig::builder()
+        .trim_blocks(true)
+        .lstrip_blocks(true)
+        .keep_trailing_newline(false)
+        .build()?;
+    env.set_syntax(syntax);
+    env.set_undefined_behavior(UndefinedBehavior::Strict);
+    env.set_auto_escape_callback(|_| AutoEscape::None);
+    env.add_global("physical_constraints", PHYSICAL_CONSTRAINTS.trim_end());
+    Ok(env)
+}
+
 const TEMPLATES: &[(&str, &str)] = &[
     (
         "induction.system.j2",
@@ -236,20 +253,10 @@ struct CodeExampleVars<'a> {
 impl Prompts {
     /// Compiles the templates and loads the examples.
     pub fn load() -> Result<Prompts, PromptError> {
-        let mut env = Environment::new();
-        let syntax = minijinja::syntax::SyntaxConfig::builder()
-            .trim_blocks(true)
-            .lstrip_blocks(true)
-            .keep_trailing_newline(false)
-            .build()
-            .map_err(|error| PromptError::Template {
-                name: "(syntax configuration)",
-                error,
-            })?;
-        env.set_syntax(syntax);
-        env.set_undefined_behavior(UndefinedBehavior::Strict);
-        env.set_auto_escape_callback(|_| AutoEscape::None);
-        env.add_global("physical_constraints", PHYSICAL_CONSTRAINTS.trim_end());
+        let mut env = template_environment().map_err(|error| PromptError::Template {
+            name: "(syntax configuration)",
+            error,
+        })?;
         for (name, text) in TEMPLATES {
             env.add_template(name, text)
                 .map_err(|error| PromptError::Template { name, error })?;
