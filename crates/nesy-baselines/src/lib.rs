@@ -9,7 +9,12 @@
 //! - [`demo2code`]: one observation call per keyframe, then one action-planning call
 //!   that adapts the observations to the target scene;
 //! - [`gpt4v`] (GPT4V-Robotics): one domain-description call with every keyframe's six
-//!   views, then one planning call on the target.
+//!   views, then one planning call on the target;
+//! - [`critic`] (Critic-V, with the same model as critic): Demo2Code's unadapted plan, then
+//!   rounds of feedback on the target and text-line SEARCH/REPLACE corrections until the
+//!   feedback says "no issue" or the budget is spent;
+//! - [`statler`]: the domain description, a predicted initial state, then rounds in which
+//!   the model extends the plan and rewrites the world state until it says "goal reached".
 //!
 //! Nothing here is symbolic: these baselines plan in text, and nothing checks the plan
 //! before code generation.
@@ -21,6 +26,7 @@
 //! parsers raise and the episode fails); in [`Fidelity::Repaired`] it is re-asked with the
 //! reason first, up to [`REPAIRED_ATTEMPTS`] replies.
 
+pub mod critic;
 pub mod demo2code;
 mod error;
 pub mod gpt4v;
@@ -28,6 +34,7 @@ mod inputs;
 pub mod parse;
 mod prompts;
 mod stage;
+pub mod statler;
 
 pub use error::BaselineError;
 pub use inputs::{BaselineInputs, Fidelity, Keyframe, SixViews};
@@ -46,6 +53,9 @@ pub struct BaselinePlan {
     /// Where this run departs from the authors' implementation, in words (empty when it
     /// does not).
     pub deviations: Vec<String>,
+    /// Rounds of the flow's loop that ran (`None` for flows without one); the budget is the
+    /// scenario's.
+    pub rounds: Option<usize>,
 }
 
 /// The model calls and images one scenario costs a flow, before code generation: exact for

@@ -103,6 +103,83 @@ pub fn first_block(reply: &str) -> Result<String, BlockError> {
     Err(BlockError::Unclosed { line: open_line })
 }
 
+/// One text edit of a plan: lines to find and the lines that replace them.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LinePatch {
+    /// The lines to find, trimmed.
+    pub search: Vec<String>,
+    /// The lines that replace them, trimmed, empty ones left out.
+    pub replace: Vec<String>,
+}
+
+/// Every `<<<<<<< SEARCH … ======= … >>>>>>> REPLACE` block of `text`, in order. A block
+/// whose markers are incomplete is not an edit and is skipped, as the authors' pattern
+/// would not match it.
+///
+/// ```
+/// use nesy_baselines::parse::line_patches;
+/// let text = "<<<<<<< SEARCH\nGrasp the cube.\n=======\nClear the cube.\nGrasp the cube.\n>>>>>>> REPLACE";
+/// let patches = line_patches(text);
+/// assert_eq!(patches[0].search, ["Grasp the cube."]);
+/// assert_eq!(patches[0].replace, ["Clear the cube.", "Grasp the cube."]);
+/// ```
+pub fn line_patches(text: &str) -> Vec<LinePatch> {
+    let text = prepared(text);
+    let mut patches = Vec::new();
+    let mut rest = text.as_str();
+    while let Some(start) = rest.find("<<<<<<< SEARCH") {
+        let after = &rest[start + "<<<<<<< SEARCH".len()..];
+        let (Some(divider), Some(end)) = (after.find("======="), after.find(">>>>>>> REPLACE")) else {
+            break;
+        };
+        if divider > end {
+            rest = &after[end..];
+            continue;
+        }
+        let lines = |block: &str| -> Vec<String> {
+            block
+                .lines()
+                .map(str::trim)
+                .filter(|l| !l.is_empty())
+                .map(str::to_string)
+                .collect()
+        };
+        patches.push(LinePatch {
+            search: lines(&after[..divider]),
+            replace: lines(&after[divider + "=======".len()..end]),
+        });
+        rest = &after[end + ">>>>>>> REPLACE".len()..];
+    }
+    patches
+}
+
+/// Applies each patch at the first place its lines appear, in order and exactly; a patch that
+/// matches nowhere leaves the plan as it is. Returns how many applied.
+pub fn apply_line_patches(plan: &mut Vec<String>, patches: &[LinePatch]) -> usize {
+    let mut applied = 0;
+    for patch in patches {
+        let n = patch.search.len();
+        if n == 0 || n > plan.len() {
+            continue;
+        }
+        if let Some(at) = (0..=plan.len() - n).find(|&i| plan[i..i + n] == patch.search[..]) {
+            plan.splice(at..at + n, patch.replace.iter().cloned());
+            applied += 1;
+        }
+    }
+    applied
+}
+
+/// `line` without a leading `N.` list number.
+pub fn without_number(line: &str) -> &str {
+    let trimmed = line.trim_start();
+    let digits = trimmed.len() - trimmed.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+    match trimmed[digits..].strip_prefix('.') {
+        Some(rest) if digits > 0 => rest.trim_start(),
+        _ => line,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -114,6 +191,18 @@ mod tests {
         let reply = "\u{2022} The lid is open.\n* not a dash\n- (OnTopOf a b)";
         assert_eq!(unordered_list(reply), ["The lid is open.", "(OnTopOf a b)"]);
         assert!(ordered_list("no list here").is_empty());
+    }
+
+    #[test]
+    fn line_patches_match_exactly_at_the_first_place() {
+        let mut plan: Vec<String> = ["a", "b", "a"].map(String::from).to_vec();
+        let text = "x\n<<<<<<< SEARCH\na\n=======\nz\n\na\n>>>>>>> REPLACE\n<<<<<<< SEARCH\nq\n=======\n>>>>>>> REPLACE\n<<<<<<< SEARCH\nbroken";
+        let patches = line_patches(text);
+        assert_eq!(patches.len(), 2);
+        assert_eq!(apply_line_patches(&mut plan, &patches), 1);
+        assert_eq!(plan, ["z", "a", "b", "a"]);
+        assert_eq!(without_number("3. Grasp"), "Grasp");
+        assert_eq!(without_number("Grasp 3."), "Grasp 3.");
     }
 
     #[test]

@@ -37,6 +37,46 @@ const TEMPLATES: &[(&str, &str)] = &[
         include_str!("../prompts/gpt4v.plan.system.j2"),
     ),
     ("gpt4v.plan.user", include_str!("../prompts/gpt4v.plan.user.j2")),
+    (
+        "demo2code.source_actions.system",
+        include_str!("../prompts/demo2code.source_actions.system.j2"),
+    ),
+    (
+        "demo2code.source_actions.user",
+        include_str!("../prompts/demo2code.source_actions.user.j2"),
+    ),
+    (
+        "critic.feedback.system",
+        include_str!("../prompts/critic.feedback.system.j2"),
+    ),
+    (
+        "critic.feedback.user",
+        include_str!("../prompts/critic.feedback.user.j2"),
+    ),
+    (
+        "critic.correction.system",
+        include_str!("../prompts/critic.correction.system.j2"),
+    ),
+    (
+        "critic.correction.user",
+        include_str!("../prompts/critic.correction.user.j2"),
+    ),
+    (
+        "statler.state.system",
+        include_str!("../prompts/statler.state.system.j2"),
+    ),
+    (
+        "statler.state.user",
+        include_str!("../prompts/statler.state.user.j2"),
+    ),
+    (
+        "statler.actions.system",
+        include_str!("../prompts/statler.actions.system.j2"),
+    ),
+    (
+        "statler.actions.user",
+        include_str!("../prompts/statler.actions.user.j2"),
+    ),
 ];
 
 /// A template failed to compile or render (a defect of this crate's files).

@@ -177,14 +177,15 @@ pub(crate) async fn target_plan(
         steps,
         stages: earlier,
         deviations: common_deviations(inputs.fidelity),
+        rounds: None,
     })
 }
 
 /// What a planning stage asks for, said again in a re-ask.
-const NUMBERED_PLAN: &str = "Write the plan as a numbered list, one action per line: \"1. ...\".";
+pub(crate) const NUMBERED_PLAN: &str = "Write the plan as a numbered list, one action per line: \"1. ...\".";
 
 /// A planning stage's reader: the numbered list of the reply, which must not be empty.
-fn numbered_plan(reply: &str) -> Result<Vec<String>, String> {
+pub(crate) fn numbered_plan(reply: &str) -> Result<Vec<String>, String> {
     let steps = crate::parse::ordered_list(reply);
     if steps.is_empty() {
         Err("it has no numbered list (lines \"1. ...\")".to_string())
@@ -194,7 +195,7 @@ fn numbered_plan(reply: &str) -> Result<Vec<String>, String> {
 }
 
 /// The deviations every flow has in a fidelity mode (the flows add their own).
-fn common_deviations(fidelity: Fidelity) -> Vec<String> {
+pub(crate) fn common_deviations(fidelity: Fidelity) -> Vec<String> {
     match fidelity {
         Fidelity::Authors => Vec::new(),
         Fidelity::Repaired => {

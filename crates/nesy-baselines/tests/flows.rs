@@ -5,7 +5,9 @@
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::{Arc, Mutex};
 
-use nesy_baselines::{BaselineError, BaselineInputs, Fidelity, Keyframe, SixViews, demo2code, gpt4v};
+use nesy_baselines::{
+    BaselineError, BaselineInputs, Fidelity, Keyframe, SixViews, critic, demo2code, gpt4v, statler,
+};
 use nesy_core::predicates::Vocabulary;
 use nesy_core::state::State;
 use nesy_vlm::{
@@ -391,4 +393,180 @@ fn a_description_over_the_endpoints_image_limit_is_refused_before_sending() {
     let error =
         pollster::block_on(gpt4v::run(&client(transport, None), &inputs(Fidelity::Authors))).unwrap_err();
     assert!(error.to_string().contains("has no fenced block"), "{error}");
+}
+
+const SOURCE_PLAN: &str = "Three transitions.\n1. Move the gripper around the red cube.\n2. Close the gripper to grasp the red cube.\n3. Drop the red cube into the box.";
+
+const FEEDBACK_BLOCKED: &str =
+    "The blue cube sits on the red cube.\n- The red cube is covered by the blue cube, so step 1 fails.";
+
+/// A correction in the style of the prompt's example: numbered SEARCH and REPLACE lines.
+const CORRECTION_NUMBERED: &str = "Case 1: the blue cube has to come off first.
+
+<<<<<<< SEARCH
+1. Move the gripper around the red cube.
+=======
+1. Move the gripper around the blue cube.
+2. Put the blue cube on the table.
+3. Move the gripper around the red cube.
+>>>>>>> REPLACE";
+
+#[test]
+fn critic_v_corrects_until_no_issue_and_keeps_the_authors_numbering_quirk() {
+    let script = |feedback: &[&'static str], corrections: &[&'static str]| {
+        let observe: &[&str] = &OBSERVATIONS;
+        Scripted::with(&[
+            (demo2code::OBSERVE, observe),
+            (critic::SOURCE_ACTIONS, &[SOURCE_PLAN]),
+            (critic::FEEDBACK, feedback),
+            (critic::CORRECTION, corrections),
+        ])
+    };
+    let no_issue = "- No issue: the plan works in this scene.";
+    // Authors: the numbered SEARCH line does not match the unnumbered plan, so the plan is
+    // unchanged; the second feedback says no issue and the loop stops.
+    let transport = script(&[FEEDBACK_BLOCKED, no_issue], &[CORRECTION_NUMBERED]);
+    let plan = pollster::block_on(critic::run(
+        &client(transport.clone(), None),
+        &inputs(Fidelity::Authors),
+    ))
+    .unwrap();
+    assert_eq!(plan.steps.len(), 3);
+    assert_eq!(plan.steps[0], "Move the gripper around the red cube.");
+    assert_eq!(plan.rounds, Some(2));
+    // The feedback sees the plan numbered and the target's views; the correction is text
+    // only and sees it one action per line, unnumbered.
+    let feedback = transport.requests(critic::FEEDBACK);
+    let text = text_of(&messages(&feedback[0])[1]);
+    assert!(
+        text.contains("1. Move the gripper around the red cube.\n2. Close"),
+        "{text}"
+    );
+    assert_eq!(images(&messages(&feedback[0])[1]), 6);
+    let correction = transport.requests(critic::CORRECTION);
+    let text = text_of(&messages(&correction[0])[1]);
+    assert!(
+        text.contains("The plan:\nMove the gripper around the red cube.\nClose"),
+        "{text}"
+    );
+    assert!(
+        text.contains("Feedback:\nThe red cube is covered by the blue cube"),
+        "{text}"
+    );
+    assert_eq!(images(&messages(&correction[0])[1]), 0);
+    // The unadapted plan's call is text only, with the source objects.
+    let source = transport.requests(critic::SOURCE_ACTIONS);
+    assert_eq!(images(&messages(&source[0])[1]), 0);
+    assert!(!text_of(&messages(&source[0])[1]).contains("blue_cube"));
+
+    // Repaired: the numbers are dropped before matching, so the edit applies.
+    let transport = script(&[FEEDBACK_BLOCKED, no_issue], &[CORRECTION_NUMBERED]);
+    let plan =
+        pollster::block_on(critic::run(&client(transport, None), &inputs(Fidelity::Repaired))).unwrap();
+    assert_eq!(
+        plan.steps,
+        [
+            "Move the gripper around the blue cube.",
+            "Put the blue cube on the table.",
+            "Move the gripper around the red cube.",
+            "Close the gripper to grasp the red cube.",
+            "Drop the red cube into the box."
+        ]
+    );
+    assert!(plan.deviations.iter().any(|d| d.contains("without list numbers")));
+
+    // The loop stops at the budget when the critic never says no issue.
+    let mut capped = inputs(Fidelity::Authors);
+    capped.budget = 2;
+    let transport = script(
+        &[FEEDBACK_BLOCKED, FEEDBACK_BLOCKED, FEEDBACK_BLOCKED],
+        &[CORRECTION_NUMBERED, CORRECTION_NUMBERED],
+    );
+    let plan = pollster::block_on(critic::run(&client(transport.clone(), None), &capped)).unwrap();
+    assert_eq!(plan.rounds, Some(2));
+    assert_eq!(transport.requests(critic::FEEDBACK).len(), 2);
+    assert_eq!(transport.requests(critic::CORRECTION).len(), 2);
+    assert_eq!(critic::shape(3, 2).calls_max, 4 + 4);
+
+    // A correction without the empty line the authors split on fails the unit, reply kept.
+    let transport = script(&[FEEDBACK_BLOCKED], &["Move the blue cube first."]);
+    let error =
+        pollster::block_on(critic::run(&client(transport, None), &inputs(Fidelity::Authors))).unwrap_err();
+    assert_eq!(error.reply(), Some("Move the blue cube first."));
+    assert!(error.to_string().contains("critic.correction"), "{error}");
+}
+
+#[test]
+fn statler_plans_in_rounds_and_lets_the_model_write_the_state() {
+    let predicted = "- (OnTopOf blue_cube red_cube)\n- (OnTopOf box floor)";
+    let round_one = "Clear the red cube first.\n1. Grasp the blue cube.\n2. Put the blue cube on the table.\n- (GripperOpen)\n- (OnTopOf blue_cube floor)";
+    let round_two = "Now the red cube.\n1. Grasp the red cube.\n2. Drop the red cube into the box.\n- (InsideOf red_cube box)\ngoal reached";
+    let transport = Scripted::with(&[
+        (gpt4v::DESCRIBE, &[DESCRIPTION]),
+        (statler::STATE, &[predicted]),
+        (statler::ACTIONS, &[round_one, round_two]),
+    ]);
+    let plan = pollster::block_on(statler::run(
+        &client(transport.clone(), None),
+        &inputs(Fidelity::Authors),
+    ))
+    .unwrap();
+    assert_eq!(
+        plan.steps,
+        [
+            "Grasp the blue cube.",
+            "Put the blue cube on the table.",
+            "Grasp the red cube.",
+            "Drop the red cube into the box."
+        ]
+    );
+    assert_eq!(plan.rounds, Some(2));
+    // The state call sees the partial tier and the ground truth; the first round sees the
+    // prediction joined with it, the second only what the model wrote.
+    let state = transport.requests(statler::STATE);
+    let text = text_of(&messages(&state[0])[1]);
+    assert!(text.contains("Partial ground truth:\n- (GripperOpen)"), "{text}");
+    assert!(!text.contains("(Open ?x)"), "{text}");
+    let rounds = transport.requests(statler::ACTIONS);
+    let first = text_of(&messages(&rounds[0])[1]);
+    assert!(first.contains("Actions so far:\nNone"), "{first}");
+    assert!(
+        first.contains("- (OnTopOf box floor)\n- (OnTopOf red_cube floor)"),
+        "{first}"
+    );
+    let second = text_of(&messages(&rounds[1])[1]);
+    assert!(
+        second.contains("Current world state:\n- (GripperOpen)\n- (OnTopOf blue_cube floor)\n\n"),
+        "{second}"
+    );
+    assert!(
+        second.contains("1. Grasp the blue cube.\n2. Put the blue cube on the table."),
+        "{second}"
+    );
+    // The same six initial views every round.
+    assert!(rounds.iter().all(|r| images(&messages(r)[1]) == 6));
+
+    // The authors' stop rule keeps a numbered "Goal reached." with a period in the plan and
+    // runs to the budget; repaired stops there and removes it.
+    let numbered_stop = "1. Grasp the red cube.\n2. Goal reached.";
+    let mut capped = inputs(Fidelity::Authors);
+    capped.budget = 2;
+    let transport = Scripted::with(&[
+        (gpt4v::DESCRIBE, &[DESCRIPTION]),
+        (statler::STATE, &[predicted]),
+        (statler::ACTIONS, &[numbered_stop, numbered_stop]),
+    ]);
+    let plan = pollster::block_on(statler::run(&client(transport, None), &capped)).unwrap();
+    assert_eq!(plan.rounds, Some(2));
+    assert_eq!(plan.steps.iter().filter(|s| *s == "Goal reached.").count(), 2);
+    capped.fidelity = Fidelity::Repaired;
+    let transport = Scripted::with(&[
+        (gpt4v::DESCRIBE, &[DESCRIPTION]),
+        (statler::STATE, &[predicted]),
+        (statler::ACTIONS, &[numbered_stop, numbered_stop]),
+    ]);
+    let plan = pollster::block_on(statler::run(&client(transport, None), &capped)).unwrap();
+    assert_eq!(plan.steps, ["Grasp the red cube."]);
+    assert_eq!(plan.rounds, Some(1));
+    assert_eq!(statler::shape(3, 2).calls_max, 4);
 }

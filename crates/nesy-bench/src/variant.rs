@@ -163,7 +163,17 @@ mod tests {
             .iter()
             .map(|v| v.id())
             .collect();
-        assert_eq!(all, ["nesycr", "demo2code", "gpt4v-robotics", "imitation"]);
+        assert_eq!(
+            all,
+            [
+                "nesycr",
+                "demo2code",
+                "gpt4v-robotics",
+                "critic-v",
+                "statler",
+                "imitation"
+            ]
+        );
         assert!(Variant::parse("nesycr+bad").is_err());
         assert!(Variant::parse("nesycr+a=1+a=2").is_err());
         assert_eq!(Variant::parse_list("nesycr, imitation").unwrap().len(), 2);

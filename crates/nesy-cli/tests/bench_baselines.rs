@@ -2,7 +2,9 @@
 //! answering every stage with hand-written replies in a chatty model's style (preambles,
 //! bold headers, numbered lists, a closing remark) and one mistake each method must survive:
 //! Demo2Code's first plan is cut off at the token cap, GPT4V-Robotics' first description
-//! comes back with null content. Both are re-asked. The live run records one cassette per
+//! comes back with null content (both re-asked), Critic-V's correction numbers its SEARCH
+//! line as its prompt's example does (so, as in the authors' code, it does not apply), and
+//! Statler's first round writes no world state (so the state it is shown next is empty). The live run records one cassette per
 //! unit; replaying them offline twice gives the same records as the live run.
 //!
 //! These replies are not a model's: the scores say what this program does in the simulator,
@@ -94,6 +96,14 @@ impl Respond for HandWritten {
             ),
             ("plan", "You plan robot actions for a new scene"),
             ("code", "You write Python programs"),
+            (
+                "source",
+                "You turn a summarised robot demonstration into its action plan.",
+            ),
+            ("review", "You review a robot action plan"),
+            ("correct", "You correct a robot action plan"),
+            ("state", "You describe robot scenes as symbolic states."),
+            ("round", "You plan robot actions step by step"),
         ]
         .into_iter()
         .find(|(_, start)| system.starts_with(start))
@@ -101,7 +111,12 @@ impl Respond for HandWritten {
         let Some(stage) = stage else {
             return ResponseTemplate::new(400).set_body_string("unexpected request");
         };
-        *self.seen.lock().unwrap().entry(stage).or_default() += 1;
+        let count = {
+            let mut seen = self.seen.lock().unwrap();
+            let n = seen.entry(stage).or_default();
+            *n += 1;
+            *n
+        };
         match stage {
             "observe" => {
                 let user = common::message_text(&messages[1]);
@@ -123,6 +138,31 @@ impl Respond for HandWritten {
             "actions" | "plan" => completion(Some(PLAN), "stop"),
             "describe" if !reask => completion(None, "stop"),
             "describe" => completion(Some(DESCRIPTION), "stop"),
+            "source" => completion(Some(SOURCE_PLAN), "stop"),
+            "review" if count == 1 => completion(
+                Some(
+                    "Checking the plan against the scene.\n- The green cube sits on the red cube, so step 1 cannot grasp the red cube.",
+                ),
+                "stop",
+            ),
+            "review" => completion(Some("- No issue."), "stop"),
+            "correct" => completion(Some(CORRECTION), "stop"),
+            "state" => completion(
+                Some("- (OnTopOf toy_box floor)\n- (OnTopOf green_cube red_cube)"),
+                "stop",
+            ),
+            "round" if count == 1 => completion(
+                Some(
+                    "First the cubes.\n1. Grasp the green cube.\n2. Drop the green cube into the toy box.\n3. Grasp the red cube.",
+                ),
+                "stop",
+            ),
+            "round" => completion(
+                Some(
+                    "1. Drop the red cube into the toy box.\n2. Grasp the blue cube.\n3. Drop the blue cube into the toy box.\n- (InsideOf red_cube toy_box)\ngoal reached",
+                ),
+                "stop",
+            ),
             _ => completion(
                 Some(&format!(
                     "Here is the program.\n\n```python\n{PROGRAM}\n```\n\nIt reads every position at run time."
@@ -133,13 +173,29 @@ impl Respond for HandWritten {
     }
 }
 
+const SOURCE_PLAN: &str = "**Demonstrated plan:**
+1. Move the gripper around the red cube.
+2. Close the gripper to grasp the red cube.
+3. Drop the red cube into the toy box.
+4. Put the fruits into the hinge box.";
+
+const CORRECTION: &str = "Case 1: the green cube must be moved first.
+
+<<<<<<< SEARCH
+1. Move the gripper around the red cube.
+=======
+1. Move the gripper around the green cube.
+2. Drop the green cube into the toy box.
+3. Move the gripper around the red cube.
+>>>>>>> REPLACE";
+
 fn bench(run: &Path, demos: &Path, vlm: &str) -> std::process::Output {
     let output = common::nesy(&[
         "bench".into(),
         "run".into(),
         run.display().to_string(),
         "--methods".into(),
-        "demo2code,gpt4v-robotics".into(),
+        "demo2code,gpt4v-robotics,critic-v,statler".into(),
         "--scenarios".into(),
         SCENARIO.into(),
         "--vlm".into(),
@@ -198,7 +254,8 @@ async fn baselines_run_live_record_and_replay_to_the_same_records() {
     let seen = seen.lock().unwrap().clone();
 
     let d2c = &live_records["demo2code"];
-    let keyframes = seen["observe"] as u64;
+    // Demo2Code and Critic-V each observe every keyframe once.
+    let keyframes = seen["observe"] as u64 / 2;
     assert!(keyframes >= 3, "{seen:?}");
     let by_purpose = &d2c["effort"]["calls_by_purpose"];
     assert_eq!(by_purpose["d2c.observe"], keyframes);
@@ -216,8 +273,24 @@ async fn baselines_run_live_record_and_replay_to_the_same_records() {
         2 * keyframes * 6 + 6,
         "{gpt4v}"
     );
-    // The same program ran for both: it puts the cubes in the box and never the fruit.
-    for record in [d2c, gpt4v] {
+    // Critic-V: the observations, the unadapted plan, two reviews and the one correction
+    // between them, which did not apply.
+    let critic = &live_records["critic-v"];
+    let by_purpose = &critic["effort"]["calls_by_purpose"];
+    assert_eq!(by_purpose["d2c.observe"], keyframes);
+    assert_eq!(by_purpose["d2c.source_actions"], 1);
+    assert_eq!(by_purpose["critic.feedback"], 2);
+    assert_eq!(by_purpose["critic.correction"], 1);
+    assert_eq!(critic["spec"]["steps"], 4);
+    assert_eq!(critic["spec"]["iterations"], 2);
+    // Statler: the description, the state, two rounds until "goal reached".
+    let statler = &live_records["statler"];
+    let by_purpose = &statler["effort"]["calls_by_purpose"];
+    assert_eq!(by_purpose["statler.state"], 1);
+    assert_eq!(by_purpose["statler.actions"], 2);
+    assert_eq!(statler["spec"]["steps"], 6);
+    // The same program ran for all: it puts the cubes in the box and never the fruit.
+    for record in [d2c, gpt4v, critic, statler] {
         assert_eq!(record["status"], "execution_failed", "{record}");
         assert_eq!(record["scores"]["sr"], 0.0, "{record}");
         assert_eq!(record["scores"]["gc"], 0.5, "{record}");

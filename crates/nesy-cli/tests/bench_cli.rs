@@ -180,6 +180,8 @@ fn methods_plan_and_bad_input() {
         "nesycr-released",
         "demo2code",
         "gpt4v-robotics",
+        "critic-v",
+        "statler",
         "code-as-policies",
         "imitation",
         "replan",

@@ -31,6 +31,10 @@ pub enum BaselineKind {
     Demo2Code,
     /// GPT4V-Robotics (the target given at planning time).
     Gpt4vRobotics,
+    /// Critic-V (the same model as critic).
+    CriticV,
+    /// Statler (reader and writer in one call per round).
+    Statler,
 }
 
 /// A baseline as a harness method.
@@ -53,6 +57,20 @@ impl Baseline {
     pub fn gpt4v_robotics() -> Baseline {
         Baseline {
             kind: BaselineKind::Gpt4vRobotics,
+        }
+    }
+
+    /// Critic-V.
+    pub fn critic_v() -> Baseline {
+        Baseline {
+            kind: BaselineKind::CriticV,
+        }
+    }
+
+    /// Statler.
+    pub fn statler() -> Baseline {
+        Baseline {
+            kind: BaselineKind::Statler,
         }
     }
 
@@ -95,6 +113,26 @@ impl Method for Baseline {
                 },
                 "one domain description from every keyframe's views at once, then one planning call on the target (no check)",
             ),
+            BaselineKind::CriticV => (
+                "critic-v",
+                "Critic-V",
+                Classes {
+                    explicit_adapt: true,
+                    ..Classes::default()
+                },
+                "Demo2Code's unadapted plan, then rounds of model feedback on the target and text-line SEARCH/REPLACE corrections until \"no issue\" (no check)",
+            ),
+            BaselineKind::Statler => (
+                "statler",
+                "Statler",
+                Classes {
+                    explicit_adapt: true,
+                    replanning: true,
+                    world_model: true,
+                    ..Classes::default()
+                },
+                "the domain description, a predicted state, then rounds that extend the plan and rewrite the state in text until \"goal reached\" (no check)",
+            ),
         };
         MethodInfo {
             name,
@@ -125,15 +163,21 @@ impl Method for Baseline {
             let plan = match self.kind {
                 BaselineKind::Demo2Code => nesy_baselines::demo2code::run(client, &baseline_inputs).await,
                 BaselineKind::Gpt4vRobotics => nesy_baselines::gpt4v::run(client, &baseline_inputs).await,
+                BaselineKind::CriticV => nesy_baselines::critic::run(client, &baseline_inputs).await,
+                BaselineKind::Statler => nesy_baselines::statler::run(client, &baseline_inputs).await,
             }
             .map_err(baseline_failure)?;
-            Ok(specified(plan, started.elapsed().as_secs_f64()))
+            Ok(specified(
+                plan,
+                baseline_inputs.budget,
+                started.elapsed().as_secs_f64(),
+            ))
         }
         .boxed()
     }
 }
 
-fn specified(plan: BaselinePlan, vlm_s: f64) -> Specified {
+fn specified(plan: BaselinePlan, budget: usize, vlm_s: f64) -> Specified {
     let mut notes: Vec<String> = plan
         .deviations
         .iter()
@@ -148,7 +192,7 @@ fn specified(plan: BaselinePlan, vlm_s: f64) -> Specified {
         spec: Specification::Plan { steps: plan.steps },
         codegen: CodegenMode::Vlm,
         adaptation: None,
-        iterations: None,
+        iterations: plan.rounds.map(|rounds| (rounds, budget)),
         states: None,
         symbolic_s: (0.0, 0.0),
         vlm_s,

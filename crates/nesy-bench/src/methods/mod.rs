@@ -229,6 +229,8 @@ pub fn registry() -> Vec<Arc<dyn Method>> {
         Arc::new(NeSyCr::released()),
         Arc::new(Baseline::demo2code()),
         Arc::new(Baseline::gpt4v_robotics()),
+        Arc::new(Baseline::critic_v()),
+        Arc::new(Baseline::statler()),
         Arc::new(CodeAsPolicies),
         Arc::new(Imitation),
         Arc::new(Replan),
