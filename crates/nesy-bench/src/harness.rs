@@ -830,14 +830,20 @@ async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
         Some(source) => reexecuted(source, unit),
         None => specify_and_code(&client, &unit_inputs, &dir, unit).await,
     };
-    let usage = client.finish().ok().map(|u| u.total);
+    let usage = client.finish().ok();
     let c = counts.lock().unwrap_or_else(|e| e.into_inner()).clone();
     effort.calls = c.calls;
     effort.images = c.images;
     effort.calls_by_purpose = c.by_purpose.clone();
     if let Some(u) = &usage {
-        effort.tokens = u.prompt_tokens + u.completion_tokens;
-        effort.cost_usd = u.cost_usd;
+        effort.tokens = u.total.prompt_tokens + u.total.completion_tokens;
+        effort.cost_usd = u.total.cost_usd;
+        effort.cost_by_purpose = u
+            .by_purpose
+            .iter()
+            .filter(|(_, t)| t.cost_usd > 0.0)
+            .map(|(purpose, t)| (purpose.clone(), t.cost_usd))
+            .collect();
     }
     let (code, mut record_base) = match phase_a {
         Ok(a) => a,

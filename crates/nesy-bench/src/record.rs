@@ -169,8 +169,11 @@ pub struct Effort {
     pub calls: u64,
     /// Images sent.
     pub images: u64,
-    /// Calls by purpose (`induce`, `patch`, `codegen`, `translate`, …).
+    /// Calls by purpose (`induce`, `patch`, `codegen`, `translate`, `d2c.observe`, …).
     pub calls_by_purpose: BTreeMap<String, u64>,
+    /// Estimated cost in US dollars by purpose (empty offline or without a price).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub cost_by_purpose: BTreeMap<String, f64>,
     /// Prompt and completion tokens (0 offline).
     pub tokens: u64,
     /// Cost in US dollars at the configured price table (0 offline).

@@ -296,6 +296,16 @@ async fn baselines_run_live_record_and_replay_to_the_same_records() {
         assert_eq!(record["scores"]["gc"], 0.5, "{record}");
     }
 
+    // The report counts the calls per method and stage.
+    let stages = std::fs::read_to_string(live.join("tables/stages.csv")).unwrap();
+    assert!(
+        stages.contains(&format!("demo2code,d2c.observe,1,{keyframes},")),
+        "{stages}"
+    );
+    assert!(stages.contains("critic-v,critic.feedback,1,2,"), "{stages}");
+    let report = std::fs::read_to_string(live.join("report.md")).unwrap();
+    assert!(report.contains("## Model calls per method and stage"), "{report}");
+
     // Offline: the live run's cassettes replayed, twice, give the live records.
     let cassettes = live.join("cassettes");
     for name in ["replay-1", "replay-2"] {

@@ -257,6 +257,7 @@ pub fn write(run: &Path, options: &ReportOptions) -> Result<ReportFiles, BenchEr
         ("status.csv", status_csv(&tables)),
         ("time.csv", time_csv(&tables)),
         ("domain_gap.csv", gap_csv(&variants, &ordered)),
+        ("stages.csv", stages_csv(&variants, &ordered)),
     ] {
         let path = run.join("tables").join(name);
         std::fs::write(&path, text).map_err(|e| BenchError::io(&path, e))?;
@@ -590,6 +591,24 @@ fn markdown(
             }
         }
     }
+    let stages = stage_use(&tables.variants, records);
+    if !stages.is_empty() {
+        let _ = writeln!(md, "\n## Model calls per method and stage\n");
+        let _ = writeln!(
+            md,
+            "| Method | stage | calls | per unit | cost (USD) |\n|---|---|---|---|---|"
+        );
+        for (v, stage, u) in &stages {
+            let _ = writeln!(
+                md,
+                "| {} | `{stage}` | {} | {:.1} | {:.4} |",
+                title_of(v),
+                u.calls,
+                u.calls as f64 / u.units.max(1) as f64,
+                u.cost_usd
+            );
+        }
+    }
     let _ = writeln!(md, "\n## Figures\n");
     let _ = writeln!(md, "![SR, GC and PD per cell](plots/sr_gc_pd.png)\n");
     let _ = writeln!(
@@ -700,6 +719,51 @@ fn status_csv(tables: &Tables) -> String {
             let _ = write!(out, ",{}", tables.all[v].statuses.get(&s).copied().unwrap_or(0));
         }
         out.push('\n');
+    }
+    out
+}
+
+/// Calls and cost per variant and stage (purpose label), over the variant's final records.
+struct StageUse {
+    calls: u64,
+    cost_usd: f64,
+    units: usize,
+}
+
+fn stage_use(variants: &[String], records: &[&UnitRecord]) -> Vec<(String, String, StageUse)> {
+    let mut rows = Vec::new();
+    for v in variants {
+        let mine: Vec<&&UnitRecord> = records.iter().filter(|r| &r.key.variant == v).collect();
+        let mut by_stage: BTreeMap<String, StageUse> = BTreeMap::new();
+        for r in &mine {
+            for (purpose, calls) in &r.effort.calls_by_purpose {
+                let entry = by_stage.entry(purpose.clone()).or_insert(StageUse {
+                    calls: 0,
+                    cost_usd: 0.0,
+                    units: mine.len(),
+                });
+                entry.calls += calls;
+                entry.cost_usd += r.effort.cost_by_purpose.get(purpose).copied().unwrap_or(0.0);
+            }
+        }
+        rows.extend(by_stage.into_iter().map(|(stage, u)| (v.clone(), stage, u)));
+    }
+    rows
+}
+
+fn stages_csv(variants: &[String], records: &[&UnitRecord]) -> String {
+    let mut out = String::from("variant,stage,units,calls,calls_per_unit,cost_usd\n");
+    for (v, stage, u) in stage_use(variants, records) {
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{:.3},{:.6}",
+            csv_field(&v),
+            csv_field(&stage),
+            u.units,
+            u.calls,
+            u.calls as f64 / u.units.max(1) as f64,
+            u.cost_usd
+        );
     }
     out
 }
