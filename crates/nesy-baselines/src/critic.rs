@@ -153,6 +153,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
         stages,
         deviations,
         rounds: Some(rounds),
+        instruction: None,
     })
 }
 

@@ -14,7 +14,10 @@
 //!   rounds of feedback on the target and text-line SEARCH/REPLACE corrections until the
 //!   feedback says "no issue" or the budget is spent;
 //! - [`statler`]: the domain description, a predicted initial state, then rounds in which
-//!   the model extends the plan and rewrites the world state until it says "goal reached".
+//!   the model extends the plan and rewrites the world state until it says "goal reached";
+//! - [`morevqa`] (MoReVQA): the domain description, event parsing, rounds of grounding and
+//!   verification until verified (capped at the budget), three visual sub-questions and
+//!   their answers, then the plan.
 //!
 //! Nothing here is symbolic: these baselines plan in text, and nothing checks the plan
 //! before code generation.
@@ -31,6 +34,8 @@ pub mod demo2code;
 mod error;
 pub mod gpt4v;
 mod inputs;
+mod json;
+pub mod morevqa;
 pub mod parse;
 mod prompts;
 mod stage;
@@ -56,6 +61,9 @@ pub struct BaselinePlan {
     /// Rounds of the flow's loop that ran (`None` for flows without one); the budget is the
     /// scenario's.
     pub rounds: Option<usize>,
+    /// The instruction code generation gets instead of the task's, when the flow rewrites
+    /// it (MoReVQA's question form).
+    pub instruction: Option<String>,
 }
 
 /// The model calls and images one scenario costs a flow, before code generation: exact for

@@ -77,6 +77,59 @@ const TEMPLATES: &[(&str, &str)] = &[
         "statler.actions.user",
         include_str!("../prompts/statler.actions.user.j2"),
     ),
+    (
+        "morevqa.parse.system",
+        include_str!("../prompts/morevqa.parse.system.j2"),
+    ),
+    (
+        "morevqa.parse.user",
+        include_str!("../prompts/morevqa.parse.user.j2"),
+    ),
+    (
+        "morevqa.ground.system",
+        include_str!("../prompts/morevqa.ground.system.j2"),
+    ),
+    (
+        "morevqa.ground.user",
+        include_str!("../prompts/morevqa.ground.user.j2"),
+    ),
+    (
+        "morevqa.verify_api.system",
+        include_str!("../prompts/morevqa.verify_api.system.j2"),
+    ),
+    (
+        "morevqa.verify_api.user",
+        include_str!("../prompts/morevqa.verify_api.user.j2"),
+    ),
+    (
+        "morevqa.verify.system",
+        include_str!("../prompts/morevqa.verify.system.j2"),
+    ),
+    (
+        "morevqa.verify.user",
+        include_str!("../prompts/morevqa.verify.user.j2"),
+    ),
+    (
+        "morevqa.vqa_api.system",
+        include_str!("../prompts/morevqa.vqa_api.system.j2"),
+    ),
+    (
+        "morevqa.vqa_api.user",
+        include_str!("../prompts/morevqa.vqa_api.user.j2"),
+    ),
+    (
+        "morevqa.vqa.system",
+        include_str!("../prompts/morevqa.vqa.system.j2"),
+    ),
+    ("morevqa.vqa.user", include_str!("../prompts/morevqa.vqa.user.j2")),
+    (
+        "morevqa.plan.system",
+        include_str!("../prompts/morevqa.plan.system.j2"),
+    ),
+    (
+        "morevqa.plan.user",
+        include_str!("../prompts/morevqa.plan.user.j2"),
+    ),
 ];
 
 /// A template failed to compile or render (a defect of this crate's files).

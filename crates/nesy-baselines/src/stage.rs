@@ -178,6 +178,7 @@ pub(crate) async fn target_plan(
         stages: earlier,
         deviations: common_deviations(inputs.fidelity),
         rounds: None,
+        instruction: None,
     })
 }
 

@@ -6,7 +6,7 @@ use std::collections::{BTreeMap, VecDeque};
 use std::sync::{Arc, Mutex};
 
 use nesy_baselines::{
-    BaselineError, BaselineInputs, Fidelity, Keyframe, SixViews, critic, demo2code, gpt4v, statler,
+    BaselineError, BaselineInputs, Fidelity, Keyframe, SixViews, critic, demo2code, gpt4v, morevqa, statler,
 };
 use nesy_core::predicates::Vocabulary;
 use nesy_core::state::State;
@@ -569,4 +569,119 @@ fn statler_plans_in_rounds_and_lets_the_model_write_the_state() {
     assert_eq!(plan.steps, ["Grasp the red cube."]);
     assert_eq!(plan.rounds, Some(1));
     assert_eq!(statler::shape(3, 2).calls_max, 4);
+}
+
+const EVENTS: &str = r#"{"question": "Is the red cube in the box?", "conjunction": "and", "parse_event": ["grasp the red cube", "drop the red cube into the box"], "event_object": ["red_cube", "red_cube, box"], "classify": "manipulation"}"#;
+const GROUNDED: &str = r#"{"event_queue": ["grasp the blue cube", "put the blue cube on the table", "grasp the red cube", "drop the red cube into the box"]}"#;
+const NOT_VERIFIED: &str = r#"{"event_queue": ["grasp the red cube", "drop the red cube into the box"], "verified": false, "reason": "the blue cube covers the red cube"}"#;
+const VERIFIED: &str = r#"{"event_queue": ["grasp the blue cube", "put the blue cube on the table", "grasp the red cube", "drop the red cube into the box"], "verified": true, "reason": "the queue clears the red cube first"}"#;
+
+fn morevqa_script(ground: &[&'static str], verify: &[&'static str]) -> Arc<Scripted> {
+    let api: &[&str] = &["verify_action(\"Is the red cube in the box?\")"; 4];
+    Scripted::with(&[
+        (gpt4v::DESCRIBE, &[DESCRIPTION]),
+        (morevqa::PARSE, &[EVENTS]),
+        (morevqa::GROUND, ground),
+        (morevqa::VERIFY_API, api),
+        (morevqa::VERIFY, verify),
+        (
+            morevqa::VQA_API,
+            &["vqa(\"What is on the red cube?\")\nvqa(\"Is the box open?\")\nvqa(\"Where is the box?\")"],
+        ),
+        (morevqa::VQA, &["The blue cube.\nYes.\nRight of the cubes."]),
+        (morevqa::PLAN, &[PLAN]),
+    ])
+}
+
+#[test]
+fn morevqa_grounds_and_verifies_until_verified_then_asks_and_plans() {
+    let transport = morevqa_script(&[GROUNDED, GROUNDED], &[NOT_VERIFIED, VERIFIED]);
+    let plan = pollster::block_on(morevqa::run(
+        &client(transport.clone(), None),
+        &inputs(Fidelity::Authors),
+    ))
+    .unwrap();
+    assert_eq!(plan.steps.len(), 4);
+    assert_eq!(plan.rounds, Some(2));
+    // Code generation gets the question form of the instruction.
+    assert_eq!(plan.instruction.as_deref(), Some("Is the red cube in the box?"));
+    assert!(plan.deviations[0].contains("capped at the scenario's budget of 10 rounds"));
+    let purposes: Vec<&str> = plan.stages.iter().map(|s| s.purpose.as_str()).collect();
+    assert_eq!(
+        purposes,
+        [
+            "gpt4v.describe",
+            "morevqa.parse",
+            "morevqa.ground",
+            "morevqa.verify_api",
+            "morevqa.verify",
+            "morevqa.ground",
+            "morevqa.verify_api",
+            "morevqa.verify",
+            "morevqa.vqa_api",
+            "morevqa.vqa",
+            "morevqa.plan"
+        ]
+    );
+    // Authors: the second grounding is the first's prompt again (no slot for the reason).
+    let ground = transport.requests(morevqa::GROUND);
+    assert!(!text_of(&messages(&ground[1])[1]).contains("blue cube covers"));
+    // The verification sees the call and the grounded queue; the plan sees the answers,
+    // the full target state and only the end-effector predicates.
+    let verify = transport.requests(morevqa::VERIFY);
+    let text = text_of(&messages(&verify[0])[1]);
+    assert!(
+        text.contains("Call: verify_action(\"Is the red cube in the box?\")"),
+        "{text}"
+    );
+    assert!(text.contains("1. grasp the blue cube"), "{text}");
+    let plan_request = &transport.requests(morevqa::PLAN)[0];
+    let text = text_of(&messages(plan_request)[1]);
+    assert!(
+        text.contains("Answers about the scene:\nThe blue cube."),
+        "{text}"
+    );
+    assert!(text.contains("- (OnTopOf blue_cube red_cube)"), "{text}");
+    assert!(!text.contains("(OnTopOf ?a ?b)"), "{text}");
+    assert_eq!(morevqa::shape(3, 10).calls_min, 8);
+
+    // The loop stops at the budget when nothing verifies.
+    let mut capped = inputs(Fidelity::Authors);
+    capped.budget = 2;
+    let transport = morevqa_script(&[GROUNDED, GROUNDED], &[NOT_VERIFIED, NOT_VERIFIED]);
+    let plan = pollster::block_on(morevqa::run(&client(transport.clone(), None), &capped)).unwrap();
+    assert_eq!(plan.rounds, Some(2));
+    assert!(plan.deviations[0].contains("without verifying"));
+    assert_eq!(transport.requests(morevqa::VERIFY).len(), 2);
+
+    // Authors: a fenced JSON reply fails as json.loads would; repaired reads it, and shows
+    // the failed check's reason to the next grounding.
+    let fenced_events = "```json\n{\"question\": \"Is the red cube in the box?\", \"parse_event\": [\"grasp the red cube\"], \"event_object\": [\"red_cube\"]}\n```";
+    let transport = Scripted::with(&[
+        (gpt4v::DESCRIBE, &[DESCRIPTION]),
+        (morevqa::PARSE, &[fenced_events]),
+    ]);
+    let error =
+        pollster::block_on(morevqa::run(&client(transport, None), &inputs(Fidelity::Authors))).unwrap_err();
+    assert!(
+        error.to_string().contains("morevqa.parse") && error.to_string().contains("not a JSON object"),
+        "{error}"
+    );
+    let transport = morevqa_script(&[GROUNDED, GROUNDED], &[NOT_VERIFIED, VERIFIED]);
+    transport
+        .replies
+        .lock()
+        .unwrap()
+        .insert(morevqa::PARSE.into(), [fenced_events.to_string()].into());
+    let plan = pollster::block_on(morevqa::run(
+        &client(transport.clone(), None),
+        &inputs(Fidelity::Repaired),
+    ))
+    .unwrap();
+    assert_eq!(plan.rounds, Some(2));
+    let ground = transport.requests(morevqa::GROUND);
+    assert!(
+        text_of(&messages(&ground[1])[1])
+            .contains("The last check of the queue failed: the blue cube covers the red cube")
+    );
 }

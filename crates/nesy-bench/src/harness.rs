@@ -695,10 +695,18 @@ async fn make_code(
 ) -> Result<(String, f64, f64), (UnitStatus, String)> {
     let started = Instant::now();
     let target = &inputs.target;
-    let instruction = target.instruction(&inputs.demo);
+    let mut instruction = target.instruction(&inputs.demo);
     let (procedure, plan) = match &specified.spec {
         Specification::Procedure { procedure, .. } => (procedure.clone(), Vec::new()),
-        Specification::Plan { steps } => (Vec::new(), steps.clone()),
+        Specification::Plan {
+            steps,
+            instruction: rewritten,
+        } => {
+            if let Some(rewritten) = rewritten {
+                instruction = rewritten.clone();
+            }
+            (Vec::new(), steps.clone())
+        }
     };
     match specified.codegen {
         CodegenMode::Template => {
@@ -998,7 +1006,7 @@ async fn specify_and_code(
     };
     let spec_text = match &specified.spec {
         Specification::Procedure { procedure, .. } => format_procedure(procedure),
-        Specification::Plan { steps } => steps
+        Specification::Plan { steps, .. } => steps
             .iter()
             .enumerate()
             .map(|(i, s)| format!("{}. {s}", i + 1))

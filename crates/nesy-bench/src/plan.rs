@@ -67,11 +67,12 @@ pub fn unit_load(unit: &Unit, keyframes: u64, budget: u64) -> Load {
                 images_max: transitions * tries * IMAGES_PER_INDUCTION + t_images,
             }
         }
-        "demo2code" | "gpt4v-robotics" | "critic-v" | "statler" => {
+        "demo2code" | "gpt4v-robotics" | "critic-v" | "morevqa" | "statler" => {
             let shape = match unit.variant.method.as_str() {
                 "demo2code" => nesy_baselines::demo2code::shape(keyframes),
                 "gpt4v-robotics" => nesy_baselines::gpt4v::shape(keyframes),
                 "critic-v" => nesy_baselines::critic::shape(keyframes, budget),
+                "morevqa" => nesy_baselines::morevqa::shape(keyframes, budget),
                 _ => nesy_baselines::statler::shape(keyframes, budget),
             };
             // One code-generation call follows the flow's own calls.

@@ -3,8 +3,9 @@
 //! bold headers, numbered lists, a closing remark) and one mistake each method must survive:
 //! Demo2Code's first plan is cut off at the token cap, GPT4V-Robotics' first description
 //! comes back with null content (both re-asked), Critic-V's correction numbers its SEARCH
-//! line as its prompt's example does (so, as in the authors' code, it does not apply), and
-//! Statler's first round writes no world state (so the state it is shown next is empty). The live run records one cassette per
+//! line as its prompt's example does (so, as in the authors' code, it does not apply),
+//! Statler's first round writes no world state (so the state it is shown next is empty), and
+//! MoReVQA's first check does not verify its queue (so it grounds again). The live run records one cassette per
 //! unit; replaying them offline twice gives the same records as the live run.
 //!
 //! These replies are not a model's: the scores say what this program does in the simulator,
@@ -104,6 +105,13 @@ impl Respond for HandWritten {
             ("correct", "You correct a robot action plan"),
             ("state", "You describe robot scenes as symbolic states."),
             ("round", "You plan robot actions step by step"),
+            ("events", "You parse a robot task into the events"),
+            ("ground", "You ground a queue of task events"),
+            ("verify_api", "You turn a question about a robot task"),
+            ("verify", "You execute a verification call"),
+            ("vqa_api", "You write the visual questions"),
+            ("vqa", "You answer visual questions"),
+            ("queue_plan", "You plan robot actions from a grounded event queue"),
         ]
         .into_iter()
         .find(|(_, start)| system.starts_with(start))
@@ -157,6 +165,38 @@ impl Respond for HandWritten {
                 ),
                 "stop",
             ),
+            "events" => completion(Some(EVENTS), "stop"),
+            "ground" => completion(Some(QUEUE), "stop"),
+            "verify_api" => completion(
+                Some("verify_action(\"Are the cubes in the toy box and the fruit in the hinge box?\")"),
+                "stop",
+            ),
+            "verify" if count == 1 => completion(
+                Some(
+                    r#"{"event_queue": ["grasp the red cube", "drop it into the toy box"], "verified": false, "reason": "the green cube is on the red cube"}"#,
+                ),
+                "stop",
+            ),
+            "verify" => completion(
+                Some(&format!(
+                    "{{\"event_queue\": {}, \"verified\": true, \"reason\": \"the stack is cleared first\"}}",
+                    &QUEUE[15..QUEUE.len() - 1]
+                )),
+                "stop",
+            ),
+            "vqa_api" => completion(
+                Some(
+                    "vqa(\"What is on the red cube?\")\nvqa(\"Is the hinge lid open?\")\nvqa(\"Where is the toy box?\")",
+                ),
+                "stop",
+            ),
+            "vqa" => completion(
+                Some(
+                    "What is on the red cube? The green cube.\nIs the hinge lid open? No.\nWhere is the toy box? Next to the cubes.",
+                ),
+                "stop",
+            ),
+            "queue_plan" => completion(Some(PLAN), "stop"),
             "round" => completion(
                 Some(
                     "1. Drop the red cube into the toy box.\n2. Grasp the blue cube.\n3. Drop the blue cube into the toy box.\n- (InsideOf red_cube toy_box)\ngoal reached",
@@ -172,6 +212,10 @@ impl Respond for HandWritten {
         }
     }
 }
+
+const EVENTS: &str = r#"{"question": "Are the cubes in the toy box and the fruit in the hinge box?", "conjunction": "and", "parse_event": ["put the cubes into the toy box", "put the fruit into the hinge box"], "event_object": ["red_cube, green_cube, blue_cube, toy_box", "lemon, hinge_body"], "classify": "manipulation"}"#;
+
+const QUEUE: &str = r#"{"event_queue": ["move the green cube off the red cube", "put the cubes into the toy box", "open the hinge lid", "put the lemon into the hinge box"]}"#;
 
 const SOURCE_PLAN: &str = "**Demonstrated plan:**
 1. Move the gripper around the red cube.
@@ -195,7 +239,7 @@ fn bench(run: &Path, demos: &Path, vlm: &str) -> std::process::Output {
         "run".into(),
         run.display().to_string(),
         "--methods".into(),
-        "demo2code,gpt4v-robotics,critic-v,statler".into(),
+        "demo2code,gpt4v-robotics,critic-v,morevqa,statler".into(),
         "--scenarios".into(),
         SCENARIO.into(),
         "--vlm".into(),
@@ -289,8 +333,16 @@ async fn baselines_run_live_record_and_replay_to_the_same_records() {
     assert_eq!(by_purpose["statler.state"], 1);
     assert_eq!(by_purpose["statler.actions"], 2);
     assert_eq!(statler["spec"]["steps"], 6);
+    // MoReVQA: the description (re-asked), M1, two rounds of three calls, M3 and the plan.
+    let morevqa = &live_records["morevqa"];
+    let by_purpose = &morevqa["effort"]["calls_by_purpose"];
+    assert_eq!(by_purpose["morevqa.parse"], 1);
+    assert_eq!(by_purpose["morevqa.ground"], 2);
+    assert_eq!(by_purpose["morevqa.verify"], 2);
+    assert_eq!(by_purpose["morevqa.vqa"], 1);
+    assert_eq!(morevqa["spec"]["iterations"], 2);
     // The same program ran for all: it puts the cubes in the box and never the fruit.
-    for record in [d2c, gpt4v, critic, statler] {
+    for record in [d2c, gpt4v, critic, morevqa, statler] {
         assert_eq!(record["status"], "execution_failed", "{record}");
         assert_eq!(record["scores"]["sr"], 0.0, "{record}");
         assert_eq!(record["scores"]["gc"], 0.5, "{record}");

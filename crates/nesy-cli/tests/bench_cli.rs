@@ -181,6 +181,7 @@ fn methods_plan_and_bad_input() {
         "demo2code",
         "gpt4v-robotics",
         "critic-v",
+        "morevqa",
         "statler",
         "code-as-policies",
         "imitation",

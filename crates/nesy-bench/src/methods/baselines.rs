@@ -35,6 +35,8 @@ pub enum BaselineKind {
     CriticV,
     /// Statler (reader and writer in one call per round).
     Statler,
+    /// MoReVQA (event parsing, grounding and verification, visual questions).
+    MoReVqa,
 }
 
 /// A baseline as a harness method.
@@ -71,6 +73,13 @@ impl Baseline {
     pub fn statler() -> Baseline {
         Baseline {
             kind: BaselineKind::Statler,
+        }
+    }
+
+    /// MoReVQA.
+    pub fn morevqa() -> Baseline {
+        Baseline {
+            kind: BaselineKind::MoReVqa,
         }
     }
 
@@ -133,6 +142,15 @@ impl Method for Baseline {
                 },
                 "the domain description, a predicted state, then rounds that extend the plan and rewrite the state in text until \"goal reached\" (no check)",
             ),
+            BaselineKind::MoReVqa => (
+                "morevqa",
+                "MoReVQA",
+                Classes {
+                    explicit_adapt: true,
+                    ..Classes::default()
+                },
+                "the domain description, event parsing, grounding and model-executed verification rounds (capped at the budget), three visual sub-questions, then the plan (no check)",
+            ),
         };
         MethodInfo {
             name,
@@ -165,6 +183,7 @@ impl Method for Baseline {
                 BaselineKind::Gpt4vRobotics => nesy_baselines::gpt4v::run(client, &baseline_inputs).await,
                 BaselineKind::CriticV => nesy_baselines::critic::run(client, &baseline_inputs).await,
                 BaselineKind::Statler => nesy_baselines::statler::run(client, &baseline_inputs).await,
+                BaselineKind::MoReVqa => nesy_baselines::morevqa::run(client, &baseline_inputs).await,
             }
             .map_err(baseline_failure)?;
             Ok(specified(
@@ -189,7 +208,10 @@ fn specified(plan: BaselinePlan, budget: usize, vlm_s: f64) -> Specified {
         }
     }
     Specified {
-        spec: Specification::Plan { steps: plan.steps },
+        spec: Specification::Plan {
+            steps: plan.steps,
+            instruction: plan.instruction,
+        },
         codegen: CodegenMode::Vlm,
         adaptation: None,
         iterations: plan.rounds.map(|rounds| (rounds, budget)),

@@ -45,7 +45,10 @@ impl Method for CodeAsPolicies {
     ) -> BoxFuture<'a, Result<Specified, MethodFailure>> {
         async move {
             Ok(Specified {
-                spec: Specification::Plan { steps: Vec::new() },
+                spec: Specification::Plan {
+                    steps: Vec::new(),
+                    instruction: None,
+                },
                 codegen: CodegenMode::Vlm,
                 adaptation: None,
                 iterations: None,

@@ -122,6 +122,9 @@ pub enum Specification {
     Plan {
         /// The steps, in order.
         steps: Vec<String>,
+        /// The instruction code generation gets instead of the target's, when the method
+        /// rewrites it (MoReVQA passes its question form).
+        instruction: Option<String>,
     },
 }
 
@@ -138,7 +141,7 @@ impl Specification {
     pub fn len(&self) -> usize {
         match self {
             Specification::Procedure { procedure, .. } => procedure.len(),
-            Specification::Plan { steps } => steps.len(),
+            Specification::Plan { steps, .. } => steps.len(),
         }
     }
 
@@ -230,6 +233,7 @@ pub fn registry() -> Vec<Arc<dyn Method>> {
         Arc::new(Baseline::demo2code()),
         Arc::new(Baseline::gpt4v_robotics()),
         Arc::new(Baseline::critic_v()),
+        Arc::new(Baseline::morevqa()),
         Arc::new(Baseline::statler()),
         Arc::new(CodeAsPolicies),
         Arc::new(Imitation),
