@@ -170,6 +170,7 @@ mod tests {
                 "demo2code",
                 "gpt4v-robotics",
                 "critic-v",
+                "morevqa",
                 "statler",
                 "imitation"
             ]
