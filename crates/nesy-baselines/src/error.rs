@@ -29,6 +29,13 @@ pub enum BaselineError {
         /// Replies asked for.
         attempts: usize,
     },
+    /// The flow ran to its end without a plan (LLM-DM in repaired mode: the planner never
+    /// solved the model's domain).
+    #[error("{message}")]
+    NoPlan {
+        /// What happened.
+        message: String,
+    },
     /// A prompt template failed (a defect of this crate's files).
     #[error(transparent)]
     Prompt(#[from] PromptError),
@@ -40,9 +47,14 @@ impl BaselineError {
     pub fn reasoner_kind(&self) -> ReasonerErrorKind {
         match self {
             BaselineError::Call { error, .. } => error.reasoner_kind(),
-            BaselineError::Unreadable { .. } => ReasonerErrorKind::Reply,
+            BaselineError::Unreadable { .. } | BaselineError::NoPlan { .. } => ReasonerErrorKind::Reply,
             BaselineError::Prompt(_) => ReasonerErrorKind::Request,
         }
+    }
+
+    /// True when the flow ended without a plan rather than on an error.
+    pub fn is_unresolved(&self) -> bool {
+        matches!(self, BaselineError::NoPlan { .. })
     }
 
     /// The reply that could not be used, if that is the failure.

@@ -17,10 +17,13 @@
 //!   the model extends the plan and rewrites the world state until it says "goal reached";
 //! - [`morevqa`] (MoReVQA): the domain description, event parsing, rounds of grounding and
 //!   verification until verified (capped at the budget), three visual sub-questions and
-//!   their answers, then the plan.
+//!   their answers, then the plan;
+//! - [`llmdm`] (LLM-DM): a PDDL domain built action by action and a predicted problem,
+//!   solved by nesy-core's planner (not Fast Downward), refined from the planner's report up
+//!   to the budget, and the plan put into words.
 //!
-//! Nothing here is symbolic: these baselines plan in text, and nothing checks the plan
-//! before code generation.
+//! Only LLM-DM uses a symbolic tool (a planner over the model's own domain); the others plan
+//! in text, and nothing checks their plans before code generation.
 //!
 //! Replies are untrusted. A cut-off reply or one with null content is re-asked once, as for
 //! every call of the project ([`nesy_vlm::reply`]). A reply whose answer cannot be found
@@ -35,6 +38,7 @@ mod error;
 pub mod gpt4v;
 mod inputs;
 mod json;
+pub mod llmdm;
 pub mod morevqa;
 pub mod parse;
 mod prompts;

@@ -103,6 +103,33 @@ pub fn first_block(reply: &str) -> Result<String, BlockError> {
     Err(BlockError::Unclosed { line: open_line })
 }
 
+/// The texts of every closed fenced block of `reply`, in order (trimmed; empty ones left
+/// out).
+///
+/// ```
+/// let reply = "Initial state\n```\n(:objects a b)\n```\n```\n(:init (on a b))\n```";
+/// assert_eq!(nesy_baselines::parse::blocks(reply), ["(:objects a b)", "(:init (on a b))"]);
+/// ```
+pub fn blocks(reply: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut rest = prepared(reply);
+    while let Ok(block) = first_block(&rest) {
+        // Continue after this block's closing fence.
+        let Some(at) = rest.find(&block) else { break };
+        let after = &rest[at + block.len()..];
+        let Some(close) = after.find('\n').map(|i| i + 1) else {
+            out.push(block);
+            break;
+        };
+        // Skip the closing fence line.
+        let tail = &after[close..];
+        let tail = tail.split_once('\n').map_or("", |(_, r)| r).to_string();
+        out.push(block);
+        rest = tail;
+    }
+    out
+}
+
 /// One text edit of a plan: lines to find and the lines that replace them.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LinePatch {

@@ -130,6 +130,54 @@ const TEMPLATES: &[(&str, &str)] = &[
         "morevqa.plan.user",
         include_str!("../prompts/morevqa.plan.user.j2"),
     ),
+    (
+        "llmdm.actions.system",
+        include_str!("../prompts/llmdm.actions.system.j2"),
+    ),
+    (
+        "llmdm.actions.user",
+        include_str!("../prompts/llmdm.actions.user.j2"),
+    ),
+    (
+        "llmdm.predicates.system",
+        include_str!("../prompts/llmdm.predicates.system.j2"),
+    ),
+    (
+        "llmdm.predicates.user",
+        include_str!("../prompts/llmdm.predicates.user.j2"),
+    ),
+    (
+        "llmdm.action.system",
+        include_str!("../prompts/llmdm.action.system.j2"),
+    ),
+    (
+        "llmdm.action.user",
+        include_str!("../prompts/llmdm.action.user.j2"),
+    ),
+    (
+        "llmdm.problem.system",
+        include_str!("../prompts/llmdm.problem.system.j2"),
+    ),
+    (
+        "llmdm.problem.user",
+        include_str!("../prompts/llmdm.problem.user.j2"),
+    ),
+    (
+        "llmdm.refine.system",
+        include_str!("../prompts/llmdm.refine.system.j2"),
+    ),
+    (
+        "llmdm.refine.user",
+        include_str!("../prompts/llmdm.refine.user.j2"),
+    ),
+    (
+        "llmdm.translate.system",
+        include_str!("../prompts/llmdm.translate.system.j2"),
+    ),
+    (
+        "llmdm.translate.user",
+        include_str!("../prompts/llmdm.translate.user.j2"),
+    ),
 ];
 
 /// A template failed to compile or render (a defect of this crate's files).

@@ -6,7 +6,8 @@ use std::collections::{BTreeMap, VecDeque};
 use std::sync::{Arc, Mutex};
 
 use nesy_baselines::{
-    BaselineError, BaselineInputs, Fidelity, Keyframe, SixViews, critic, demo2code, gpt4v, morevqa, statler,
+    BaselineError, BaselineInputs, Fidelity, Keyframe, SixViews, critic, demo2code, gpt4v, llmdm, morevqa,
+    statler,
 };
 use nesy_core::predicates::Vocabulary;
 use nesy_core::state::State;
@@ -684,4 +685,105 @@ fn morevqa_grounds_and_verifies_until_verified_then_asks_and_plans() {
         text_of(&messages(&ground[1])[1])
             .contains("The last check of the queue failed: the blue cube covers the red cube")
     );
+}
+
+const RECOMMENDED: &str = "Two kinds of action.\n1. pick_up: grasp an object from the table\n2. drop_in: release a held object into a container";
+const PROPOSED: &str = "The tier covers what we need; one helper:\n- (reachable ?x): the arm can reach ?x";
+const PICK_UP: &str = "Action name:\n- pick_up\nParameters:\n1. ?x: the object\nPreconditions\n```\n(and (GripperOpen) (OnTopOf ?x floor))\n```\nEffects\n```\n(and (GripperHolding ?x) (not (GripperOpen)) (not (OnTopOf ?x floor)))\n```";
+const DROP_IN_NEEDS_OPEN: &str = "Action name:\n- drop_in\nParameters:\n1. ?x: the held object\n2. ?b: the container\nPreconditions\n```\n(and (GripperHolding ?x) (Open ?b))\n```\nEffects\n```\n(and (InsideOf ?x ?b) (GripperOpen) (not (GripperHolding ?x)))\n```";
+const PROBLEM_REPLY: &str = "Initial state\n```\n(:objects red_cube box floor)\n```\n```\n(:init (GripperOpen) (OnTopOf red_cube floor))\n```\nGoal state\n```\n(:goal (InsideOf red_cube box))\n```";
+const REFINED: &str = "The box is never open, so drop_in can never apply; drop the condition.\n```\n(define (domain llmdm)\n  (:requirements :strips :negative-preconditions)\n  (:predicates (GripperOpen) (GripperHolding ?x) (OnTopOf ?x ?y) (InsideOf ?x ?y))\n  (:action pick_up :parameters (?x) :precondition (and (GripperOpen) (OnTopOf ?x floor))\n    :effect (and (GripperHolding ?x) (not (GripperOpen)) (not (OnTopOf ?x floor))))\n  (:action drop_in :parameters (?x ?b) :precondition (GripperHolding ?x)\n    :effect (and (InsideOf ?x ?b) (GripperOpen) (not (GripperHolding ?x)))))\n```";
+const TRANSLATED: &str = "1. Pick up the red cube.\n2. Drop the red cube into the box.";
+
+fn llmdm_script(drop_in: &'static str, refine: &[&'static str], translate: &[&'static str]) -> Arc<Scripted> {
+    Scripted::with(&[
+        (gpt4v::DESCRIBE, &[DESCRIPTION]),
+        (llmdm::ACTIONS, &[RECOMMENDED]),
+        (llmdm::PREDICATES, &[PROPOSED]),
+        (llmdm::ACTION, &[PICK_UP, drop_in]),
+        (llmdm::PROBLEM, &[PROBLEM_REPLY]),
+        (llmdm::REFINE, refine),
+        (llmdm::TRANSLATE, translate),
+    ])
+}
+
+#[test]
+fn llm_dm_builds_a_domain_plans_refines_on_failure_and_translates_the_plan() {
+    // The model's drop_in needs an open box that never is: no plan; the refinement drops
+    // the condition and the planner solves the refined domain.
+    let transport = llmdm_script(DROP_IN_NEEDS_OPEN, &[REFINED], &[TRANSLATED]);
+    let plan = pollster::block_on(llmdm::run(
+        &client(transport.clone(), None),
+        &inputs(Fidelity::Authors),
+    ))
+    .unwrap();
+    assert_eq!(
+        plan.steps,
+        ["Pick up the red cube.", "Drop the red cube into the box."]
+    );
+    assert_eq!(plan.rounds, Some(1));
+    assert!(plan.deviations[0].contains("not Fast Downward"));
+    // The predicates joined the tier's, cut at their first `:`; each action has its call.
+    let actions = transport.requests(llmdm::ACTION);
+    assert_eq!(actions.len(), 2);
+    let text = text_of(&messages(&actions[0])[1]);
+    assert!(text.contains("(reachable ?x)\n(OverOf ?a ?b)"), "{text}");
+    assert!(!text.contains("the arm can reach"), "{text}");
+    // The refinement sees the domain, the problem and the planner's report.
+    let refine = transport.requests(llmdm::REFINE);
+    let text = text_of(&messages(&refine[0])[1]);
+    assert!(
+        text.contains("(:action drop_in\n    :parameters (?x ?b)"),
+        "{text}"
+    );
+    assert!(text.contains("(:goal (InsideOf red_cube box))"), "{text}");
+    assert!(text.contains("Plan not found by the nesy planner"), "{text}");
+    let translate = transport.requests(llmdm::TRANSLATE);
+    let text = text_of(&messages(&translate[0])[1]);
+    assert!(
+        text.contains("1. (pick_up red_cube)\n2. (drop_in red_cube box)"),
+        "{text}"
+    );
+
+    // Never solvable within a budget of one: the authors do not solve after the last
+    // refinement and hand "None" to code generation; repaired solves once more, then ends
+    // without a plan.
+    let mut one = inputs(Fidelity::Authors);
+    one.budget = 1;
+    let still_closed = "Keep it.\n```\n(define (domain llmdm) (:requirements :strips :negative-preconditions)\n (:predicates (GripperOpen) (GripperHolding ?x) (OnTopOf ?x ?y) (InsideOf ?x ?y) (Open ?x))\n (:action drop_in :parameters (?x ?b) :precondition (and (GripperHolding ?x) (Open ?b)) :effect (InsideOf ?x ?b)))\n```";
+    let transport = llmdm_script(DROP_IN_NEEDS_OPEN, &[still_closed], &[]);
+    let plan = pollster::block_on(llmdm::run(&client(transport.clone(), None), &one)).unwrap();
+    assert_eq!(plan.steps, ["None"]);
+    assert_eq!(transport.requests(llmdm::REFINE).len(), 1);
+    one.fidelity = Fidelity::Repaired;
+    let transport = llmdm_script(DROP_IN_NEEDS_OPEN, &[still_closed], &[]);
+    let error = pollster::block_on(llmdm::run(&client(transport, None), &one)).unwrap_err();
+    assert!(error.is_unresolved(), "{error}");
+
+    // A formula that does not parse: the authors' code raises; repaired sends the parse
+    // error back as the planner's report.
+    let broken = "Action name:\n- drop_in\nParameters:\n1. ?x\n2. ?b\nPreconditions\n```\n(and (GripperHolding ?x)\n```\nEffects\n```\n(InsideOf ?x ?b)\n```";
+    let transport = llmdm_script(broken, &[REFINED], &[TRANSLATED]);
+    let error =
+        pollster::block_on(llmdm::run(&client(transport, None), &inputs(Fidelity::Authors))).unwrap_err();
+    assert!(
+        error.to_string().contains("llmdm.pddl") && error.to_string().contains("does not parse"),
+        "{error}"
+    );
+    let transport = llmdm_script(broken, &[REFINED], &[TRANSLATED]);
+    let plan = pollster::block_on(llmdm::run(
+        &client(transport.clone(), None),
+        &inputs(Fidelity::Repaired),
+    ))
+    .unwrap();
+    assert_eq!(plan.steps.len(), 2);
+    let text = text_of(&messages(&transport.requests(llmdm::REFINE)[0])[1]);
+    assert!(text.contains("the domain does not parse"), "{text}");
+
+    // An action reply with "Effects" twice fails as the authors' split does.
+    let twice = "Action name:\n- drop_in\nPreconditions\n```\n(GripperHolding ?x)\n```\nEffects\n```\n(InsideOf ?x ?b)\n```\nEffects again";
+    let transport = llmdm_script(twice, &[], &[]);
+    let error =
+        pollster::block_on(llmdm::run(&client(transport, None), &inputs(Fidelity::Authors))).unwrap_err();
+    assert!(error.to_string().contains("\"Effects\" 2 times"), "{error}");
 }

@@ -17,6 +17,10 @@ pub const IMAGES_PER_INDUCTION: u64 = 6;
 /// Images per state translation: the three labelled views.
 pub const IMAGES_PER_TRANSLATION: u64 = 3;
 
+/// The most actions LLM-DM's model is assumed to recommend (one construction call each): the
+/// method sets no bound, so the plan's maximum rests on this assumption.
+pub const LLMDM_ACTIONS: u64 = 10;
+
 /// Calls and images of one unit, or a range.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
 pub struct Load {
@@ -67,12 +71,13 @@ pub fn unit_load(unit: &Unit, keyframes: u64, budget: u64) -> Load {
                 images_max: transitions * tries * IMAGES_PER_INDUCTION + t_images,
             }
         }
-        "demo2code" | "gpt4v-robotics" | "critic-v" | "morevqa" | "statler" => {
+        "demo2code" | "gpt4v-robotics" | "critic-v" | "morevqa" | "statler" | "llm-dm" => {
             let shape = match unit.variant.method.as_str() {
                 "demo2code" => nesy_baselines::demo2code::shape(keyframes),
                 "gpt4v-robotics" => nesy_baselines::gpt4v::shape(keyframes),
                 "critic-v" => nesy_baselines::critic::shape(keyframes, budget),
                 "morevqa" => nesy_baselines::morevqa::shape(keyframes, budget),
+                "llm-dm" => nesy_baselines::llmdm::shape(keyframes, budget, LLMDM_ACTIONS),
                 _ => nesy_baselines::statler::shape(keyframes, budget),
             };
             // One code-generation call follows the flow's own calls.

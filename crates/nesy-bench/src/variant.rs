@@ -172,6 +172,7 @@ mod tests {
                 "critic-v",
                 "morevqa",
                 "statler",
+                "llm-dm",
                 "imitation"
             ]
         );

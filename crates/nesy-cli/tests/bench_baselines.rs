@@ -4,8 +4,10 @@
 //! Demo2Code's first plan is cut off at the token cap, GPT4V-Robotics' first description
 //! comes back with null content (both re-asked), Critic-V's correction numbers its SEARCH
 //! line as its prompt's example does (so, as in the authors' code, it does not apply),
-//! Statler's first round writes no world state (so the state it is shown next is empty), and
-//! MoReVQA's first check does not verify its queue (so it grounds again). The live run records one cassette per
+//! Statler's first round writes no world state (so the state it is shown next is empty),
+//! MoReVQA's first check does not verify its queue (so it grounds again), and LLM-DM's first
+//! domain cannot reach the goal (so the planner's report goes back and the refined domain is
+//! solved). The live run records one cassette per
 //! unit; replaying them offline twice gives the same records as the live run.
 //!
 //! These replies are not a model's: the scores say what this program does in the simulator,
@@ -112,6 +114,12 @@ impl Respond for HandWritten {
             ("vqa_api", "You write the visual questions"),
             ("vqa", "You answer visual questions"),
             ("queue_plan", "You plan robot actions from a grounded event queue"),
+            ("recommend", "You list the actions a robot domain needs."),
+            ("predicates", "You propose the predicates of a PDDL domain."),
+            ("action", "You write one action of a PDDL domain."),
+            ("problem", "You write the PDDL problem of a robot scene."),
+            ("refine", "You repair a PDDL domain that failed to plan."),
+            ("translate", "You turn a PDDL plan into robot actions in words."),
         ]
         .into_iter()
         .find(|(_, start)| system.starts_with(start))
@@ -197,6 +205,26 @@ impl Respond for HandWritten {
                 "stop",
             ),
             "queue_plan" => completion(Some(PLAN), "stop"),
+            "recommend" => completion(
+                Some(
+                    "Two actions cover the domain.\n\n1. pick_up: grasp an object from the table\n2. drop_in: release a held object into a container",
+                ),
+                "stop",
+            ),
+            "predicates" => completion(
+                Some("The tier covers most of it.\n- (reachable ?x): the arm can reach ?x"),
+                "stop",
+            ),
+            "action" if common::message_text(&messages[1]).contains("pick_up") => {
+                completion(Some(PICK_UP), "stop")
+            }
+            "action" => completion(Some(DROP_IN), "stop"),
+            "problem" => completion(Some(PROBLEM), "stop"),
+            "refine" => completion(Some(REFINED), "stop"),
+            "translate" => completion(
+                Some("1. Pick up the red cube.\n2. Drop the red cube into the toy box."),
+                "stop",
+            ),
             "round" => completion(
                 Some(
                     "1. Drop the red cube into the toy box.\n2. Grasp the blue cube.\n3. Drop the blue cube into the toy box.\n- (InsideOf red_cube toy_box)\ngoal reached",
@@ -212,6 +240,15 @@ impl Respond for HandWritten {
         }
     }
 }
+
+const PICK_UP: &str = "**Action name:**\n- pick_up\nParameters:\n1. ?x: the object\nPreconditions\n```\n(and (GripperOpen) (OnTopOf ?x floor))\n```\nEffects\n```\n(and (GripperHolding ?x) (not (GripperOpen)) (not (OnTopOf ?x floor)))\n```";
+
+/// The mistake: dropping needs an open container, and the toy box never is.
+const DROP_IN: &str = "**Action name:**\n- drop_in\nParameters:\n1. ?x: the held object\n2. ?b: the container\nPreconditions\n```\n(and (GripperHolding ?x) (Open ?b))\n```\nEffects\n```\n(and (InsideOf ?x ?b) (GripperOpen) (not (GripperHolding ?x)))\n```";
+
+const PROBLEM: &str = "From the views:\n\nInitial state\n```\n(:objects red_cube green_cube blue_cube toy_box floor)\n```\n```\n(:init (GripperOpen) (OnTopOf red_cube floor) (OnTopOf toy_box floor))\n```\nGoal state\n```\n(:goal (InsideOf red_cube toy_box))\n```";
+
+const REFINED: &str = "The toy box has no lid, so drop_in should not need it open.\n```\n(define (domain llmdm)\n  (:requirements :strips :negative-preconditions)\n  (:predicates (GripperOpen) (GripperHolding ?x) (OnTopOf ?x ?y) (InsideOf ?x ?y))\n  (:action pick_up :parameters (?x) :precondition (and (GripperOpen) (OnTopOf ?x floor))\n    :effect (and (GripperHolding ?x) (not (GripperOpen)) (not (OnTopOf ?x floor))))\n  (:action drop_in :parameters (?x ?b) :precondition (GripperHolding ?x)\n    :effect (and (InsideOf ?x ?b) (GripperOpen) (not (GripperHolding ?x)))))\n```";
 
 const EVENTS: &str = r#"{"question": "Are the cubes in the toy box and the fruit in the hinge box?", "conjunction": "and", "parse_event": ["put the cubes into the toy box", "put the fruit into the hinge box"], "event_object": ["red_cube, green_cube, blue_cube, toy_box", "lemon, hinge_body"], "classify": "manipulation"}"#;
 
@@ -239,7 +276,7 @@ fn bench(run: &Path, demos: &Path, vlm: &str) -> std::process::Output {
         "run".into(),
         run.display().to_string(),
         "--methods".into(),
-        "demo2code,gpt4v-robotics,critic-v,morevqa,statler".into(),
+        "demo2code,gpt4v-robotics,critic-v,morevqa,statler,llm-dm".into(),
         "--scenarios".into(),
         SCENARIO.into(),
         "--vlm".into(),
@@ -341,8 +378,16 @@ async fn baselines_run_live_record_and_replay_to_the_same_records() {
     assert_eq!(by_purpose["morevqa.verify"], 2);
     assert_eq!(by_purpose["morevqa.vqa"], 1);
     assert_eq!(morevqa["spec"]["iterations"], 2);
+    // LLM-DM: one construction per recommended action, one refinement, then the plan in words.
+    let llmdm = &live_records["llm-dm"];
+    let by_purpose = &llmdm["effort"]["calls_by_purpose"];
+    assert_eq!(by_purpose["llmdm.action"], 2);
+    assert_eq!(by_purpose["llmdm.refine"], 1);
+    assert_eq!(by_purpose["llmdm.translate"], 1);
+    assert_eq!(llmdm["spec"]["steps"], 2);
+    assert_eq!(llmdm["spec"]["iterations"], 1);
     // The same program ran for all: it puts the cubes in the box and never the fruit.
-    for record in [d2c, gpt4v, critic, morevqa, statler] {
+    for record in [d2c, gpt4v, critic, morevqa, statler, llmdm] {
         assert_eq!(record["status"], "execution_failed", "{record}");
         assert_eq!(record["scores"]["sr"], 0.0, "{record}");
         assert_eq!(record["scores"]["gc"], 0.5, "{record}");

@@ -183,6 +183,7 @@ fn methods_plan_and_bad_input() {
         "critic-v",
         "morevqa",
         "statler",
+        "llm-dm",
         "code-as-policies",
         "imitation",
         "replan",

@@ -49,6 +49,22 @@ pub enum Heuristic {
     Blind,
 }
 
+/// How lifted schemas become ground actions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Grounding {
+    /// Every argument tuple of the parameters' types, pruned by static preconditions. An
+    /// untyped 4-parameter schema over 30 objects is 810 000 tuples.
+    #[default]
+    AllTuples,
+    /// Only the tuples whose positive atomic preconditions are reachable in the delete
+    /// relaxation from the initial state, as Fast Downward's translator grounds: each schema's
+    /// parameters are bound by joining those preconditions with the reachable facts, to a
+    /// fixpoint. Actions it leaves out can never apply, so plans are the same as with
+    /// [`Grounding::AllTuples`], found in the same order.
+    Reachable,
+}
+
 /// Search settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct PlannerConfig {
@@ -58,8 +74,14 @@ pub struct PlannerConfig {
     pub heuristic: Heuristic,
     /// Stop after expanding this many states.
     pub max_expansions: usize,
-    /// Stop after this much wall-clock time.
+    /// Stop after this much wall-clock time; [`plan`] counts grounding in it too.
     pub time_limit: Option<Duration>,
+    /// How lifted schemas are grounded.
+    #[serde(default)]
+    pub grounding: Grounding,
+    /// Refuse to ground more than this many actions ([`PlanError::TooManyActions`]).
+    #[serde(default)]
+    pub max_ground_actions: Option<usize>,
     /// Greedy search on h_FF only: keep a second open list of the states reached by helpful
     /// actions (the relaxed plan's applicable actions) and favour it after each improvement
     /// (see [`Search::Gbfs`]). Off, greedy search uses one open list.
@@ -79,6 +101,8 @@ impl Default for PlannerConfig {
             max_expansions: 200_000,
             time_limit: Some(Duration::from_secs(10)),
             preferred_operators: true,
+            grounding: Grounding::AllTuples,
+            max_ground_actions: None,
         }
     }
 }
@@ -118,6 +142,50 @@ pub enum PlanError {
     /// An operator or the goal could not be grounded.
     #[error("grounding failed: {0}")]
     Ground(#[from] GroundError),
+    /// Grounding passed the cap of [`PlannerConfig::max_ground_actions`].
+    #[error(
+        "grounding stopped at the cap of {cap} ground actions while grounding `{schema}`; the schemas' parameters admit too many argument tuples"
+    )]
+    TooManyActions {
+        /// The cap.
+        cap: usize,
+        /// The schema being grounded when the cap was passed.
+        schema: String,
+    },
+    /// The time limit ran out while grounding, before any search.
+    #[error("time limit reached while grounding (after {actions} ground actions)")]
+    GroundingTimeLimit {
+        /// Ground actions built by then.
+        actions: usize,
+    },
+}
+
+/// What grounding may spend: [`PlannerConfig`]'s grounding mode and cap, and a deadline.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct GroundingLimits {
+    /// How schemas are grounded.
+    pub grounding: Grounding,
+    /// The most ground actions.
+    pub max_actions: Option<usize>,
+    /// When to give up.
+    pub deadline: Option<Instant>,
+}
+
+impl GroundingLimits {
+    fn check(&self, actions: usize, schema: &Operator) -> Result<(), PlanError> {
+        if let Some(cap) = self.max_actions
+            && actions > cap
+        {
+            return Err(PlanError::TooManyActions {
+                cap,
+                schema: schema.name.clone(),
+            });
+        }
+        if self.deadline.is_some_and(|d| Instant::now() > d) {
+            return Err(PlanError::GroundingTimeLimit { actions });
+        }
+        Ok(())
+    }
 }
 
 /// A search node: state, (parent, action) and path cost.
@@ -161,6 +229,138 @@ fn static_truth(g: &Ground, is_static: &dyn Fn(Atom) -> bool, init: &State) -> O
     }
 }
 
+/// The positive atoms among a schema's top-level precondition conjuncts: the ones a
+/// reachable binding must find among the reachable facts.
+fn positive_atoms(schema: &Operator) -> Vec<crate::formula::AtomPattern> {
+    schema
+        .pre
+        .iter()
+        .flat_map(|f| f.conjuncts())
+        .filter_map(|f| match f {
+            Formula::Atom(p) => Some(p),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The argument tuples of `schema` whose positive atomic preconditions are all in `facts`,
+/// in the order [`tuples`] would list them: parameters that such an atom mentions are bound
+/// by matching it against the facts of its predicate, the others range over their domain.
+fn joined_tuples(schema: &Operator, domains: &[Vec<Symbol>], facts: &FxHashSet<Atom>) -> Vec<Vec<Symbol>> {
+    use crate::formula::Term;
+    let index: FxHashMap<Symbol, usize> = schema
+        .params
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (p.name, i))
+        .collect();
+    let mut by_pred: FxHashMap<Symbol, Vec<Atom>> = FxHashMap::default();
+    for atom in facts {
+        by_pred.entry(atom.pred()).or_default().push(*atom);
+    }
+    let patterns = positive_atoms(schema);
+    // Partial bindings, extended one precondition at a time.
+    let mut partial: Vec<Vec<Option<Symbol>>> = vec![vec![None; domains.len()]];
+    for pattern in &patterns {
+        let candidates = by_pred.get(&pattern.pred).map(Vec::as_slice).unwrap_or_default();
+        let mut next = Vec::new();
+        for binding in &partial {
+            'fact: for fact in candidates {
+                if fact.args().len() != pattern.args.len() {
+                    continue;
+                }
+                let mut extended = binding.clone();
+                for (term, value) in pattern.args.iter().zip(fact.args()) {
+                    match term {
+                        Term::Const(c) if c != value => continue 'fact,
+                        Term::Const(_) => {}
+                        Term::Var(v) => {
+                            let Some(&i) = index.get(v) else { continue };
+                            match extended[i] {
+                                Some(bound) if bound != *value => continue 'fact,
+                                Some(_) => {}
+                                None if !domains[i].contains(value) => continue 'fact,
+                                None => extended[i] = Some(*value),
+                            }
+                        }
+                    }
+                }
+                next.push(extended);
+            }
+        }
+        next.sort();
+        next.dedup();
+        partial = next;
+        if partial.is_empty() {
+            return Vec::new();
+        }
+    }
+    let mut out: Vec<Vec<Symbol>> = Vec::new();
+    for binding in partial {
+        let choices: Vec<Vec<Symbol>> = binding
+            .iter()
+            .zip(domains)
+            .map(|(b, d)| b.map_or_else(|| d.clone(), |v| vec![v]))
+            .collect();
+        out.extend(tuples(&choices));
+    }
+    // Universe order, as `tuples` over the full domains lists them.
+    let rank = |args: &Vec<Symbol>| -> Vec<usize> {
+        args.iter()
+            .zip(domains)
+            .map(|(a, d)| d.iter().position(|x| x == a).unwrap_or(usize::MAX))
+            .collect()
+    };
+    out.sort_by_key(rank);
+    out.dedup();
+    out
+}
+
+/// The facts reachable from `init` in the delete relaxation, grounding each schema by
+/// [`joined_tuples`] over the facts found so far, until nothing new is added.
+fn relaxed_reachable(
+    actions: &[Operator],
+    universe: &Universe,
+    init: &State,
+    limits: &GroundingLimits,
+) -> Result<FxHashSet<Atom>, PlanError> {
+    let mut facts: FxHashSet<Atom> = init.iter().copied().collect();
+    loop {
+        let mut added = false;
+        let mut grounded = 0usize;
+        for schema in actions {
+            let domains: Vec<Vec<Symbol>> = schema
+                .params
+                .iter()
+                .map(|p| universe.objects_of(p.ty))
+                .collect::<Result<_, _>>()
+                .map_err(GroundError::from)?;
+            let candidates = if schema.params.is_empty() {
+                vec![Vec::new()]
+            } else {
+                joined_tuples(schema, &domains, &facts)
+            };
+            grounded += candidates.len();
+            limits.check(grounded, schema)?;
+            for args in candidates {
+                let c = schema.compile_with(&args, universe)?;
+                for atom in c
+                    .effects
+                    .adds
+                    .iter()
+                    .copied()
+                    .chain(c.effects.conditional.iter().filter(|e| e.add).map(|e| e.atom))
+                {
+                    added |= facts.insert(atom);
+                }
+            }
+        }
+        if !added {
+            return Ok(facts);
+        }
+    }
+}
+
 fn tuples(types: &[Vec<Symbol>]) -> Vec<Vec<Symbol>> {
     let mut out = vec![Vec::new()];
     for choices in types {
@@ -184,10 +384,24 @@ pub struct Task {
 }
 
 impl Task {
-    /// Grounds `actions` (lifted schemas or ground operators) over `universe`. Operators
-    /// whose static preconditions (over predicates no action changes) are false in `init`
-    /// are pruned.
-    pub fn ground(actions: &[Operator], universe: &Universe, init: &State) -> Result<Task, GroundError> {
+    /// Grounds `actions` (lifted schemas or ground operators) over `universe`, every
+    /// argument tuple. Operators whose static preconditions (over predicates no action
+    /// changes) are false in `init` are pruned.
+    pub fn ground(actions: &[Operator], universe: &Universe, init: &State) -> Result<Task, PlanError> {
+        Task::ground_within(actions, universe, init, &GroundingLimits::default())
+    }
+
+    /// [`Task::ground`] with a grounding mode, a cap on ground actions and a deadline.
+    pub fn ground_within(
+        actions: &[Operator],
+        universe: &Universe,
+        init: &State,
+        limits: &GroundingLimits,
+    ) -> Result<Task, PlanError> {
+        let reachable = match limits.grounding {
+            Grounding::AllTuples => None,
+            Grounding::Reachable => Some(relaxed_reachable(actions, universe, init, limits)?),
+        };
         let mut compiled: Vec<(Operator, CompiledOperator)> = Vec::new();
         for schema in actions {
             if schema.params.is_empty() {
@@ -198,12 +412,21 @@ impl Task {
                 .params
                 .iter()
                 .map(|p| universe.objects_of(p.ty))
-                .collect::<Result<_, _>>()?;
-            for args in tuples(&domains) {
+                .collect::<Result<_, _>>()
+                .map_err(GroundError::from)?;
+            let candidates = match &reachable {
+                None => tuples(&domains),
+                Some(facts) => joined_tuples(schema, &domains, facts),
+            };
+            for args in candidates {
                 let op = schema.instantiate(&args, universe)?;
                 let c = op.compile(universe)?;
                 compiled.push((op, c));
+                if compiled.len().is_multiple_of(1024) {
+                    limits.check(compiled.len(), schema)?;
+                }
             }
+            limits.check(compiled.len(), schema)?;
         }
         let mut changing: FxHashSet<Symbol> = FxHashSet::default();
         for (_, c) in &compiled {
@@ -761,8 +984,19 @@ pub fn plan(
     goal: &Formula,
     config: &PlannerConfig,
 ) -> Result<Plan, PlanError> {
-    let mut task = Task::ground(actions, universe, init)?;
-    task.plan(universe, init, goal, config)
+    let started = Instant::now();
+    let limits = GroundingLimits {
+        grounding: config.grounding,
+        max_actions: config.max_ground_actions,
+        deadline: config.time_limit.map(|t| started + t),
+    };
+    let mut task = Task::ground_within(actions, universe, init, &limits)?;
+    // The search gets what grounding left of the limit.
+    let config = PlannerConfig {
+        time_limit: config.time_limit.map(|t| t.saturating_sub(started.elapsed())),
+        ..*config
+    };
+    task.plan(universe, init, goal, &config)
 }
 
 #[cfg(test)]
@@ -830,6 +1064,107 @@ mod tests {
         assert!(matches!(
             plan(&d.actions, &u, &p.init, &p.goal, &cfg),
             Err(PlanError::Unsolvable { .. })
+        ));
+    }
+
+    /// An untyped domain in the style of a model-written one: a 4-parameter move between
+    /// linked places, over `n` places and one robot.
+    fn untyped_chain(n: usize) -> (crate::pddl::Domain, crate::pddl::Problem) {
+        let d = parse_domain(
+            "(define (domain chain) (:requirements :strips)
+             (:predicates (at ?r ?p) (link ?a ?b) (robot ?r) (free ?p))
+             (:action move :parameters (?r ?from ?to ?via)
+               :precondition (and (robot ?r) (at ?r ?from) (link ?from ?to) (free ?via))
+               :effect (and (at ?r ?to) (not (at ?r ?from)))))",
+        )
+        .unwrap();
+        let places: Vec<String> = (0..n).map(|i| format!("p{i}")).collect();
+        let links: String = (1..n).map(|i| format!("(link p{} p{i}) ", i - 1)).collect();
+        let p = parse_problem(
+            &format!(
+                "(define (problem c) (:domain chain) (:objects r {})
+                  (:init (robot r) (at r p0) (free p0) {links})
+                  (:goal (at r p{})))",
+                places.join(" "),
+                n - 1
+            ),
+            &d,
+        )
+        .unwrap();
+        (d, p)
+    }
+
+    #[test]
+    fn reachable_grounding_keeps_the_plans_and_drops_actions_that_never_apply() {
+        let d = parse_domain(BW).unwrap();
+        let p = parse_problem(
+            "(define (problem s) (:domain bw) (:objects a b c - block)
+              (:init (on c a) (ontable a) (ontable b) (clear b) (clear c) (handempty))
+              (:goal (and (on a b) (on b c))))",
+            &d,
+        )
+        .unwrap();
+        let u = d.universe(&p).unwrap();
+        for search in [Search::Gbfs, Search::AStar] {
+            for heuristic in [Heuristic::HFf, Heuristic::HMax] {
+                let all = PlannerConfig {
+                    search,
+                    heuristic,
+                    ..Default::default()
+                };
+                let reachable = PlannerConfig {
+                    grounding: Grounding::Reachable,
+                    ..all
+                };
+                assert_eq!(
+                    plan(&d.actions, &u, &p.init, &p.goal, &all).unwrap(),
+                    plan(&d.actions, &u, &p.init, &p.goal, &reachable).unwrap(),
+                    "{search:?} {heuristic:?}"
+                );
+            }
+        }
+        // Over the untyped chain, every tuple of 31 objects is 923 521 actions; the
+        // reachable ones are the moves along links, times the one free place.
+        let (d, p) = untyped_chain(30);
+        let u = d.universe(&p).unwrap();
+        let limits = GroundingLimits {
+            grounding: Grounding::Reachable,
+            ..Default::default()
+        };
+        let task = Task::ground_within(&d.actions, &u, &p.init, &limits).unwrap();
+        assert_eq!(task.num_actions(), 29);
+        let optimal = PlannerConfig {
+            search: Search::AStar,
+            heuristic: Heuristic::HMax,
+            grounding: Grounding::Reachable,
+            max_ground_actions: Some(10_000),
+            ..Default::default()
+        };
+        let found = plan(&d.actions, &u, &p.init, &p.goal, &optimal).unwrap();
+        assert_eq!(found.steps.len(), 29);
+    }
+
+    #[test]
+    fn grounding_stops_at_its_cap_and_inside_the_time_limit() {
+        let (d, p) = untyped_chain(30);
+        let u = d.universe(&p).unwrap();
+        let capped = PlannerConfig {
+            max_ground_actions: Some(100_000),
+            ..Default::default()
+        };
+        match plan(&d.actions, &u, &p.init, &p.goal, &capped) {
+            Err(e @ PlanError::TooManyActions { cap: 100_000, .. }) => {
+                assert!(e.to_string().contains("`move`"), "{e}");
+            }
+            other => panic!("{other:?}"),
+        }
+        let no_time = PlannerConfig {
+            time_limit: Some(Duration::ZERO),
+            ..Default::default()
+        };
+        assert!(matches!(
+            plan(&d.actions, &u, &p.init, &p.goal, &no_time),
+            Err(PlanError::GroundingTimeLimit { .. })
         ));
     }
 }

@@ -37,6 +37,8 @@ pub enum BaselineKind {
     Statler,
     /// MoReVQA (event parsing, grounding and verification, visual questions).
     MoReVqa,
+    /// LLM-DM (a model-written PDDL domain and problem, nesy-core's planner).
+    LlmDm,
 }
 
 /// A baseline as a harness method.
@@ -80,6 +82,13 @@ impl Baseline {
     pub fn morevqa() -> Baseline {
         Baseline {
             kind: BaselineKind::MoReVqa,
+        }
+    }
+
+    /// LLM-DM.
+    pub fn llm_dm() -> Baseline {
+        Baseline {
+            kind: BaselineKind::LlmDm,
         }
     }
 
@@ -151,6 +160,18 @@ impl Method for Baseline {
                 },
                 "the domain description, event parsing, grounding and model-executed verification rounds (capped at the budget), three visual sub-questions, then the plan (no check)",
             ),
+            BaselineKind::LlmDm => (
+                "llm-dm",
+                "LLM-DM",
+                Classes {
+                    explicit_adapt: true,
+                    replanning: true,
+                    world_model: true,
+                    symbolic_tool: true,
+                    ..Classes::default()
+                },
+                "a PDDL domain written action by action and a predicted problem, solved by the nesy planner (A* with h_max; not Fast Downward), the domain refined from the planner's report up to the budget, the plan put into words",
+            ),
         };
         MethodInfo {
             name,
@@ -184,6 +205,7 @@ impl Method for Baseline {
                 BaselineKind::CriticV => nesy_baselines::critic::run(client, &baseline_inputs).await,
                 BaselineKind::Statler => nesy_baselines::statler::run(client, &baseline_inputs).await,
                 BaselineKind::MoReVqa => nesy_baselines::morevqa::run(client, &baseline_inputs).await,
+                BaselineKind::LlmDm => nesy_baselines::llmdm::run(client, &baseline_inputs).await,
             }
             .map_err(baseline_failure)?;
             Ok(specified(
@@ -224,6 +246,9 @@ fn specified(plan: BaselinePlan, budget: usize, vlm_s: f64) -> Specified {
 
 /// The unit's failure for a baseline error; an unreadable reply is kept in the message.
 fn baseline_failure(error: BaselineError) -> MethodFailure {
+    if error.is_unresolved() {
+        return MethodFailure::new(UnitStatus::Unresolved, error.to_string());
+    }
     let mut message = error.to_string();
     if let Some(reply) = error.reply() {
         let excerpt: String = reply.chars().take(2000).collect();

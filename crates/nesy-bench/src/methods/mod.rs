@@ -235,6 +235,7 @@ pub fn registry() -> Vec<Arc<dyn Method>> {
         Arc::new(Baseline::critic_v()),
         Arc::new(Baseline::morevqa()),
         Arc::new(Baseline::statler()),
+        Arc::new(Baseline::llm_dm()),
         Arc::new(CodeAsPolicies),
         Arc::new(Imitation),
         Arc::new(Replan),

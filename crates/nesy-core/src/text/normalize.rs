@@ -85,8 +85,10 @@ fn unquote_atoms(text: &str) -> String {
         match after.find('`') {
             Some(close)
                 if {
+                    // A span never crosses a line: a fence's backticks around a one-line
+                    // formula are not a span.
                     let inner = after[..close].trim();
-                    inner.starts_with('(') && inner.ends_with(')') && !inner.contains('\n')
+                    inner.starts_with('(') && inner.ends_with(')') && !after[..close].contains('\n')
                 } =>
             {
                 out.push_str(&rest[..open]);
@@ -110,6 +112,9 @@ mod tests {
     #[test]
     fn fences_and_plain_code_spans_are_kept() {
         let reply = "```\n- (GripperOpen)\n```\nUse `None` for an empty state.";
+        assert_eq!(normalize_reply(reply), reply);
+        // A fenced one-line formula keeps its fences.
+        let reply = "Preconditions\n```\n(and (GripperOpen) (OnTopOf ?x floor))\n```\n";
         assert_eq!(normalize_reply(reply), reply);
     }
 
