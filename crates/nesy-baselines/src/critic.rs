@@ -18,7 +18,7 @@ use crate::demo2code::observe_all;
 use crate::inputs::{BaselineInputs, Fidelity};
 use crate::parse::{LinePatch, apply_line_patches, line_patches, prepared, unordered_list, without_number};
 use crate::prompts::{BaselinePrompts, bullets, numbered, state_lines};
-use crate::stage::{NUMBERED_PLAN, Stage, common_deviations, numbered_plan};
+use crate::stage::{NUMBERED_PLAN, Stage, numbered_plan};
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
 /// The purpose label of the unadapted plan's call.
@@ -142,12 +142,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
             "critic correction"
         );
     }
-    let mut deviations = common_deviations(inputs.fidelity);
-    if repaired {
-        deviations.push(
-            "SEARCH and REPLACE lines are read without list numbers, so numbered edits of the unnumbered plan apply".into(),
-        );
-    }
+    let deviations = crate::Baseline::CriticV.deviations(inputs.fidelity);
     Ok(BaselinePlan {
         steps: plan,
         stages,

@@ -49,7 +49,15 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
             observations: numbered(&observations),
         },
     )?;
-    target_plan(client, inputs, ACTIONS, prompt, stages).await
+    target_plan(
+        crate::Baseline::Demo2Code,
+        client,
+        inputs,
+        ACTIONS,
+        prompt,
+        stages,
+    )
+    .await
 }
 
 /// One observation per keyframe, in keyframe order, with their stage records.

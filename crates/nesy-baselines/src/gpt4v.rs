@@ -54,7 +54,15 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
             end_effector_state: state_lines(&end_effector_atoms(inputs, &inputs.target_state)),
         },
     )?;
-    target_plan(client, inputs, PLAN, prompt, vec![describe]).await
+    target_plan(
+        crate::Baseline::Gpt4vRobotics,
+        client,
+        inputs,
+        PLAN,
+        prompt,
+        vec![describe],
+    )
+    .await
 }
 
 /// The domain description (the first fenced block of the reply) from every keyframe's

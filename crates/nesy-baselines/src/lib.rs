@@ -70,6 +70,95 @@ pub struct BaselinePlan {
     pub instruction: Option<String>,
 }
 
+/// The six baselines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Baseline {
+    /// Demo2Code, adapted to the target at its last stage.
+    Demo2Code,
+    /// GPT4V-Robotics, the target given at planning time.
+    Gpt4vRobotics,
+    /// Critic-V, with the same model as critic.
+    CriticV,
+    /// MoReVQA.
+    MoReVqa,
+    /// Statler, reader and writer in one call per round.
+    Statler,
+    /// LLM-DM, with nesy-core's planner.
+    LlmDm,
+}
+
+impl Baseline {
+    /// Every baseline, in the paper's table order.
+    pub const ALL: [Baseline; 6] = [
+        Baseline::Demo2Code,
+        Baseline::Gpt4vRobotics,
+        Baseline::CriticV,
+        Baseline::MoReVqa,
+        Baseline::Statler,
+        Baseline::LlmDm,
+    ];
+
+    /// Runs the baseline's flow on `inputs`.
+    pub async fn run(
+        self,
+        client: &nesy_vlm::VlmClient,
+        inputs: &BaselineInputs,
+    ) -> Result<BaselinePlan, BaselineError> {
+        match self {
+            Baseline::Demo2Code => demo2code::run(client, inputs).await,
+            Baseline::Gpt4vRobotics => gpt4v::run(client, inputs).await,
+            Baseline::CriticV => critic::run(client, inputs).await,
+            Baseline::MoReVqa => morevqa::run(client, inputs).await,
+            Baseline::Statler => statler::run(client, inputs).await,
+            Baseline::LlmDm => llmdm::run(client, inputs).await,
+        }
+    }
+
+    /// Where the flow departs from the authors' code in `fidelity`, in words: what a run's
+    /// manifest lists, and what every plan carries.
+    pub fn deviations(self, fidelity: Fidelity) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        match self {
+            Baseline::MoReVqa => out.push(
+                "the verification loop is capped at the scenario's budget (the authors' loop has no bound)"
+                    .into(),
+            ),
+            Baseline::LlmDm => {
+                out.push(format!("planned with the {}", llmdm::PLANNER));
+                out.push("a domain or problem that does not parse goes back to the model as the planner's report, with the parser's position (the authors' code raises)".into());
+            }
+            _ => {}
+        }
+        if fidelity == Fidelity::Authors {
+            return out;
+        }
+        out.push(
+            "a reply without its answer is re-asked with the reason (the authors' parser raises)".into(),
+        );
+        let repaired: &[&str] = match self {
+            Baseline::Demo2Code | Baseline::Gpt4vRobotics => &[],
+            Baseline::CriticV => &[
+                "SEARCH and REPLACE lines are read without list numbers, so numbered edits of the unnumbered plan apply",
+            ],
+            Baseline::MoReVqa => &[
+                "JSON objects are read out of prose or a fence (the authors parse the whole reply)",
+                "the grounding call is shown the last check's reason (the authors' template has no slot for it)",
+            ],
+            Baseline::Statler => &[
+                "a reply that writes no world state keeps the previous one",
+                "a \"goal reached\" step in any case, with or without a period, stops the loop and is removed",
+            ],
+            Baseline::LlmDm => &[
+                "the domain is solved once more after the budget's last refinement",
+                "without a plan the unit ends without a specification (the authors generate code from \"None\")",
+            ],
+        };
+        out.extend(repaired.iter().map(|d| d.to_string()));
+        out
+    }
+}
+
 /// The model calls and images one scenario costs a flow, before code generation: exact for
 /// fixed stages, the most for loops.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]

@@ -19,12 +19,13 @@
 //! with a cap on ground actions, and a 10 s limit over grounding and search
 //! ([`PLANNER`]). Its reports are nesy-core's error messages, not Fast Downward's output.
 //!
-//! [`Fidelity::Authors`] keeps the authors' behaviour: a domain or problem that does not parse
-//! ends the unit (their environment is built outside the `try`); after the budget's last
-//! refinement nothing is solved again; and without a plan the specification is the single
-//! step "None", so code generation runs from the instruction alone. [`Fidelity::Repaired`]
-//! sends parse errors back to the model as the planner's report, solves once more after the
-//! last refinement, and ends without a plan as [`BaselineError::NoPlan`].
+//! In both modes a domain or problem that does not parse goes back to the model as the
+//! planner's report, with the parser's position (the authors build their environment
+//! outside the `try`, so there it raises; catching it is a deviation). [`Fidelity::Authors`]
+//! keeps the rest of their behaviour: after the budget's last refinement nothing is solved
+//! again, and without a plan the specification is the single step "None", so code generation
+//! runs from the instruction alone. [`Fidelity::Repaired`] solves once more after the last
+//! refinement and ends without a plan as [`BaselineError::NoPlan`].
 
 use std::time::Duration;
 
@@ -38,7 +39,7 @@ use crate::gpt4v::describe_domain;
 use crate::inputs::{BaselineInputs, Fidelity};
 use crate::parse::{blocks, first_block, ordered_list, prepared, unordered_list};
 use crate::prompts::{BaselinePrompts, bullets, numbered, state_lines};
-use crate::stage::{NUMBERED_PLAN, Stage, StageRecord, common_deviations, numbered_plan};
+use crate::stage::{NUMBERED_PLAN, Stage, StageRecord, numbered_plan};
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
 /// The action-recommendation call.
@@ -127,7 +128,7 @@ struct TranslateVars {
 
 /// Why the planner gave no plan.
 enum SolveError {
-    /// The domain or the problem does not parse (the authors' code raises here).
+    /// The domain or the problem does not parse, with the parser's position.
     Parse(String),
     /// Parsed, but no plan was found.
     Plan(String),
@@ -247,16 +248,9 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
                 found = Some(steps);
                 break;
             }
-            Err(SolveError::Plan(context)) => context,
-            Err(SolveError::Parse(context)) if repaired => context,
-            Err(SolveError::Parse(context)) => {
-                return Err(BaselineError::Unreadable {
-                    purpose: "llmdm.pddl".into(),
-                    reply: format!("{domain}\n\n{problem}"),
-                    problem: context,
-                    attempts: 1,
-                });
-            }
+            // A domain or problem that does not parse is reported like a failed plan; the
+            // authors' code raises there instead (a deviation in both modes).
+            Err(SolveError::Plan(context) | SolveError::Parse(context)) => context,
         };
         if rounds == inputs.budget {
             break;
@@ -284,16 +278,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
         solve_and_refine = repaired || rounds < inputs.budget;
     }
 
-    let mut deviations = vec![format!("planned with the {PLANNER}")];
-    deviations.extend(common_deviations(inputs.fidelity));
-    if repaired {
-        deviations.push("a domain or problem that does not parse goes back to the model as the planner's report (the authors' code raises)".into());
-        deviations.push("the domain is solved once more after the budget's last refinement".into());
-        deviations.push(
-            "without a plan the unit ends without a specification (the authors generate code from \"None\")"
-                .into(),
-        );
-    }
+    let deviations = crate::Baseline::LlmDm.deviations(inputs.fidelity);
     let steps = match found {
         Some(ground) => {
             let prompt = prompts.render(

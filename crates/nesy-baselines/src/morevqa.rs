@@ -23,7 +23,7 @@ use crate::inputs::{BaselineInputs, Fidelity};
 use crate::json;
 use crate::parse::prepared;
 use crate::prompts::{BaselinePrompts, bullets, numbered, state_lines};
-use crate::stage::{NUMBERED_PLAN, Stage, StageRecord, common_deviations, numbered_plan};
+use crate::stage::{NUMBERED_PLAN, Stage, StageRecord, numbered_plan};
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
 /// M1: event parsing.
@@ -244,24 +244,16 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
         .await?;
     keep(record);
 
-    let mut deviations = vec![format!(
-        "the verification loop is capped at the scenario's budget of {} rounds (the authors' loop has no bound); it ran {rounds}{}",
+    let mut deviations = crate::Baseline::MoReVqa.deviations(inputs.fidelity);
+    deviations.push(format!(
+        "the verification loop ran {rounds} of its {} rounds{}",
         inputs.budget,
         if verified {
             " and verified"
         } else {
             " without verifying"
         }
-    )];
-    deviations.extend(common_deviations(inputs.fidelity));
-    if tolerant {
-        deviations
-            .push("JSON objects are read out of prose or a fence (the authors parse the whole reply)".into());
-        deviations.push(
-            "the grounding call is shown the last check's reason (the authors' template has no slot for it)"
-                .into(),
-        );
-    }
+    ));
     Ok(BaselinePlan {
         steps,
         stages,

@@ -154,6 +154,7 @@ impl Stage<'_> {
 /// The last stage of a flow: the rendered prompt with the target's six images, read as a
 /// numbered plan; returns the plan with every stage's record (`earlier` and this one).
 pub(crate) async fn target_plan(
+    baseline: crate::Baseline,
     client: &VlmClient,
     inputs: &crate::BaselineInputs,
     purpose: &'static str,
@@ -176,7 +177,7 @@ pub(crate) async fn target_plan(
     Ok(crate::BaselinePlan {
         steps,
         stages: earlier,
-        deviations: common_deviations(inputs.fidelity),
+        deviations: baseline.deviations(inputs.fidelity),
         rounds: None,
         instruction: None,
     })
@@ -192,15 +193,5 @@ pub(crate) fn numbered_plan(reply: &str) -> Result<Vec<String>, String> {
         Err("it has no numbered list (lines \"1. ...\")".to_string())
     } else {
         Ok(steps)
-    }
-}
-
-/// The deviations every flow has in a fidelity mode (the flows add their own).
-pub(crate) fn common_deviations(fidelity: Fidelity) -> Vec<String> {
-    match fidelity {
-        Fidelity::Authors => Vec::new(),
-        Fidelity::Repaired => {
-            vec!["a reply without its answer is re-asked with the reason (the authors' parser raises)".into()]
-        }
     }
 }

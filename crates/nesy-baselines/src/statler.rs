@@ -23,7 +23,7 @@ use crate::gpt4v::describe_domain;
 use crate::inputs::{BaselineInputs, Fidelity};
 use crate::parse::{ordered_list, unordered_list};
 use crate::prompts::{BaselinePrompts, bullets, numbered, state_lines};
-use crate::stage::{Stage, common_deviations};
+use crate::stage::Stage;
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
 /// The purpose label of the initial-state call.
@@ -140,14 +140,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
             break;
         }
     }
-    let mut deviations = common_deviations(inputs.fidelity);
-    if repaired {
-        deviations.push("a reply that writes no world state keeps the previous one".into());
-        deviations.push(
-            "a \"goal reached\" step in any case, with or without a period, stops the loop and is removed"
-                .into(),
-        );
-    }
+    let deviations = crate::Baseline::Statler.deviations(inputs.fidelity);
     Ok(BaselinePlan {
         steps: actions,
         stages,

@@ -225,6 +225,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, BenchError> {
             variant: v.clone(),
             id: v.id(),
             config_hash: String::new(),
+            deviations: method.deviations(v),
         });
     }
     let files = load_suite(config.suite_dir.as_deref())?;

@@ -84,6 +84,10 @@ pub struct VariantEntry {
     /// Hash of everything that shapes its units' results: the variant, the responder, the
     /// run settings, the simulator and the prompts.
     pub config_hash: String,
+    /// Where the variant departs from the authors' implementation (the baselines' fidelity
+    /// modes, LLM-DM's planner, MoReVQA's cap).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub deviations: Vec<String>,
 }
 
 /// The build and the machine a run came from.

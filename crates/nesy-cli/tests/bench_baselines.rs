@@ -393,6 +393,24 @@ async fn baselines_run_live_record_and_replay_to_the_same_records() {
         assert_eq!(record["scores"]["gc"], 0.5, "{record}");
     }
 
+    // The manifest lists every departure from the authors' code.
+    let manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(live.join("manifest.json")).unwrap()).unwrap();
+    let deviations = |id: &str| -> String {
+        manifest["variants"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|v| v["id"] == id)
+            .map(|v| v["deviations"].to_string())
+            .unwrap_or_default()
+    };
+    assert!(deviations("llm-dm").contains("not Fast Downward"), "{manifest}");
+    assert!(
+        deviations("morevqa").contains("authors' loop has no bound"),
+        "{manifest}"
+    );
+
     // The report counts the calls per method and stage.
     let stages = std::fs::read_to_string(live.join("tables/stages.csv")).unwrap();
     assert!(

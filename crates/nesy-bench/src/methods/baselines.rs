@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use futures::FutureExt as _;
 use futures::future::BoxFuture;
-use nesy_baselines::{BaselineError, BaselineInputs, BaselinePlan, Fidelity, Keyframe, SixViews};
+use nesy_baselines::{Baseline, BaselineError, BaselineInputs, BaselinePlan, Fidelity, Keyframe, SixViews};
 use nesy_core::predicates::Vocabulary;
 use nesy_pipeline::CodegenMode;
 use nesy_sim::demo::CameraName;
@@ -24,77 +24,23 @@ use crate::error::BenchError;
 use crate::record::UnitStatus;
 use crate::variant::Variant;
 
-/// Which baseline.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum BaselineKind {
-    /// Demo2Code (adapted to the target at its last stage).
-    Demo2Code,
-    /// GPT4V-Robotics (the target given at planning time).
-    Gpt4vRobotics,
-    /// Critic-V (the same model as critic).
-    CriticV,
-    /// Statler (reader and writer in one call per round).
-    Statler,
-    /// MoReVQA (event parsing, grounding and verification, visual questions).
-    MoReVqa,
-    /// LLM-DM (a model-written PDDL domain and problem, nesy-core's planner).
-    LlmDm,
-}
-
 /// A baseline as a harness method.
 #[derive(Debug, Clone, Copy)]
-pub struct Baseline {
-    kind: BaselineKind,
+pub struct BaselineMethod {
+    baseline: Baseline,
 }
 
 const SETTINGS: &[&str] = &["fidelity=authors|repaired (the authors' behaviour, or their quirks fixed)"];
 
-impl Baseline {
-    /// Demo2Code.
-    pub fn demo2code() -> Baseline {
-        Baseline {
-            kind: BaselineKind::Demo2Code,
-        }
-    }
-
-    /// GPT4V-Robotics.
-    pub fn gpt4v_robotics() -> Baseline {
-        Baseline {
-            kind: BaselineKind::Gpt4vRobotics,
-        }
-    }
-
-    /// Critic-V.
-    pub fn critic_v() -> Baseline {
-        Baseline {
-            kind: BaselineKind::CriticV,
-        }
-    }
-
-    /// Statler.
-    pub fn statler() -> Baseline {
-        Baseline {
-            kind: BaselineKind::Statler,
-        }
-    }
-
-    /// MoReVQA.
-    pub fn morevqa() -> Baseline {
-        Baseline {
-            kind: BaselineKind::MoReVqa,
-        }
-    }
-
-    /// LLM-DM.
-    pub fn llm_dm() -> Baseline {
-        Baseline {
-            kind: BaselineKind::LlmDm,
-        }
+impl BaselineMethod {
+    /// The harness method of `baseline`.
+    pub fn new(baseline: Baseline) -> BaselineMethod {
+        BaselineMethod { baseline }
     }
 
     /// Which baseline this is.
-    pub fn kind(&self) -> BaselineKind {
-        self.kind
+    pub fn baseline(&self) -> Baseline {
+        self.baseline
     }
 
     fn fidelity(variant: &Variant) -> Result<Fidelity, BenchError> {
@@ -108,10 +54,10 @@ impl Baseline {
     }
 }
 
-impl Method for Baseline {
+impl Method for BaselineMethod {
     fn info(&self) -> MethodInfo {
-        let (name, title, classes, summary) = match self.kind {
-            BaselineKind::Demo2Code => (
+        let (name, title, classes, summary) = match self.baseline {
+            Baseline::Demo2Code => (
                 "demo2code",
                 "Demo2Code",
                 Classes {
@@ -120,7 +66,7 @@ impl Method for Baseline {
                 },
                 "one observation per keyframe, then one call that adapts them into the target's plan (no check)",
             ),
-            BaselineKind::Gpt4vRobotics => (
+            Baseline::Gpt4vRobotics => (
                 "gpt4v-robotics",
                 "GPT4V-Robotics",
                 Classes {
@@ -131,7 +77,7 @@ impl Method for Baseline {
                 },
                 "one domain description from every keyframe's views at once, then one planning call on the target (no check)",
             ),
-            BaselineKind::CriticV => (
+            Baseline::CriticV => (
                 "critic-v",
                 "Critic-V",
                 Classes {
@@ -140,7 +86,7 @@ impl Method for Baseline {
                 },
                 "Demo2Code's unadapted plan, then rounds of model feedback on the target and text-line SEARCH/REPLACE corrections until \"no issue\" (no check)",
             ),
-            BaselineKind::Statler => (
+            Baseline::Statler => (
                 "statler",
                 "Statler",
                 Classes {
@@ -151,7 +97,7 @@ impl Method for Baseline {
                 },
                 "the domain description, a predicted state, then rounds that extend the plan and rewrite the state in text until \"goal reached\" (no check)",
             ),
-            BaselineKind::MoReVqa => (
+            Baseline::MoReVqa => (
                 "morevqa",
                 "MoReVQA",
                 Classes {
@@ -160,7 +106,7 @@ impl Method for Baseline {
                 },
                 "the domain description, event parsing, grounding and model-executed verification rounds (capped at the budget), three visual sub-questions, then the plan (no check)",
             ),
-            BaselineKind::LlmDm => (
+            Baseline::LlmDm => (
                 "llm-dm",
                 "LLM-DM",
                 Classes {
@@ -186,7 +132,13 @@ impl Method for Baseline {
 
     fn validate(&self, variant: &Variant) -> Result<(), BenchError> {
         check_keys(variant, SETTINGS)?;
-        Baseline::fidelity(variant).map(|_| ())
+        BaselineMethod::fidelity(variant).map(|_| ())
+    }
+
+    fn deviations(&self, variant: &Variant) -> Vec<String> {
+        BaselineMethod::fidelity(variant)
+            .map(|f| self.baseline.deviations(f))
+            .unwrap_or_default()
     }
 
     fn specify<'a>(
@@ -195,19 +147,15 @@ impl Method for Baseline {
         client: &'a VlmClient,
     ) -> BoxFuture<'a, Result<Specified, MethodFailure>> {
         async move {
-            let fidelity = Baseline::fidelity(&inputs.variant)
+            let fidelity = BaselineMethod::fidelity(&inputs.variant)
                 .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?;
             let baseline_inputs = baseline_inputs(inputs, fidelity)?;
             let started = Instant::now();
-            let plan = match self.kind {
-                BaselineKind::Demo2Code => nesy_baselines::demo2code::run(client, &baseline_inputs).await,
-                BaselineKind::Gpt4vRobotics => nesy_baselines::gpt4v::run(client, &baseline_inputs).await,
-                BaselineKind::CriticV => nesy_baselines::critic::run(client, &baseline_inputs).await,
-                BaselineKind::Statler => nesy_baselines::statler::run(client, &baseline_inputs).await,
-                BaselineKind::MoReVqa => nesy_baselines::morevqa::run(client, &baseline_inputs).await,
-                BaselineKind::LlmDm => nesy_baselines::llmdm::run(client, &baseline_inputs).await,
-            }
-            .map_err(baseline_failure)?;
+            let plan = self
+                .baseline
+                .run(client, &baseline_inputs)
+                .await
+                .map_err(baseline_failure)?;
             Ok(specified(
                 plan,
                 baseline_inputs.budget,

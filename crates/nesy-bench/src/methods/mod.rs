@@ -26,7 +26,7 @@ use crate::error::BenchError;
 use crate::record::UnitStatus;
 use crate::variant::Variant;
 
-pub use baselines::{Baseline, BaselineKind};
+pub use baselines::BaselineMethod;
 pub use code_as_policies::CodeAsPolicies;
 pub use imitation::Imitation;
 pub use nesycr::NeSyCr;
@@ -216,6 +216,12 @@ pub trait Method: Send + Sync {
     /// Checks a variant's settings (called before a run starts, so a typo fails at once).
     fn validate(&self, variant: &Variant) -> Result<(), BenchError>;
 
+    /// Where the variant departs from the authors' implementation, in words, for the run
+    /// manifest (none by default).
+    fn deviations(&self, _variant: &Variant) -> Vec<String> {
+        Vec::new()
+    }
+
     /// Produces the unit's specification, asking `client` for any model calls (clones of a
     /// client share its transport and accounting).
     fn specify<'a>(
@@ -227,19 +233,16 @@ pub trait Method: Send + Sync {
 
 /// Every method the harness knows, in table order.
 pub fn registry() -> Vec<Arc<dyn Method>> {
-    vec![
-        Arc::new(NeSyCr::full()),
-        Arc::new(NeSyCr::released()),
-        Arc::new(Baseline::demo2code()),
-        Arc::new(Baseline::gpt4v_robotics()),
-        Arc::new(Baseline::critic_v()),
-        Arc::new(Baseline::morevqa()),
-        Arc::new(Baseline::statler()),
-        Arc::new(Baseline::llm_dm()),
-        Arc::new(CodeAsPolicies),
-        Arc::new(Imitation),
-        Arc::new(Replan),
-    ]
+    let mut methods: Vec<Arc<dyn Method>> = vec![Arc::new(NeSyCr::full()), Arc::new(NeSyCr::released())];
+    methods.extend(
+        nesy_baselines::Baseline::ALL
+            .into_iter()
+            .map(|b| Arc::new(BaselineMethod::new(b)) as Arc<dyn Method>),
+    );
+    methods.push(Arc::new(CodeAsPolicies));
+    methods.push(Arc::new(Imitation));
+    methods.push(Arc::new(Replan));
+    methods
 }
 
 /// What `all` in a method list stands for: NeSyCR and every baseline of the paper's Table 1
