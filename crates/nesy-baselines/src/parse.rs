@@ -78,29 +78,7 @@ pub enum BlockError {
 /// ```
 pub fn first_block(reply: &str) -> Result<String, BlockError> {
     let text = prepared(reply);
-    let mut lines = text.lines().enumerate();
-    let (open_line, fence) = lines
-        .by_ref()
-        .find_map(|(i, line)| {
-            let trimmed = line.trim_start();
-            let marker = trimmed.chars().next().filter(|c| *c == '`' || *c == '~')?;
-            let run = trimmed.chars().take_while(|c| *c == marker).count();
-            (run >= 3).then(|| (i + 1, marker.to_string().repeat(run)))
-        })
-        .ok_or(BlockError::NoBlock)?;
-    let mut body = Vec::new();
-    for (_, line) in lines {
-        if line.trim() == fence {
-            let block = body.join("\n").trim().to_string();
-            return if block.is_empty() {
-                Err(BlockError::Empty { line: open_line })
-            } else {
-                Ok(block)
-            };
-        }
-        body.push(line);
-    }
-    Err(BlockError::Unclosed { line: open_line })
+    next_block(&mut text.lines().enumerate()).unwrap_or(Err(BlockError::NoBlock))
 }
 
 /// The texts of every closed fenced block of `reply`, in order (trimmed; empty ones left
@@ -111,23 +89,41 @@ pub fn first_block(reply: &str) -> Result<String, BlockError> {
 /// assert_eq!(nesy_baselines::parse::blocks(reply), ["(:objects a b)", "(:init (on a b))"]);
 /// ```
 pub fn blocks(reply: &str) -> Vec<String> {
+    let text = prepared(reply);
+    let mut lines = text.lines().enumerate();
     let mut out = Vec::new();
-    let mut rest = prepared(reply);
-    while let Ok(block) = first_block(&rest) {
-        // Continue after this block's closing fence.
-        let Some(at) = rest.find(&block) else { break };
-        let after = &rest[at + block.len()..];
-        let Some(close) = after.find('\n').map(|i| i + 1) else {
-            out.push(block);
-            break;
-        };
-        // Skip the closing fence line.
-        let tail = &after[close..];
-        let tail = tail.split_once('\n').map_or("", |(_, r)| r).to_string();
-        out.push(block);
-        rest = tail;
+    while let Some(block) = next_block(&mut lines) {
+        match block {
+            Ok(block) => out.push(block),
+            Err(BlockError::Empty { .. }) => {}
+            Err(_) => break,
+        }
     }
     out
+}
+
+/// The next fenced block of `lines` (opened by three or more backticks or tildes, closed by
+/// the same fence), consuming the lines up to its closing fence; `None` when no fence opens.
+fn next_block<'a>(lines: &mut impl Iterator<Item = (usize, &'a str)>) -> Option<Result<String, BlockError>> {
+    let (open_line, fence) = lines.find_map(|(i, line)| {
+        let trimmed = line.trim_start();
+        let marker = trimmed.chars().next().filter(|c| *c == '`' || *c == '~')?;
+        let run = trimmed.chars().take_while(|c| *c == marker).count();
+        (run >= 3).then(|| (i + 1, marker.to_string().repeat(run)))
+    })?;
+    let mut body = Vec::new();
+    for (_, line) in lines {
+        if line.trim() == fence {
+            let block = body.join("\n").trim().to_string();
+            return Some(if block.is_empty() {
+                Err(BlockError::Empty { line: open_line })
+            } else {
+                Ok(block)
+            });
+        }
+        body.push(line);
+    }
+    Some(Err(BlockError::Unclosed { line: open_line }))
 }
 
 /// One text edit of a plan: lines to find and the lines that replace them.

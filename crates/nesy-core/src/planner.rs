@@ -246,7 +246,7 @@ fn positive_atoms(schema: &Operator) -> Vec<crate::formula::AtomPattern> {
 /// The argument tuples of `schema` whose positive atomic preconditions are all in `facts`,
 /// in the order [`tuples`] would list them: parameters that such an atom mentions are bound
 /// by matching it against the facts of its predicate, the others range over their domain.
-fn joined_tuples(schema: &Operator, domains: &[Vec<Symbol>], facts: &FxHashSet<Atom>) -> Vec<Vec<Symbol>> {
+fn joined_tuples(schema: &Operator, domains: &[Vec<Symbol>], by_pred: &FactIndex) -> Vec<Vec<Symbol>> {
     use crate::formula::Term;
     let index: FxHashMap<Symbol, usize> = schema
         .params
@@ -254,10 +254,6 @@ fn joined_tuples(schema: &Operator, domains: &[Vec<Symbol>], facts: &FxHashSet<A
         .enumerate()
         .map(|(i, p)| (p.name, i))
         .collect();
-    let mut by_pred: FxHashMap<Symbol, Vec<Atom>> = FxHashMap::default();
-    for atom in facts {
-        by_pred.entry(atom.pred()).or_default().push(*atom);
-    }
     let patterns = positive_atoms(schema);
     // Partial bindings, extended one precondition at a time.
     let mut partial: Vec<Vec<Option<Symbol>>> = vec![vec![None; domains.len()]];
@@ -316,29 +312,47 @@ fn joined_tuples(schema: &Operator, domains: &[Vec<Symbol>], facts: &FxHashSet<A
     out
 }
 
-/// The facts reachable from `init` in the delete relaxation, grounding each schema by
-/// [`joined_tuples`] over the facts found so far, until nothing new is added.
+/// Facts by predicate, for [`joined_tuples`].
+type FactIndex = FxHashMap<Symbol, Vec<Atom>>;
+
+fn index_by_predicate(facts: &FxHashSet<Atom>) -> FactIndex {
+    let mut by_pred = FactIndex::default();
+    for atom in facts {
+        by_pred.entry(atom.pred()).or_default().push(*atom);
+    }
+    by_pred
+}
+
+/// The facts reachable from `init` in the delete relaxation, by predicate: each round
+/// grounds every schema by [`joined_tuples`] over the facts of the rounds before, until a
+/// round adds nothing.
 fn relaxed_reachable(
     actions: &[Operator],
     universe: &Universe,
     init: &State,
     limits: &GroundingLimits,
-) -> Result<FxHashSet<Atom>, PlanError> {
-    let mut facts: FxHashSet<Atom> = init.iter().copied().collect();
-    loop {
-        let mut added = false;
-        let mut grounded = 0usize;
-        for schema in actions {
-            let domains: Vec<Vec<Symbol>> = schema
+) -> Result<FactIndex, PlanError> {
+    let domains: Vec<Vec<Vec<Symbol>>> = actions
+        .iter()
+        .map(|schema| {
+            schema
                 .params
                 .iter()
                 .map(|p| universe.objects_of(p.ty))
                 .collect::<Result<_, _>>()
-                .map_err(GroundError::from)?;
+        })
+        .collect::<Result<_, _>>()
+        .map_err(GroundError::from)?;
+    let mut facts: FxHashSet<Atom> = init.iter().copied().collect();
+    loop {
+        let index = index_by_predicate(&facts);
+        let mut added = false;
+        let mut grounded = 0usize;
+        for (schema, domains) in actions.iter().zip(&domains) {
             let candidates = if schema.params.is_empty() {
                 vec![Vec::new()]
             } else {
-                joined_tuples(schema, &domains, &facts)
+                joined_tuples(schema, domains, &index)
             };
             grounded += candidates.len();
             limits.check(grounded, schema)?;
@@ -356,7 +370,7 @@ fn relaxed_reachable(
             }
         }
         if !added {
-            return Ok(facts);
+            return Ok(index);
         }
     }
 }
