@@ -64,6 +64,8 @@ pub struct RunConfig {
     pub run_dir: PathBuf,
     /// The variants.
     pub variants: Vec<Variant>,
+    /// The study these variants make up, if any (the report adds its table).
+    pub study: Option<crate::study::Study>,
     /// The scenarios.
     pub selection: Selection,
     /// Read the suite from this folder instead of generating it.
@@ -211,7 +213,12 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, BenchError> {
             )));
         }
         if let Some(noise) = v.option("noise") {
-            noise_of(noise)?;
+            let knobs = noise_of(noise)?;
+            if knobs.perturbs_states() && v.option("states") != Some("vlm") {
+                return Err(BenchError::Usage(format!(
+                    "variant {v}: the state knobs perturb state translation, which only runs with states=vlm; add +states=vlm"
+                )));
+            }
             if responder != Responder::Oracle {
                 return Err(BenchError::Usage(format!(
                     "variant {v}: `noise` perturbs the offline responder's answers and needs --vlm oracle"
@@ -258,6 +265,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, BenchError> {
         selection: config.selection.clone(),
         settings: config.settings.clone(),
         variants: entries,
+        study: config.study,
         units: units.iter().map(|u| u.key.clone()).collect(),
         reexecutes: config.reexecute.clone(),
         config_hash: String::new(),
@@ -487,7 +495,7 @@ fn unit_dir(shared: &Shared, unit: &Unit) -> PathBuf {
 }
 
 /// `ROOT/<scenario>/<variant>[.r<k>].json`. The suffix is appended, not set: a variant id
-/// holds dots (`noise=drop=0.1`) and a repeat ends in `.r<k>`, and `set_extension` would
+/// holds dots (`noise=op-drop=0.1`) and a repeat ends in `.r<k>`, and `set_extension` would
 /// replace either, so two units would share one recording.
 fn cassette_path(unit: &Unit, root: &Path) -> PathBuf {
     recording_path(&unit.key, &unit.variant, root)
@@ -1137,8 +1145,8 @@ mod tests {
             path("nesycr", 0),
             path("nesycr", 1),
             path("nesycr", 2),
-            path("nesycr+noise=drop=0.1", 0),
-            path("nesycr+noise=drop=0.2", 0),
+            path("nesycr+noise=op-drop=0.1", 0),
+            path("nesycr+noise=op-drop=0.2", 0),
         ];
         for (i, a) in paths.iter().enumerate() {
             assert_eq!(a.extension().and_then(|e| e.to_str()), Some("json"), "{a:?}");

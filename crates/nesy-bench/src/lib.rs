@@ -14,6 +14,8 @@
 //! - [`shard`], [`merge`]: job arrays and their merge; [`slurm`] writes the `sbatch` file.
 //! - [`plan`]: model calls and images per method and cell, before any call.
 //! - [`report`]: `report.md`, `tables/*.csv` and PNG plots.
+//! - [`study`]: the ablation and robustness studies, each a set of variants under one
+//!   stated error model, reported in the shape of the paper's Table 3 and Table 8.
 //!
 //! Offline, no number is a method's performance: the reference responder bounds NeSyCR
 //! from above, the controls measure the benchmark, and every report says which it is.
@@ -32,6 +34,7 @@ pub mod report;
 pub mod shard;
 pub mod slurm;
 pub mod store;
+pub mod study;
 pub mod unit;
 pub mod variant;
 

@@ -144,6 +144,9 @@ pub struct Manifest {
     pub settings: RunSettings,
     /// The variants.
     pub variants: Vec<VariantEntry>,
+    /// The study the variants make up, if the run is one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub study: Option<crate::study::Study>,
     /// Every unit, in stable order.
     pub units: Vec<UnitKey>,
     /// The run whose specifications this run re-executes (phase B only), if any.
@@ -172,6 +175,8 @@ impl Manifest {
             repeats: u32,
             settings: &'a RunSettings,
             variants: &'a [VariantEntry],
+            #[serde(skip_serializing_if = "Option::is_none")]
+            study: Option<crate::study::Study>,
             units: &'a [UnitKey],
             reexecutes: &'a Option<PathBuf>,
         }
@@ -184,6 +189,7 @@ impl Manifest {
             repeats: self.repeats,
             settings: &self.settings,
             variants: &self.variants,
+            study: self.study,
             units: &self.units,
             reexecutes: &self.reexecutes,
         })

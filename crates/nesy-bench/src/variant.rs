@@ -1,5 +1,5 @@
 //! A variant is a method with its settings, written `method` or `method+key=value+…` on the
-//! command line (`nesycr+verification=off`, `nesycr+noise=drop=0.1;flip=0.05`). Units
+//! command line (`nesycr+verification=off`, `nesycr+noise=op-drop=0.1;op-flip=0.05`). Units
 //! of one variant share a configuration hash; a resumed run refuses records of a variant
 //! whose settings changed.
 
@@ -155,8 +155,8 @@ mod tests {
         assert_eq!(v.method, "nesycr");
         assert_eq!(v.id(), "nesycr+on-unresolved=compile-last+verification=off");
         assert_eq!(Variant::parse(&v.id()).unwrap(), v);
-        let noisy = Variant::parse("nesycr+noise=drop=0.1;flip=0.05").unwrap();
-        assert_eq!(noisy.option("noise"), Some("drop=0.1;flip=0.05"));
+        let noisy = Variant::parse("nesycr+noise=op-drop=0.1;op-flip=0.05").unwrap();
+        assert_eq!(noisy.option("noise"), Some("op-drop=0.1;op-flip=0.05"));
         assert!(Variant::parse("").is_err());
         let all: Vec<String> = Variant::parse_list("all,imitation")
             .unwrap()

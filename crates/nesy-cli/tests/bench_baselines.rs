@@ -270,22 +270,39 @@ const CORRECTION: &str = "Case 1: the green cube must be moved first.
 3. Move the gripper around the red cube.
 >>>>>>> REPLACE";
 
+const BASELINES: &str = "demo2code,gpt4v-robotics,critic-v,morevqa,statler,llm-dm";
+
 fn bench(run: &Path, demos: &Path, vlm: &str) -> std::process::Output {
-    let output = common::nesy(&[
+    bench_with(run, demos, vlm, BASELINES, SCENARIO, &[])
+}
+
+/// `nesy bench run` of `methods` on `scenarios`, which must exit 0.
+fn bench_with(
+    run: &Path,
+    demos: &Path,
+    vlm: &str,
+    methods: &str,
+    scenarios: &str,
+    extra: &[&str],
+) -> std::process::Output {
+    let mut args: Vec<String> = vec![
         "bench".into(),
         "run".into(),
         run.display().to_string(),
         "--methods".into(),
-        "demo2code,gpt4v-robotics,critic-v,morevqa,statler,llm-dm".into(),
+        methods.into(),
         "--scenarios".into(),
-        SCENARIO.into(),
+        scenarios.into(),
         "--vlm".into(),
         vlm.into(),
-        "--vlm-model".into(),
-        "mock-vlm".into(),
         "--demos".into(),
         demos.display().to_string(),
-    ]);
+    ];
+    if vlm != "oracle" {
+        args.extend(["--vlm-model".to_owned(), "mock-vlm".to_owned()]);
+    }
+    args.extend(extra.iter().map(|s| s.to_string()));
+    let output = common::nesy(&args);
     assert_eq!(
         output.status.code(),
         Some(0),
@@ -298,6 +315,15 @@ fn bench(run: &Path, demos: &Path, vlm: &str) -> std::process::Output {
 
 /// The unit records of a run, by method, without the fields that measure time or place.
 fn records(run: &Path) -> BTreeMap<String, Value> {
+    records_by_unit(run)
+        .into_values()
+        .map(|r| (r["method"].as_str().unwrap().to_string(), r))
+        .collect()
+}
+
+/// The unit records of a run by unit (scenario and variant), without the fields that
+/// measure time or place, or depend on the responder's configuration and price.
+fn records_by_unit(run: &Path) -> BTreeMap<String, Value> {
     let mut out = BTreeMap::new();
     for entry in std::fs::read_dir(run.join("results")).unwrap().flatten() {
         for line in std::fs::read_to_string(entry.path()).unwrap().lines() {
@@ -307,7 +333,12 @@ fn records(run: &Path) -> BTreeMap<String, Value> {
             }
             let effort = record["effort"].as_object_mut().unwrap();
             effort.retain(|k, _| !k.ends_with("_s"));
-            out.insert(record["method"].as_str().unwrap().to_string(), record);
+            let unit = format!(
+                "{}/{}",
+                record["scenario"].as_str().unwrap(),
+                record["variant"].as_str().unwrap()
+            );
+            out.insert(unit, record);
         }
     }
     out
@@ -439,6 +470,96 @@ async fn baselines_run_live_record_and_replay_to_the_same_records() {
                 r["effort"].as_object_mut().unwrap().remove("cost_usd");
             }
             assert_eq!(got, expected, "{method}");
+        }
+    }
+}
+
+/// `--methods all` over the three fixture scenarios of the README's small run, replayed:
+/// NeSyCR's calls recorded from the offline responder, the six baselines' from the
+/// hand-written server; both sets of cassettes together replay twice into the same records,
+/// and those are the recorded runs' records.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn all_methods_replay_to_identical_records_over_the_fixture_scenarios() {
+    const FIXTURES: &str = "obst_low_00_s0,grip_low_02_s0,comb_low_00_s0";
+    let scratch = common::scratch();
+    let demos = scratch.path().join("demos");
+    let oracle = scratch.path().join("oracle");
+    let live = scratch.path().join("live");
+    let (oracle_dir, demos_dir) = (oracle.clone(), demos.clone());
+    tokio::task::spawn_blocking(move || {
+        bench_with(
+            &oracle_dir,
+            &demos_dir,
+            "oracle",
+            "nesycr",
+            FIXTURES,
+            &["--record-cassettes"],
+        )
+    })
+    .await
+    .unwrap();
+    let server = MockServer::start().await;
+    Mock::given(method("POST"))
+        .and(path("/v1/chat/completions"))
+        .respond_with(HandWritten::default())
+        .mount(&server)
+        .await;
+    let url = format!("{}/v1", server.uri());
+    let (live_dir, demos_dir) = (live.clone(), demos.clone());
+    // One unit at a time: the server's replies depend on how often it was asked.
+    tokio::task::spawn_blocking(move || {
+        bench_with(&live_dir, &demos_dir, &url, BASELINES, FIXTURES, &["--jobs", "1"])
+    })
+    .await
+    .unwrap();
+    let mut recorded = records_by_unit(&oracle);
+    recorded.extend(records_by_unit(&live));
+    assert_eq!(recorded.len(), 3 * 7, "{:?}", recorded.keys());
+
+    let cassettes = scratch.path().join("cassettes");
+    for from in [oracle.join("cassettes"), live.join("cassettes")] {
+        copy_tree(&from, &cassettes);
+    }
+    let vlm = format!("replay:{}", cassettes.display());
+    let mut replays = Vec::new();
+    for name in ["replay-1", "replay-2"] {
+        let run = scratch.path().join(name);
+        let (run_dir, demos_dir, vlm) = (run.clone(), demos.clone(), vlm.clone());
+        tokio::task::spawn_blocking(move || bench_with(&run_dir, &demos_dir, &vlm, "all", FIXTURES, &[]))
+            .await
+            .unwrap();
+        replays.push(records_by_unit(&run));
+    }
+    let strip = |mut r: Value| {
+        r.as_object_mut().unwrap().remove("config_hash");
+        r["effort"].as_object_mut().unwrap().remove("cost_usd");
+        r
+    };
+    assert_eq!(replays[0], replays[1], "two replays differ");
+    for (unit, record) in &recorded {
+        let got = replays[0]
+            .get(unit)
+            .unwrap_or_else(|| panic!("{unit} not replayed"));
+        assert_eq!(strip(got.clone()), strip(record.clone()), "{unit}");
+    }
+    // NeSyCR's replayed answers are the responder's: it succeeds on all three.
+    for scenario in FIXTURES.split(',') {
+        assert_eq!(
+            recorded[&format!("{scenario}/nesycr")]["status"],
+            "succeeded",
+            "{scenario}"
+        );
+    }
+}
+
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap().flatten() {
+        let target = to.join(entry.file_name());
+        if entry.path().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
         }
     }
 }

@@ -221,3 +221,73 @@ fn methods_plan_and_bad_input() {
     assert_eq!(offline.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&offline.stderr).contains("cannot answer them honestly"));
 }
+
+/// `--study ablation` on one Combination/medium scenario: the five rows under one error
+/// model, the table with its SYNTHETIC banner, the CSV and the figure; a state knob without
+/// translated states and an unknown study are refused.
+#[test]
+fn the_ablation_study_runs_its_rows_and_reports_them_in_table_3_shape() {
+    let scratch = common::scratch();
+    let run = scratch.path().join("ablation");
+    let demos = scratch.path().join("demos");
+    let out = common::nesy(&[
+        "bench".into(),
+        "run".into(),
+        run.display().to_string(),
+        "--study".into(),
+        "ablation".into(),
+        "--scenarios".into(),
+        "comb_medium_07_s1".into(),
+        "--repeats".into(),
+        "2".into(),
+        "--vlm".into(),
+        "oracle".into(),
+        "--demos".into(),
+        demos.display().to_string(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Five rows × two repeats.
+    assert_eq!(lines(&run), 10);
+    let report = std::fs::read_to_string(run.join("report.md")).unwrap();
+    assert!(report.contains("## Ablations (Table 3 shape)"), "{report}");
+    assert!(
+        report.contains("SYNTHETIC — no model answered. Error model:"),
+        "{report}"
+    );
+    assert!(report.contains("reading A"), "{report}");
+    let csv = table(&run, "study.csv");
+    assert_eq!(csv.lines().count(), 6, "{csv}");
+    assert!(
+        csv.lines().nth(1).unwrap().starts_with("ablation,NeSyCR,"),
+        "{csv}"
+    );
+    assert!(run.join("plots/study.png").is_file());
+    let manifest = std::fs::read_to_string(run.join("manifest.json")).unwrap();
+    assert!(manifest.contains("\"study\": \"ablation\""), "{manifest}");
+
+    let stateless = common::nesy(&[
+        "bench".into(),
+        "plan".into(),
+        "--methods".into(),
+        "nesycr+noise=state-drop=0.1".into(),
+        "--vlm".into(),
+        "oracle".into(),
+    ]);
+    assert_eq!(stateless.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&stateless.stderr).contains("add +states=vlm"));
+    let unknown = common::nesy(&[
+        "bench".into(),
+        "plan".into(),
+        "--study".into(),
+        "ablations".into(),
+        "--vlm".into(),
+        "oracle".into(),
+    ]);
+    assert_eq!(unknown.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&unknown.stderr).contains("expected one of ablation, robustness"));
+}

@@ -35,7 +35,7 @@ pub enum VlmSource {
     Url(String, Box<ConfigOverrides>),
     /// Replay a cassette, never touching the network.
     Replay(PathBuf),
-    /// The offline reference responder, with its noise settings (`drop=0.1,flip=0.1`...).
+    /// The offline reference responder, with its noise settings (`op-drop=0.1,bad-patch=0.2`...).
     Oracle {
         /// Noise knobs as given on the command line (empty: none).
         noise: String,

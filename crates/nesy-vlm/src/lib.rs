@@ -66,7 +66,7 @@
 //! use std::sync::Arc;
 //! use nesy_vlm::{BackendKind, OracleNoise, OracleTransport, VlmClient, VlmConfig};
 //!
-//! let noise: OracleNoise = "drop=0.1,bad-patch=0.2".parse().unwrap();
+//! let noise: OracleNoise = "op-drop=0.1,bad-patch=0.2".parse().unwrap();
 //! let oracle = Arc::new(OracleTransport::new().unwrap().with_noise(noise, 7));
 //! let config = VlmConfig::new(BackendKind::OpenAi, "oracle");
 //! let client = VlmClient::with_transport(&config, oracle.clone());

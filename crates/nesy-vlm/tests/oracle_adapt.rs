@@ -288,7 +288,7 @@ async fn heavy_noise_ends_verified_or_honestly_unresolved() {
         source: Embodiment::Finger,
         target: Embodiment::Finger,
     };
-    let r = adapt_and_execute(&case, "drop=0.1,flip=0.1,bad-patch=0.5".parse().unwrap(), 4).await;
+    let r = adapt_and_execute(&case, "op-drop=0.1,op-flip=0.1,bad-patch=0.5".parse().unwrap(), 4).await;
     println!("{:?} {:?}", r.stats, r.outcome.is_adapted());
     assert!(r.stats.perturbed_literals > 0);
     match &r.outcome {

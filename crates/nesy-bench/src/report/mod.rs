@@ -8,6 +8,7 @@
 //! unusable demonstration are excluded from every method alike and listed.
 
 pub mod plot;
+mod study;
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -192,6 +193,25 @@ pub struct ReportFiles {
 
 /// The banner of an offline run: what its numbers are and are not.
 pub fn banner(manifest: &Manifest) -> Option<String> {
+    let noisy: Vec<String> = manifest
+        .variants
+        .iter()
+        .filter_map(|v| v.variant.option("noise").map(|n| format!("`{n}`")))
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let base = base_banner(manifest)?;
+    Some(if noisy.is_empty() {
+        base
+    } else {
+        format!(
+            "{base} SYNTHETIC: variants with `noise` degrade the responder's answers on purpose under the stated error model ({}); their rows are not upper bounds either.",
+            noisy.join(", ")
+        )
+    })
+}
+
+fn base_banner(manifest: &Manifest) -> Option<String> {
     match &manifest.responder {
         Responder::Live { .. } => None,
         Responder::Oracle => Some(
@@ -273,7 +293,24 @@ pub fn write(run: &Path, options: &ReportOptions) -> Result<ReportFiles, BenchEr
         canvas.save(&path)?;
         files.plots.push(path);
     }
-    let md = markdown(&manifest, &tables, &ordered, &missing, banner.as_deref());
+    let study = manifest.study.map(|s| study::StudyTable::build(s, &ordered));
+    if let Some(table) = &study {
+        let path = run.join("tables").join("study.csv");
+        std::fs::write(&path, table.csv()).map_err(|e| BenchError::io(&path, e))?;
+        files.tables.push(path);
+        let path = run.join("plots").join("study.png");
+        table.plot().save(&path)?;
+        files.plots.push(path);
+    }
+    let study_md = study.as_ref().map(study::StudyTable::markdown);
+    let md = markdown(
+        &manifest,
+        &tables,
+        &ordered,
+        &missing,
+        banner.as_deref(),
+        study_md.as_deref(),
+    );
     std::fs::write(&files.report, md).map_err(|e| BenchError::io(&files.report, e))?;
     Ok(files)
 }
@@ -377,6 +414,7 @@ fn markdown(
     records: &[&UnitRecord],
     missing: &[String],
     banner: Option<&str>,
+    study: Option<&str>,
 ) -> String {
     let mut md = String::new();
     let partial = if missing.is_empty() { "" } else { " — PARTIAL" };
@@ -444,6 +482,10 @@ fn markdown(
             "excluded from every method (`demo_unusable`)"
         }
     );
+    if let Some(section) = study {
+        let _ = writeln!(md);
+        md.push_str(section);
+    }
     let _ = writeln!(md, "\n## Methods\n");
     for v in &manifest.variants {
         if let Ok(m) = methods::find(&v.variant.method) {

@@ -34,7 +34,7 @@ pub struct AdaptArgs {
     /// Record every model call to this cassette (replay it later with `--vlm replay:FILE`).
     #[arg(long, value_name = "CASSETTE")]
     pub record: Option<PathBuf>,
-    /// Noise for `--vlm oracle`, e.g. `drop=0.1,flip=0.1,bad-patch=0.2`.
+    /// Noise for `--vlm oracle`, e.g. `op-drop=0.1,state-inject=0.1,bad-patch=0.2` (`nesy-vlm`'s README lists the knobs).
     #[arg(long, value_name = "SPEC", default_value = "")]
     pub oracle_noise: String,
     /// Symbolic states: ground truth (`observed`), the VLM's state translation (`vlm`), or

@@ -13,6 +13,7 @@ use nesy_bench::demos::DemoCache;
 use nesy_bench::harness::{self, Prepared};
 use nesy_bench::manifest::{Manifest, RunSettings};
 use nesy_bench::methods::{self, OfflineMeaning, Role};
+use nesy_bench::study::Study;
 use nesy_bench::{
     BenchProgress, ResponderSetup, RunConfig, Selection, Shard, StopSignal, UnitRecord, UnitStatus, Variant,
 };
@@ -80,21 +81,29 @@ pub struct RunArgs {
     /// again resumes.
     pub run: Option<PathBuf>,
     /// Methods and variants, comma-separated: `nesycr,imitation,replan`,
-    /// `nesycr+verification=off` (`nesy bench methods` lists them).
-    #[arg(long, value_name = "LIST", default_value = "nesycr")]
-    pub methods: String,
-    /// Scenarios: `all`, or ids and id prefixes, comma-separated (`comb_medium`).
-    #[arg(long, value_name = "LIST", default_value = "all")]
-    pub scenarios: String,
+    /// `nesycr+verification=off` (`nesy bench methods` lists them). Default `nesycr`, or
+    /// the study's variants with `--study`.
+    #[arg(long, value_name = "LIST")]
+    pub methods: Option<String>,
+    /// A study: `ablation` (Table 3's shape) or `robustness` (Table 8's shape), each a set
+    /// of NeSyCR variants under one stated error model, on Combination/medium with 3
+    /// repeats unless `--scenarios` and `--repeats` say otherwise. Needs `--vlm oracle`.
+    #[arg(long, value_name = "NAME", conflicts_with = "methods")]
+    pub study: Option<String>,
+    /// Scenarios: `all`, or ids and id prefixes, comma-separated (`comb_medium`). Default
+    /// `all`, or the study's cell with `--study`.
+    #[arg(long, value_name = "LIST")]
+    pub scenarios: Option<String>,
     /// Keep a random sample of this many of the selected scenarios.
     #[arg(long, value_name = "N")]
     pub sample: Option<usize>,
     /// Seed of `--sample`.
     #[arg(long, value_name = "SEED", default_value_t = 0)]
     pub sample_seed: u64,
-    /// Repeats per method and scenario.
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub repeats: u32,
+    /// Repeats per method and scenario, each with its own seed. Default 1, or 3 with
+    /// `--study`.
+    #[arg(long, value_name = "N")]
+    pub repeats: Option<u32>,
     /// The run seed every unit's seed derives from.
     #[arg(long, value_name = "SEED", default_value_t = 0)]
     pub seed: u64,
@@ -252,7 +261,13 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
         "--policy-timeout must be a positive number of seconds, got {}",
         args.policy_timeout
     );
-    anyhow::ensure!(args.repeats >= 1, "--repeats must be at least 1");
+    let study = args.study.as_deref().map(Study::parse).transpose()?;
+    let repeats = args.repeats.unwrap_or(if study.is_some() {
+        Study::DEFAULT_REPEATS
+    } else {
+        1
+    });
+    anyhow::ensure!(repeats >= 1, "--repeats must be at least 1");
     if let Some(r) = args.max_error_rate {
         anyhow::ensure!(
             (0.0..=1.0).contains(&r),
@@ -265,7 +280,12 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
             "--max-cost-usd must be a non-negative number, got {c}"
         );
     }
-    let mut selection = Selection::parse(&args.scenarios);
+    let scenarios = args.scenarios.as_deref().unwrap_or(if study.is_some() {
+        Study::DEFAULT_SCENARIOS
+    } else {
+        "all"
+    });
+    let mut selection = Selection::parse(scenarios);
     selection.sample = args.sample;
     selection.sample_seed = args.sample_seed;
     let run_dir = args
@@ -274,10 +294,14 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
         .unwrap_or_else(|| PathBuf::from("runs/bench").join(harness::default_run_id()));
     Ok(RunConfig {
         run_dir,
-        variants: Variant::parse_list(&args.methods)?,
+        variants: match study {
+            Some(s) => s.rows().into_iter().map(|r| r.variant).collect(),
+            None => Variant::parse_list(args.methods.as_deref().unwrap_or("nesycr"))?,
+        },
+        study,
         selection,
         suite_dir: args.suite.clone(),
-        repeats: args.repeats,
+        repeats,
         run_seed: args.seed,
         responder: responder(args)?,
         demo_cache: args.demos.clone(),

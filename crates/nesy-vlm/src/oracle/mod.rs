@@ -32,8 +32,10 @@ use serde::{Deserialize, Serialize};
 
 pub use domain::{DomainError, NESY_WORLD_PDDL, WorldDomain, object_type, semantic};
 pub use induce::{InduceError, InducedAction, RecordedCall, api_function, induce};
-pub use noise::{NoiseError, NoiseRng, OracleNoise};
-pub use patch::{OraclePatchError, ProposedPatch, Strategy, plan_to_goal, propose};
+pub use noise::{NoiseError, NoiseRng, OracleNoise, Relations, StateScope};
+pub use patch::{
+    OraclePatchError, ProposedPatch, Strategy, misplaced, plan_to_goal, propose, propose_for_guess,
+};
 
 use crate::context::{CodeGenerationContext, StateTranslationContext, VlmTask};
 use crate::error::TransportError;
@@ -73,8 +75,11 @@ pub struct OracleStats {
     pub patches: usize,
     /// Patch replies corrupted by `bad_patch`.
     pub corrupted_patches: usize,
-    /// Literals or atoms changed by `drop`/`flip`.
+    /// Operator literals and state atoms changed by the operator and state knobs.
     pub perturbed_literals: usize,
+    /// Patch requests without identification whose failing step the oracle guessed
+    /// (`localize_miss`).
+    pub localize_misses: usize,
     /// State translations.
     pub translations: usize,
     /// Programs compiled.
@@ -162,7 +167,24 @@ impl OracleTransport {
                 Ok(induce::format_reply(&action, call.as_ref()))
             }
             VlmTask::Patch(ctx) => {
-                let mut proposed = match propose(self.world, &ctx, &self.planner) {
+                // Without identification, a model may patch the wrong step: the guess
+                // replaces the request before the planner sees it.
+                // When nothing can be planned for the guessed step, the answer is the
+                // correctly localised one.
+                let guessed = if rng.chance(self.noise.localize_miss) {
+                    patch::misplaced(&ctx, &mut |n| rng.below(n))
+                        .and_then(|g| patch::propose_for_guess(self.world, &g, &self.planner).ok())
+                } else {
+                    None
+                };
+                if guessed.is_some() {
+                    self.bump(|s| s.localize_misses += 1);
+                }
+                let answer = match guessed {
+                    Some(p) => Ok(p),
+                    None => propose(self.world, &ctx, &self.planner),
+                };
+                let mut proposed = match answer {
                     Ok(p) => p,
                     Err(e) => {
                         // An honest non-answer, said in a typed way: the same request would get
@@ -242,27 +264,19 @@ fn translate(
         ))
     })?;
     let objects: Vec<Symbol> = ctx.objects.iter().map(|o| Symbol::new(o)).collect();
+    let mut atoms: Vec<Atom> = truth
+        .sorted_by_text()
+        .into_iter()
+        .filter(|a| !ctx.known.contains(a))
+        .copied()
+        .collect();
     let mut changed = 0;
-    let mut lines = Vec::new();
-    for atom in truth.sorted_by_text() {
-        if ctx.known.contains(atom) {
-            continue;
-        }
-        if rng.chance(noise.drop) {
-            changed += 1;
-            continue;
-        }
-        let mut atom = *atom;
-        if rng.chance(noise.flip) && !atom.args().is_empty() && objects.len() > 1 {
-            let mut args = atom.args().to_vec();
-            let last = args.len() - 1;
-            let others: Vec<Symbol> = objects.iter().copied().filter(|o| *o != args[last]).collect();
-            args[last] = others[rng.below(others.len())];
-            atom = Atom::from_symbols(atom.pred(), args);
-            changed += 1;
-        }
-        lines.push(format!("- {atom}"));
+    if noise.perturbs_states() && noise.state_scope.covers(&ctx.view_set) {
+        let (perturbed, report) = noise::perturb_state(&atoms, &objects, noise, rng);
+        atoms = perturbed;
+        changed = report.changed();
     }
+    let mut lines: Vec<String> = atoms.iter().map(|a| format!("- {a}")).collect();
     if lines.is_empty() {
         lines.push("None".into());
     }
@@ -302,5 +316,79 @@ impl Transport for OracleTransport {
         } else {
             format!("oracle noise {}", self.noise)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nesy_core::predicates::Tier;
+    use nesy_core::state::State;
+
+    use super::*;
+
+    fn translation(view_set: &str, truth: &State) -> WireRequest {
+        let ctx = StateTranslationContext {
+            view_set: view_set.into(),
+            instruction: "put the cubes in the box".into(),
+            objects: ["red_cube", "green_cube", "blue_cube", "toy_box", "floor"]
+                .map(String::from)
+                .to_vec(),
+            tier: Tier::Full,
+            known: State::new(),
+            ground_truth: Some(truth.clone()),
+        };
+        WireRequest {
+            path: "/chat/completions".into(),
+            body: serde_json::json!({"view": view_set}),
+            task: Some(VlmTask::StateTranslation(ctx).to_task_context()),
+            purpose: None,
+        }
+    }
+
+    fn atoms_of(reply: &str) -> Vec<Atom> {
+        reply
+            .lines()
+            .filter_map(|l| l.strip_prefix("- "))
+            .map(|a| a.parse().unwrap())
+            .collect()
+    }
+
+    fn truth() -> State {
+        [
+            "(OnTopOf red_cube floor)",
+            "(OnTopOf green_cube red_cube)",
+            "(OnTopOf blue_cube floor)",
+            "(InsideOf blue_cube toy_box)",
+            "(OnTopOf toy_box floor)",
+            "(GripperOpen)",
+        ]
+        .iter()
+        .map(|a| a.parse::<Atom>().unwrap())
+        .collect()
+    }
+
+    #[test]
+    fn demo_scope_perturbs_keyframes_and_leaves_the_target_untouched() {
+        let noise: OracleNoise = "state-drop=0.4,state-inject=0.4".parse().unwrap();
+        let oracle = OracleTransport::new().unwrap().with_noise(noise, 3);
+        let truth = truth();
+        let mut sorted: Vec<Atom> = truth.sorted_by_text().into_iter().copied().collect();
+        sorted.sort_by_key(|a| a.to_string());
+        let target = atoms_of(&oracle.answer(&translation("target/initial", &truth)).unwrap());
+        assert_eq!(target, sorted, "the target is out of scope");
+        let demo = atoms_of(&oracle.answer(&translation("demo/keyframe/2", &truth)).unwrap());
+        assert_ne!(demo, sorted, "a demo keyframe is in scope");
+        // 0.4 of 5 binary relations: 2 dropped, 2 injected.
+        assert_eq!(demo.iter().filter(|a| !truth.contains(a)).count(), 2, "{demo:?}");
+        assert_eq!(truth.iter().filter(|a| !demo.contains(a)).count(), 2, "{demo:?}");
+        assert_eq!(oracle.stats().perturbed_literals, 4);
+
+        let both = OracleTransport::new()
+            .unwrap()
+            .with_noise("state-drop=0.4,state-scope=target".parse().unwrap(), 3);
+        let target = atoms_of(&both.answer(&translation("target/initial", &truth)).unwrap());
+        assert_eq!(target.len(), sorted.len() - 2);
+        let demo = atoms_of(&both.answer(&translation("demo/keyframe/2", &truth)).unwrap());
+        assert_eq!(demo, sorted);
     }
 }

@@ -242,11 +242,70 @@ pub fn plan_to_goal(
     planning.plan(state, goal).map(|(ops, _)| ops)
 }
 
-/// Proposes a patch for a refinement request.
+/// A patch request made without identification, re-aimed at a step the oracle guesses
+/// instead of the one that fails (`localize_miss`): a step other than the first failing
+/// one whose preconditions do not hold in ŝ₁, the only state such a request carries, with
+/// those unmet preconditions and ŝ₁ as its error state. `pick(n)` chooses among the `n`
+/// candidates. `None` when the request is identified or no other step is a candidate, so
+/// the guess would be the true failing step.
+pub fn misplaced(ctx: &PatchContext, pick: &mut dyn FnMut(usize) -> usize) -> Option<PatchContext> {
+    let req = &ctx.request;
+    if req.kind != ViolationKind::Unidentified || req.procedure.is_empty() {
+        return None;
+    }
+    let truly_failing = verify_procedure(&req.initial_state, &req.procedure, None).first_failure;
+    let candidates: Vec<(usize, Vec<UnmetPrecondition>)> = req
+        .procedure
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| Some(*i) != truly_failing)
+        .filter_map(|(i, op)| match apply(&req.initial_state, op) {
+            Err(ExecError::Violation(v)) => Some((i, v.unmet)),
+            _ => None,
+        })
+        .collect();
+    if candidates.is_empty() {
+        return None;
+    }
+    let (step, unmet) = candidates[pick(candidates.len()).min(candidates.len() - 1)].clone();
+    let mut guessed = ctx.clone();
+    let r = &mut guessed.request;
+    r.kind = ViolationKind::Precondition;
+    r.failing_step = Some(step);
+    r.executed = r.procedure[..step].to_vec();
+    r.erroneous = Some(r.procedure[step].clone());
+    r.remaining = r.procedure[step + 1..].to_vec();
+    r.error_state = r.initial_state.clone();
+    r.unmet = unmet;
+    Some(guessed)
+}
+
+/// Proposes a patch for a refinement request: the best candidate that passes the
+/// verifier's own check.
 pub fn propose(
     world: &WorldDomain,
     ctx: &PatchContext,
     config: &PlannerConfig,
+) -> Result<ProposedPatch, OraclePatchError> {
+    propose_checked(world, ctx, config, true)
+}
+
+/// Proposes a patch for a request re-aimed by [`misplaced`]: the first candidate for the
+/// guessed step, unchecked, since a model that guessed the step has no check either (the
+/// loop's verification, when on, is what rejects it).
+pub fn propose_for_guess(
+    world: &WorldDomain,
+    ctx: &PatchContext,
+    config: &PlannerConfig,
+) -> Result<ProposedPatch, OraclePatchError> {
+    propose_checked(world, ctx, config, false)
+}
+
+fn propose_checked(
+    world: &WorldDomain,
+    ctx: &PatchContext,
+    config: &PlannerConfig,
+    checked: bool,
 ) -> Result<ProposedPatch, OraclePatchError> {
     let req = &ctx.request;
     let mut names: Vec<Symbol> = req.task.objects.clone();
@@ -393,6 +452,15 @@ pub fn propose(
             }
         }
     }
+    if !checked {
+        return candidates.into_iter().next().ok_or_else(|| {
+            OraclePatchError::Unresolvable(if reasons.is_empty() {
+                "no candidate patch for the guessed step".into()
+            } else {
+                reasons.join("; ")
+            })
+        });
+    }
     let best = candidates
         .into_iter()
         .filter_map(|p| score(procedure, &req.initial_state, &violation, p))
@@ -536,5 +604,78 @@ mod tests {
         let report = verify_procedure(&init, &patched, Some(&goal));
         assert!(report.first_failure.is_none());
         assert!(report.goal.is_some_and(|g| g.satisfied), "{patched:?}");
+    }
+
+    /// Without identification and with a missed localisation, the request is re-aimed at a
+    /// step that is not the failing one but whose preconditions fail in ŝ₁; an identified
+    /// request is never re-aimed.
+    #[test]
+    fn a_missed_localisation_patches_another_step_that_fails_in_the_initial_state() {
+        let world = WorldDomain::builtin().unwrap();
+        let demo_init = parse_state_list(
+            "- (Open hinge_lid)\n- (GripperOpen)\n- (FingerGripper)\n- (OnTopOf hinge_body floor)\n- (OnTopOf apple floor)",
+        )
+        .unwrap();
+        let names = ["apple", "hinge_body", "hinge_lid", "hinge_handle", "floor"];
+        let universe = world.universe(names);
+        let planning = Planning {
+            universe: universe.clone(),
+            schemas: world.schemas_for(Embodiment::Finger, &universe),
+            target: Embodiment::Finger,
+            config: &PlannerConfig::default(),
+        };
+        let (procedure, _) = planning
+            .plan(&demo_init, &parse_formula("(InsideOf apple hinge_body)").unwrap())
+            .unwrap();
+        // The target's lid is closed.
+        let init = parse_state_list(
+            "- (Closed hinge_lid)\n- (GripperOpen)\n- (FingerGripper)\n- (OnTopOf hinge_body floor)\n- (OnTopOf apple floor)",
+        )
+        .unwrap();
+        let truly = verify_procedure(&init, &procedure, None).first_failure.unwrap();
+        let request = PatchRequest {
+            iteration: 0,
+            task: TaskContext {
+                instruction: "Put the apple in the hinge box.".into(),
+                objects: names.iter().map(|n| Symbol::new(n)).collect::<Vec<_>>(),
+                tier: Tier::Full,
+                vocabulary: Vocabulary::default(),
+            },
+            kind: ViolationKind::Unidentified,
+            executed: Vec::new(),
+            procedure: procedure.clone(),
+            erroneous: None,
+            remaining: Vec::new(),
+            failing_step: None,
+            initial_state: init.clone(),
+            error_state: init.clone(),
+            unmet: Vec::new(),
+            feedback: Vec::new(),
+        };
+        let ctx = PatchContext {
+            request,
+            target_embodiment: Embodiment::Finger,
+        };
+        let mut seen = Vec::new();
+        for pick in 0..procedure.len() {
+            let Some(guessed) = misplaced(&ctx, &mut |n| pick % n) else {
+                panic!("no candidate step");
+            };
+            let r = &guessed.request;
+            let step = r.failing_step.unwrap();
+            assert_ne!(step, truly);
+            assert_eq!(r.kind, ViolationKind::Precondition);
+            assert!(!r.unmet.is_empty());
+            assert!(apply(&init, &procedure[step]).is_err());
+            assert_eq!(r.executed.len(), step);
+            assert_eq!(r.error_state, init);
+            seen.push(step);
+        }
+        seen.sort();
+        seen.dedup();
+        assert!(seen.len() > 1, "the guess varies with the draw: {seen:?}");
+        let mut identified = ctx.clone();
+        identified.request.kind = ViolationKind::Precondition;
+        assert!(misplaced(&identified, &mut |_| 0).is_none());
     }
 }

@@ -1,0 +1,272 @@
+//! A study's table (Table 3's or Table 8's shape), its CSV and its figure.
+//!
+//! SR and GC are averaged per scenario over its repeats first, and the mean ± SE is taken
+//! over scenarios, so the noise seeds of one scenario are not counted as independent
+//! episodes. PD is over the successful units, as in the paper.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use nesy_core::metrics::{MeanSe, Tally};
+
+use super::csv_field;
+use super::plot::{self, Bars, Frame, Value};
+use crate::record::{UnitRecord, UnitStatus};
+use crate::study::{Study, StudyRow};
+
+/// One row's figures.
+#[derive(Debug, Clone)]
+pub(super) struct RowStats {
+    row: StudyRow,
+    id: String,
+    /// Scenarios with at least one scored unit.
+    scenarios: usize,
+    /// Scored units.
+    units: usize,
+    sr: MeanSe,
+    gc: MeanSe,
+    pd: MeanSe,
+    calls: MeanSe,
+    statuses: BTreeMap<UnitStatus, usize>,
+    /// Mean precision and recall of the translated demo states, where states were
+    /// translated.
+    agreement: Option<(f64, f64)>,
+}
+
+/// The study's rows, in the study's order.
+#[derive(Debug, Clone)]
+pub(super) struct StudyTable {
+    study: Study,
+    rows: Vec<RowStats>,
+}
+
+/// `mean±SE`, or the mean alone with its n when there is no SE to give.
+fn shown(m: &MeanSe) -> String {
+    match m.n {
+        0 => "—".to_owned(),
+        1 => format!("{:.2} (n=1)", m.mean),
+        _ => m.to_string(),
+    }
+}
+
+fn tally(values: impl IntoIterator<Item = f64>) -> MeanSe {
+    let mut t = Tally::default();
+    values.into_iter().for_each(|v| t.push(v));
+    t.mean_se()
+}
+
+impl StudyTable {
+    /// Tallies the records of every row of `study`.
+    pub(super) fn build(study: Study, records: &[&UnitRecord]) -> StudyTable {
+        let rows = study
+            .rows()
+            .into_iter()
+            .map(|row| {
+                let id = row.variant.id();
+                let mine: Vec<&UnitRecord> =
+                    records.iter().copied().filter(|r| r.key.variant == id).collect();
+                let mut statuses = BTreeMap::new();
+                for r in &mine {
+                    *statuses.entry(r.status).or_default() += 1;
+                }
+                let scored: Vec<&UnitRecord> =
+                    mine.iter().copied().filter(|r| r.status.is_scored()).collect();
+                let mut by_scenario: BTreeMap<&str, Vec<&UnitRecord>> = BTreeMap::new();
+                for r in &scored {
+                    by_scenario.entry(r.key.scenario.as_str()).or_default().push(r);
+                }
+                let scenario_mean = |pick: &dyn Fn(&UnitRecord) -> f64| {
+                    tally(
+                        by_scenario
+                            .values()
+                            .map(|rs| rs.iter().map(|r| pick(r)).sum::<f64>() / rs.len() as f64),
+                    )
+                    .percent()
+                };
+                let translated: Vec<_> = scored.iter().filter_map(|r| r.states.as_ref()).collect();
+                let agreement = (!translated.is_empty()).then(|| {
+                    let n = translated.len() as f64;
+                    (
+                        translated.iter().map(|a| a.precision).sum::<f64>() / n,
+                        translated.iter().map(|a| a.recall).sum::<f64>() / n,
+                    )
+                });
+                RowStats {
+                    id,
+                    scenarios: by_scenario.len(),
+                    units: scored.len(),
+                    sr: scenario_mean(&|r| r.scores.sr),
+                    gc: scenario_mean(&|r| r.scores.gc),
+                    pd: tally(scored.iter().filter(|r| r.scores.sr == 1.0).map(|r| r.scores.pd)).percent(),
+                    calls: tally(scored.iter().map(|r| r.effort.calls as f64)),
+                    statuses,
+                    agreement,
+                    row,
+                }
+            })
+            .collect();
+        StudyTable { study, rows }
+    }
+
+    /// The markdown section: banner, table, comparison with the full method, readings.
+    pub(super) fn markdown(&self) -> String {
+        let mut md = String::new();
+        let study = self.study;
+        let _ = writeln!(md, "## {}\n", study.title());
+        let _ = writeln!(
+            md,
+            "> **SYNTHETIC — no model answered. Error model: {}** These rows say what nesy's symbolic checks do with a literal responder under this error model; they are not NeSyCR's or any ablation's performance, and they are not comparable with the paper's table, whose numbers come from a real model on the authors' scenes.\n",
+            study.error_model()
+        );
+        let translated = self.rows.iter().any(|r| r.agreement.is_some());
+        let _ = write!(
+            md,
+            "| row | scenarios | units | SR | GC | PD (successful units) | ΔSR vs full | \\|ΔSR\\| > SE | model calls / unit |"
+        );
+        if translated {
+            let _ = write!(md, " demo-state P / R |");
+        }
+        let _ = writeln!(md);
+        let _ = write!(md, "|---|---|---|---|---|---|---|---|---|");
+        if translated {
+            let _ = write!(md, "---|");
+        }
+        let _ = writeln!(md);
+        let full = self.rows.first();
+        for (k, r) in self.rows.iter().enumerate() {
+            let (delta, exceeds) = match full {
+                Some(f) if k > 0 && r.scenarios > 0 && f.scenarios > 0 => {
+                    let d = r.sr.mean - f.sr.mean;
+                    let se = r.sr.se.max(f.sr.se);
+                    (format!("{d:+.2}"), if d.abs() > se { "yes" } else { "no" })
+                }
+                _ => ("—".to_owned(), "—"),
+            };
+            let _ = write!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {:.1} |",
+                r.row.label,
+                r.scenarios,
+                r.units,
+                shown(&r.sr),
+                shown(&r.gc),
+                shown(&r.pd),
+                delta,
+                exceeds,
+                r.calls.mean
+            );
+            if translated {
+                match r.agreement {
+                    Some((p, rc)) => {
+                        let _ = write!(md, " {p:.3} / {rc:.3} |");
+                    }
+                    None => {
+                        let _ = write!(md, " — |");
+                    }
+                }
+            }
+            let _ = writeln!(md);
+        }
+        let _ = writeln!(
+            md,
+            "\nSR and GC: mean × 100 ± SE over scenarios, each scenario's repeats (noise seeds) averaged first. PD: mean × 100 ± SE over the units that succeeded. ΔSR is against the first row; \"|ΔSR| > SE\" compares it with the larger of the two rows' SEs.\n"
+        );
+        let _ = writeln!(md, "How the units ended:\n");
+        for r in &self.rows {
+            let parts: Vec<String> = r.statuses.iter().map(|(s, n)| format!("{s} {n}")).collect();
+            let _ = writeln!(md, "- {}: {}", r.row.label, parts.join(", "));
+        }
+        let _ = writeln!(md, "\nWhat each row runs:\n");
+        for r in &self.rows {
+            let _ = writeln!(md, "- **{}** (`{}`): {}.", r.row.label, r.id, r.row.reading);
+        }
+        let _ = writeln!(md);
+        md
+    }
+
+    /// One CSV line per row.
+    pub(super) fn csv(&self) -> String {
+        let mut out = String::from(
+            "study,row,variant,scenarios,units,sr_mean,sr_se,gc_mean,gc_se,pd_success_mean,pd_success_se,pd_success_n,calls_mean,demo_state_precision,demo_state_recall\n",
+        );
+        for r in &self.rows {
+            let (p, rc) = r.agreement.map_or((String::new(), String::new()), |(p, rc)| {
+                (format!("{p:.4}"), format!("{rc:.4}"))
+            });
+            let _ = writeln!(
+                out,
+                "{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{},{:.2},{p},{rc}",
+                self.study.name(),
+                csv_field(r.row.label),
+                csv_field(&r.id),
+                r.scenarios,
+                r.units,
+                r.sr.mean,
+                r.sr.se,
+                r.gc.mean,
+                r.gc.se,
+                r.pd.mean,
+                r.pd.se,
+                r.pd.n,
+                r.calls.mean
+            );
+        }
+        out
+    }
+
+    /// SR, GC and PD per row as grouped bars with SE whiskers.
+    pub(super) fn plot(&self) -> plot::Canvas {
+        let (w, h) = (1200usize, 560usize);
+        let header = format!(
+            "{} - SYNTHETIC, offline responder under a stated error model",
+            self.study.title()
+        );
+        let mut c = plot::canvas_with_header(
+            w,
+            h,
+            &header,
+            Some("SYNTHETIC - no model answered; report.md states the error model"),
+        );
+        let categories = vec![
+            "SR (%)".to_owned(),
+            "GC (%)".to_owned(),
+            "PD (%, successful)".to_owned(),
+        ];
+        let series: Vec<String> = self.rows.iter().map(|r| r.row.label.to_owned()).collect();
+        let value = |m: &MeanSe| {
+            (m.n > 0).then_some(Value {
+                mean: m.mean,
+                se: if m.n > 1 { m.se } else { f64::NAN },
+            })
+        };
+        let values: Vec<Vec<Option<Value>>> = self
+            .rows
+            .iter()
+            .map(|r| vec![value(&r.sr), value(&r.gc), value(&r.pd)])
+            .collect();
+        plot::draw_bars(
+            &mut c,
+            Frame {
+                x: 0,
+                y: 44,
+                w: w as i64,
+                h: 440,
+            },
+            &Bars {
+                title: "mean x 100 +- SE",
+                y_label: "%",
+                y_max: 100.0,
+                categories: &categories,
+                series: &series,
+                values: &values,
+            },
+        );
+        plot::legend(&mut c, 70, h as i64 - 64, &series);
+        plot::footnote(
+            &mut c,
+            h as i64 - 24,
+            "SR, GC: SE over scenarios (repeats averaged first); PD: SE over successful units",
+        );
+        c
+    }
+}
