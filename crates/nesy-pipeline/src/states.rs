@@ -48,7 +48,9 @@ pub enum StateSource {
         /// Replies that could not be used (not a state list, names the task does not have,
         /// cut off, null content) and were re-asked.
         reasked_replies: usize,
-        /// Micro-averaged precision/recall/F1 against ground truth, where it was known.
+        /// Micro-averaged precision/recall/F1 against ground truth, where it was known,
+        /// over the demo keyframes and the target together. The reference is the truth
+        /// restricted to the prompt's tier and its known atoms, which is what a reply can say.
         agreement: Option<Agreement>,
     },
 }
@@ -216,8 +218,19 @@ pub async fn symbolic_states(
         rejected_atoms += translated.rejected.len();
         reasked_replies += translated.reasked.len();
         if let Some(truth) = &request.ground_truth {
+            // The reference is the part of the truth the prompt could express: its tier's
+            // predicates and the atoms given as known. Atoms of predicates outside the tier
+            // are never accepted from any reply, so counting them would lower recall for a
+            // perfect translator.
+            let in_tier: Vec<_> = request
+                .vocabulary
+                .tier(request.tier)
+                .iter()
+                .map(|p| p.name)
+                .collect();
+            let expressible = |a: &&Atom| in_tier.contains(&a.pred()) || request.known.contains(a);
             predicted += translated.state.len();
-            actual += truth.len();
+            actual += truth.iter().filter(expressible).count();
             tp += translated.state.iter().filter(|a| truth.contains(a)).count();
         }
         states.push(translated.state.clone());

@@ -53,6 +53,11 @@ impl Canvas {
         }
     }
 
+    /// The canvas width in pixels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
     fn put(&mut self, x: i64, y: i64, c: Rgb) {
         if x < 0 || y < 0 || x >= self.width as i64 || y >= self.height as i64 {
             return;
@@ -301,12 +306,21 @@ pub fn draw_lines(canvas: &mut Canvas, f: Frame, lines: &Lines) {
 }
 
 /// Draws a legend of `series` in a row starting at (x, y).
+///
+/// Entries that would run past the canvas's right edge start a new line
+/// 16 pixels lower, so long labels stay readable instead of being clipped.
 pub fn legend(canvas: &mut Canvas, x: i64, y: i64, series: &[String]) {
-    let mut cx = x;
+    let right = canvas.width() as i64 - 8;
+    let (mut cx, mut cy) = (x, y);
     for (s, name) in series.iter().enumerate() {
-        canvas.rect(cx, y, cx + 12, y + 10, PALETTE[s % PALETTE.len()]);
-        canvas.text(cx + 16, y + 1, name, BLACK, 1);
-        cx += 16 + name.chars().count() as i64 * 8 + 20;
+        let entry = 16 + name.chars().count() as i64 * 8;
+        if cx > x && cx + entry > right {
+            cx = x;
+            cy += 16;
+        }
+        canvas.rect(cx, cy, cx + 12, cy + 10, PALETTE[s % PALETTE.len()]);
+        canvas.text(cx + 16, cy + 1, name, BLACK, 1);
+        cx += entry + 20;
     }
 }
 

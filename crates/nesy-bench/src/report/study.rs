@@ -28,8 +28,8 @@ pub(super) struct RowStats {
     pd: MeanSe,
     calls: MeanSe,
     statuses: BTreeMap<UnitStatus, usize>,
-    /// Mean precision and recall of the translated demo states, where states were
-    /// translated.
+    /// Mean precision and recall of the translated states (demo keyframes and target
+    /// pooled per unit), where states were translated.
     agreement: Option<(f64, f64)>,
 }
 
@@ -124,7 +124,7 @@ impl StudyTable {
             "| row | scenarios | units | SR | GC | PD (successful units) | ΔSR vs full | \\|ΔSR\\| > SE | model calls / unit |"
         );
         if translated {
-            let _ = write!(md, " demo-state P / R |");
+            let _ = write!(md, " state P / R |");
         }
         let _ = writeln!(md);
         let _ = write!(md, "|---|---|---|---|---|---|---|---|---|");
@@ -169,7 +169,12 @@ impl StudyTable {
         }
         let _ = writeln!(
             md,
-            "\nSR and GC: mean × 100 ± SE over scenarios, each scenario's repeats (noise seeds) averaged first. PD: mean × 100 ± SE over the units that succeeded. ΔSR is against the first row; \"|ΔSR| > SE\" compares it with the larger of the two rows' SEs.\n"
+            "\nSR and GC: mean × 100 ± SE over scenarios, each scenario's repeats (noise seeds) averaged first. PD: mean × 100 ± SE over the units that succeeded. ΔSR is against the first row; \"|ΔSR| > SE\" compares it with the larger of the two rows' SEs.{}\n",
+            if translated {
+                " State P / R: the translated states' precision and recall against the ground truth the prompt's predicate tier can express, demo keyframes and target pooled per unit, then averaged over units; a demo-only perturbation therefore shows diluted by the unperturbed target."
+            } else {
+                ""
+            }
         );
         let _ = writeln!(md, "How the units ended:\n");
         for r in &self.rows {
@@ -187,7 +192,7 @@ impl StudyTable {
     /// One CSV line per row.
     pub(super) fn csv(&self) -> String {
         let mut out = String::from(
-            "study,row,variant,scenarios,units,sr_mean,sr_se,gc_mean,gc_se,pd_success_mean,pd_success_se,pd_success_n,calls_mean,demo_state_precision,demo_state_recall\n",
+            "study,row,variant,scenarios,units,sr_mean,sr_se,gc_mean,gc_se,pd_success_mean,pd_success_se,pd_success_n,calls_mean,state_precision,state_recall\n",
         );
         for r in &self.rows {
             let (p, rc) = r.agreement.map_or((String::new(), String::new()), |(p, rc)| {
@@ -217,10 +222,7 @@ impl StudyTable {
     /// SR, GC and PD per row as grouped bars with SE whiskers.
     pub(super) fn plot(&self) -> plot::Canvas {
         let (w, h) = (1200usize, 560usize);
-        let header = format!(
-            "{} - SYNTHETIC, offline responder under a stated error model",
-            self.study.title()
-        );
+        let header = format!("{} - SYNTHETIC", self.study.title());
         let mut c = plot::canvas_with_header(
             w,
             h,
@@ -261,7 +263,7 @@ impl StudyTable {
                 values: &values,
             },
         );
-        plot::legend(&mut c, 70, h as i64 - 64, &series);
+        plot::legend(&mut c, 70, h as i64 - 72, &series);
         plot::footnote(
             &mut c,
             h as i64 - 24,
