@@ -43,6 +43,7 @@ use crate::methods::{self, Method, MethodFailure, OfflineMeaning, Specification,
 use crate::record::{Agreement, Effort, Scores, SpecSummary, SubtaskScore, UnitRecord, UnitStatus};
 use crate::shard::Shard;
 use crate::store::{self, ResultsWriter};
+use crate::study::Study;
 use crate::unit::{Selection, Unit, UnitKey, units};
 use crate::variant::{Variant, config_hash, hex};
 
@@ -65,7 +66,7 @@ pub struct RunConfig {
     /// The variants.
     pub variants: Vec<Variant>,
     /// The study these variants make up, if any (the report adds its table).
-    pub study: Option<crate::study::Study>,
+    pub study: Option<Study>,
     /// The scenarios.
     pub selection: Selection,
     /// Read the suite from this folder instead of generating it.
@@ -173,6 +174,15 @@ pub fn load_suite(dir: Option<&Path>) -> Result<Vec<ConfigFile>, BenchError> {
     })
 }
 
+/// The suite a run uses: the folder's when given, else the complexity-gap suite for a study
+/// that runs on it, else the 440.
+pub fn run_suite(dir: Option<&Path>, study: Option<Study>) -> Result<Vec<ConfigFile>, BenchError> {
+    match (dir, study) {
+        (None, Some(s)) if s.uses_gap_suite() => Ok(scenario::generate_gap_suite()),
+        _ => load_suite(dir),
+    }
+}
+
 fn suite_hash(files: &[ConfigFile]) -> String {
     config_hash(&files.iter().map(ConfigFile::to_json_pretty).collect::<Vec<_>>())
 }
@@ -235,7 +245,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, BenchError> {
             deviations: method.deviations(v),
         });
     }
-    let files = load_suite(config.suite_dir.as_deref())?;
+    let files = run_suite(config.suite_dir.as_deref(), config.study)?;
     let scenarios = config.selection.apply(scenario::scenarios(&files))?;
     let units = units(
         &config.variants,
@@ -553,6 +563,7 @@ fn base_record(
         method: unit.variant.method.clone(),
         factor: unit.factor(),
         complexity: unit.complexity(),
+        added_subtasks: unit.scenario.added_subtasks,
         seed: unit.seed,
         config_hash: shared
             .manifest

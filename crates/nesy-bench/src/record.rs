@@ -217,6 +217,10 @@ pub struct UnitRecord {
     pub factor: Factor,
     /// The scenario's complexity.
     pub complexity: Complexity,
+    /// Subtasks the target has beyond the demonstration's, for a scenario of the
+    /// complexity-gap suite (absent for the 440).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub added_subtasks: Option<u8>,
     /// The unit's seed.
     pub seed: u64,
     /// Hash of the variant's configuration (a resume refuses records whose hash differs).

@@ -160,6 +160,7 @@ pub(crate) mod tests {
             method: variant.into(),
             factor: Factor::Obst,
             complexity: Complexity::Low,
+            added_subtasks: None,
             seed: 1,
             config_hash: "h".into(),
             status,

@@ -291,3 +291,69 @@ fn the_ablation_study_runs_its_rows_and_reports_them_in_table_3_shape() {
     assert_eq!(unknown.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&unknown.stderr).contains("expected one of ablation, robustness"));
 }
+
+/// `--study complexity-gap` on one configuration of the auxiliary suite at +0 and +1 added
+/// subtasks: four rows, the breakdown by added subtasks in the report, its CSV and figure,
+/// and the records marked with their added subtasks. A loop that takes its goal from the
+/// demonstration cannot succeed once the target asks for a subtask the demonstration never
+/// shows, and neither can the unadapted procedure.
+#[test]
+fn the_complexity_gap_study_reports_sr_and_pd_by_added_subtasks() {
+    let scratch = common::scratch();
+    let run = scratch.path().join("gap");
+    let demos = scratch.path().join("demos");
+    let out = common::nesy(&[
+        "bench".into(),
+        "run".into(),
+        run.display().to_string(),
+        "--study".into(),
+        "complexity-gap".into(),
+        "--scenarios".into(),
+        "gap_obst_plus0_03_s0,gap_obst_plus1_03_s0".into(),
+        "--vlm".into(),
+        "oracle".into(),
+        "--demos".into(),
+        demos.display().to_string(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Four rows × two scenarios × one repeat.
+    assert_eq!(lines(&run), 8);
+    let report = std::fs::read_to_string(run.join("report.md")).unwrap();
+    assert!(
+        report.contains("## Complexity gap (Figure 4(b) shape)"),
+        "{report}"
+    );
+    assert!(report.contains("By added subtasks"), "{report}");
+    assert!(
+        report.contains("auxiliary complexity-gap suite (not part of the 440)"),
+        "{report}"
+    );
+    let csv = table(&run, "complexity_gap.csv");
+    assert_eq!(csv.lines().count(), 1 + 4 * 2, "{csv}");
+    let sr_at = |prefix: &str| -> f64 {
+        let line = csv
+            .lines()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("{prefix}: {csv}"));
+        // study,row,variant,added_subtasks,scenarios,sr_mean,…: the row label is quoted.
+        line[prefix.len()..].split(',').nth(1).unwrap().parse().unwrap()
+    };
+    assert_eq!(
+        sr_at("complexity-gap,\"NeSyCR, demonstrated goal\",nesycr,1,"),
+        0.0
+    );
+    assert_eq!(sr_at("complexity-gap,Imitation (control),imitation,1,"), 0.0);
+    assert!(run.join("plots/complexity_gap.png").is_file());
+    let results = std::fs::read_dir(run.join("results"))
+        .unwrap()
+        .flatten()
+        .map(|e| std::fs::read_to_string(e.path()).unwrap())
+        .collect::<String>();
+    assert_eq!(results.matches("\"added_subtasks\":1").count(), 4, "{results}");
+    assert_eq!(results.matches("\"added_subtasks\":0").count(), 4, "{results}");
+}

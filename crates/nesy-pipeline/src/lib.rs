@@ -217,6 +217,7 @@ pub fn adaptation_inputs(
             .chain(target.objects.iter().cloned())
             .map(|n| Symbol::new(&n))
             .collect(),
+        goal: None,
     };
     (demonstration, target_task)
 }

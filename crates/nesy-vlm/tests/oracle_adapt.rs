@@ -112,6 +112,7 @@ async fn adapt_and_execute(case: &Case, noise: OracleNoise, budget: usize) -> Ru
             vocabulary: Vocabulary::default(),
         },
         scene_names: Vec::new(),
+        goal: None,
     };
     // The oracle behind the real client and reasoner.
     let oracle = Arc::new(

@@ -44,6 +44,7 @@ const SETTINGS: &[&str] = &[
     "identification=on|off (Eq. 6, `conflict`: tell the model where and why the procedure fails)",
     "verification=on|off (Eq. 8, `verification`: check each proposal before accepting it)",
     "goal-check=on|off (require the derived goal at the end)",
+    "goal=demo|target (the goal derived from the demonstration, or the target task's own, as a complexity-gap target states it)",
     "drop-unconditioned=on|off (drop induced operators without preconditions)",
     "on-unresolved=fail|compile-last|compile-best",
     "induction-tries=N",
@@ -62,6 +63,8 @@ pub(crate) struct Settings {
     pub budget: Option<usize>,
     pub states: StatesMode,
     pub codegen: CodegenMode,
+    /// Take the goal from the target task instead of the demonstration.
+    pub target_goal: bool,
 }
 
 impl NeSyCr {
@@ -134,6 +137,15 @@ impl NeSyCr {
                 )));
             }
         };
+        let target_goal = match variant.option("goal") {
+            None | Some("demo") => false,
+            Some("target") => true,
+            Some(other) => {
+                return Err(BenchError::Usage(format!(
+                    "variant {variant}: goal={other:?}; expected demo or target"
+                )));
+            }
+        };
         let codegen = match variant.option("codegen") {
             None | Some("vlm") => CodegenMode::Vlm,
             Some("template") => CodegenMode::Template,
@@ -156,6 +168,7 @@ impl NeSyCr {
             budget: number("budget")?,
             states,
             codegen,
+            target_goal,
         })
     }
 }
@@ -226,8 +239,13 @@ impl Method for NeSyCr {
             )
             .await
             .map_err(pipeline_failure)?;
-            let (demonstration, target) =
+            let (demonstration, mut target) =
                 adaptation_inputs(&inputs.demo, &inputs.target, setting, &states, &vocabulary);
+            if settings.target_goal {
+                // The target task's goal as its scene states it: what the target instruction
+                // asks for, including subtasks the demonstration never shows.
+                target.goal = Some(super::replan::target_goal(inputs));
+            }
             let budget = settings.budget.unwrap_or(setting.budget);
             let config = AdaptConfig {
                 budget,

@@ -305,22 +305,50 @@ pub fn draw_lines(canvas: &mut Canvas, f: Frame, lines: &Lines) {
     }
 }
 
+/// Height of one legend line, in pixels.
+pub const LEGEND_LINE: i64 = 16;
+
+/// Where each legend entry starts, relative to the legend's origin at `x` on a canvas
+/// `width` wide: entries that would run past the right edge start a new line.
+fn legend_layout(width: usize, x: i64, series: &[String]) -> Vec<(i64, i64)> {
+    let right = width as i64 - 8;
+    let (mut cx, mut cy) = (x, 0);
+    series
+        .iter()
+        .map(|name| {
+            let entry = 16 + name.chars().count() as i64 * 8;
+            if cx > x && cx + entry > right {
+                cx = x;
+                cy += LEGEND_LINE;
+            }
+            let at = (cx, cy);
+            cx += entry + 20;
+            at
+        })
+        .collect()
+}
+
+/// How many lines the legend of `series` takes at `x` on a canvas `width` wide, so a
+/// figure can make room for it before drawing.
+pub fn legend_lines(width: usize, x: i64, series: &[String]) -> i64 {
+    legend_layout(width, x, series)
+        .last()
+        .map_or(0, |&(_, dy)| dy / LEGEND_LINE + 1)
+}
+
 /// Draws a legend of `series` in a row starting at (x, y).
 ///
 /// Entries that would run past the canvas's right edge start a new line
-/// 16 pixels lower, so long labels stay readable instead of being clipped.
+/// [`LEGEND_LINE`] pixels lower, so long labels stay readable instead of being clipped.
 pub fn legend(canvas: &mut Canvas, x: i64, y: i64, series: &[String]) {
-    let right = canvas.width() as i64 - 8;
-    let (mut cx, mut cy) = (x, y);
-    for (s, name) in series.iter().enumerate() {
-        let entry = 16 + name.chars().count() as i64 * 8;
-        if cx > x && cx + entry > right {
-            cx = x;
-            cy += 16;
-        }
+    for (s, (name, (cx, dy))) in series
+        .iter()
+        .zip(legend_layout(canvas.width(), x, series))
+        .enumerate()
+    {
+        let cy = y + dy;
         canvas.rect(cx, cy, cx + 12, cy + 10, PALETTE[s % PALETTE.len()]);
         canvas.text(cx + 16, cy + 1, name, BLACK, 1);
-        cx += entry + 20;
     }
 }
 
@@ -401,5 +429,21 @@ mod tests {
         let decoder = png::Decoder::new(std::io::Cursor::new(png));
         let reader = decoder.read_info().unwrap();
         assert_eq!((reader.info().width, reader.info().height), (400, 300));
+    }
+
+    #[test]
+    fn a_legend_wraps_at_the_right_edge_and_says_how_many_lines_it_needs() {
+        let short: Vec<String> = ["a", "b"].map(String::from).to_vec();
+        assert_eq!(legend_lines(400, 10, &short), 1);
+        assert_eq!(legend_lines(400, 10, &[]), 0);
+        // Each 40-character name is 336 px with its swatch: one per line on a 400 px canvas.
+        let long: Vec<String> = (0..3).map(|i| format!("{i:0>40}")).collect();
+        assert_eq!(legend_lines(400, 10, &long), 3);
+        let at = legend_layout(400, 10, &long);
+        assert!(at.iter().all(|&(x, _)| x == 10), "{at:?}");
+        assert_eq!(
+            at.iter().map(|&(_, y)| y).collect::<Vec<_>>(),
+            vec![0, LEGEND_LINE, 2 * LEGEND_LINE]
+        );
     }
 }

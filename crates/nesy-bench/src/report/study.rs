@@ -31,6 +31,35 @@ pub(super) struct RowStats {
     /// Mean precision and recall of the translated states (demo keyframes and target
     /// pooled per unit), where states were translated.
     agreement: Option<(f64, f64)>,
+    /// Per added-subtask count (complexity-gap scenarios only): SR pooled as the row's,
+    /// and PD over the successful units.
+    by_added: BTreeMap<u8, AddedStats>,
+}
+
+/// One row's figures at one added-subtask count.
+#[derive(Debug, Clone)]
+pub(super) struct AddedStats {
+    scenarios: usize,
+    sr: MeanSe,
+    pd: MeanSe,
+}
+
+/// SR averaged per scenario over its repeats, then mean × 100 ± SE over scenarios.
+fn scenario_sr(records: &[&UnitRecord]) -> (usize, MeanSe) {
+    let mut by_scenario: BTreeMap<&str, Vec<f64>> = BTreeMap::new();
+    for r in records {
+        by_scenario
+            .entry(r.key.scenario.as_str())
+            .or_default()
+            .push(r.scores.sr);
+    }
+    let sr = tally(
+        by_scenario
+            .values()
+            .map(|v| v.iter().sum::<f64>() / v.len() as f64),
+    )
+    .percent();
+    (by_scenario.len(), sr)
 }
 
 /// The study's rows, in the study's order.
@@ -91,7 +120,23 @@ impl StudyTable {
                         translated.iter().map(|a| a.recall).sum::<f64>() / n,
                     )
                 });
+                let mut by_added: BTreeMap<u8, Vec<&UnitRecord>> = BTreeMap::new();
+                for r in &scored {
+                    if let Some(k) = r.added_subtasks {
+                        by_added.entry(k).or_default().push(r);
+                    }
+                }
+                let by_added = by_added
+                    .into_iter()
+                    .map(|(k, rs)| {
+                        let (scenarios, sr) = scenario_sr(&rs);
+                        let pd =
+                            tally(rs.iter().filter(|r| r.scores.sr == 1.0).map(|r| r.scores.pd)).percent();
+                        (k, AddedStats { scenarios, sr, pd })
+                    })
+                    .collect();
                 RowStats {
+                    by_added,
                     id,
                     scenarios: by_scenario.len(),
                     units: scored.len(),
@@ -176,6 +221,37 @@ impl StudyTable {
                 ""
             }
         );
+        let added: Vec<u8> = self.added_counts();
+        if !added.is_empty() {
+            let _ = writeln!(
+                md,
+                "By added subtasks (the target's subtasks beyond the demonstration's one): SR as above, PD over the successful units, n = scenarios.\n"
+            );
+            let _ = write!(md, "| row |");
+            for k in &added {
+                let _ = write!(md, " +{k} SR | +{k} PD |");
+            }
+            let _ = writeln!(md);
+            let _ = writeln!(md, "|---|{}", "---|---|".repeat(added.len()));
+            for r in &self.rows {
+                let _ = write!(md, "| {} |", r.row.label);
+                for k in &added {
+                    match r.by_added.get(k) {
+                        Some(a) => {
+                            let _ = write!(md, " {} (n={}) | {} |", shown(&a.sr), a.scenarios, shown(&a.pd));
+                        }
+                        None => {
+                            let _ = write!(md, " — | — |");
+                        }
+                    }
+                }
+                let _ = writeln!(md);
+            }
+            let _ = writeln!(
+                md,
+                "\n![SR and PD against the added subtasks](plots/complexity_gap.png)\n"
+            );
+        }
         let _ = writeln!(md, "How the units ended:\n");
         for r in &self.rows {
             let parts: Vec<String> = r.statuses.iter().map(|(s, n)| format!("{s} {n}")).collect();
@@ -187,6 +263,87 @@ impl StudyTable {
         }
         let _ = writeln!(md);
         md
+    }
+
+    /// The added-subtask counts any row has records for, ascending.
+    fn added_counts(&self) -> Vec<u8> {
+        let mut added: Vec<u8> = self
+            .rows
+            .iter()
+            .flat_map(|r| r.by_added.keys().copied())
+            .collect();
+        added.sort_unstable();
+        added.dedup();
+        added
+    }
+
+    /// One CSV line per row and added-subtask count, when the records are of the
+    /// complexity-gap suite.
+    pub(super) fn added_csv(&self) -> Option<String> {
+        let added = self.added_counts();
+        if added.is_empty() {
+            return None;
+        }
+        let mut out = String::from(
+            "study,row,variant,added_subtasks,scenarios,sr_mean,sr_se,pd_success_mean,pd_success_se,pd_success_n\n",
+        );
+        for r in &self.rows {
+            for (k, a) in &r.by_added {
+                let _ = writeln!(
+                    out,
+                    "{},{},{},{k},{},{:.4},{:.4},{:.4},{:.4},{}",
+                    self.study.name(),
+                    csv_field(r.row.label),
+                    csv_field(&r.id),
+                    a.scenarios,
+                    a.sr.mean,
+                    a.sr.se,
+                    a.pd.mean,
+                    a.pd.se,
+                    a.pd.n
+                );
+            }
+        }
+        Some(out)
+    }
+
+    /// SR and PD against the added subtasks, one line per row, when the records are of the
+    /// complexity-gap suite.
+    pub(super) fn added_plot(&self) -> Option<plot::Canvas> {
+        let added = self.added_counts();
+        if added.is_empty() {
+            return None;
+        }
+        let categories: Vec<String> = added.iter().map(|k| format!("+{k}")).collect();
+        let series: Vec<String> = self.rows.iter().map(|r| r.row.label.to_owned()).collect();
+        let pick = |f: &dyn Fn(&AddedStats) -> &MeanSe| -> Vec<Vec<Option<Value>>> {
+            self.rows
+                .iter()
+                .map(|r| {
+                    added
+                        .iter()
+                        .map(|k| {
+                            r.by_added.get(k).map(f).filter(|m| m.n > 0).map(|m| Value {
+                                mean: m.mean,
+                                se: if m.n > 1 { m.se } else { f64::NAN },
+                            })
+                        })
+                        .collect()
+                })
+                .collect()
+        };
+        Some(super::two_panel_lines(
+            super::SrPd {
+                header: "SR and PD against the complexity gap (auxiliary suite)",
+                x_label: "subtasks added to the demonstrated one",
+                categories: &categories,
+                series: &series,
+                sr: &pick(&|a| &a.sr),
+                pd: &pick(&|a| &a.pd),
+                note: "OFFLINE: the reference responder plans what the demo does not show; not the paper's Figure 4(b)",
+            },
+            Some("OFFLINE - no model answered; report.md states what the rows mean"),
+        ))
     }
 
     /// One CSV line per row.
@@ -221,7 +378,11 @@ impl StudyTable {
 
     /// SR, GC and PD per row as grouped bars with SE whiskers.
     pub(super) fn plot(&self) -> plot::Canvas {
-        let (w, h) = (1200usize, 560usize);
+        let w = 1200usize;
+        let series: Vec<String> = self.rows.iter().map(|r| r.row.label.to_owned()).collect();
+        // The layout leaves room for two legend lines; more lengthen the canvas.
+        let extra = (plot::legend_lines(w, 70, &series) - 2).max(0) * plot::LEGEND_LINE;
+        let h = 560 + extra as usize;
         let header = format!("{} - SYNTHETIC", self.study.title());
         let mut c = plot::canvas_with_header(
             w,
@@ -234,7 +395,6 @@ impl StudyTable {
             "GC (%)".to_owned(),
             "PD (%, successful)".to_owned(),
         ];
-        let series: Vec<String> = self.rows.iter().map(|r| r.row.label.to_owned()).collect();
         let value = |m: &MeanSe| {
             (m.n > 0).then_some(Value {
                 mean: m.mean,
@@ -263,7 +423,7 @@ impl StudyTable {
                 values: &values,
             },
         );
-        plot::legend(&mut c, 70, h as i64 - 72, &series);
+        plot::legend(&mut c, 70, h as i64 - 72 - extra, &series);
         plot::footnote(
             &mut c,
             h as i64 - 24,

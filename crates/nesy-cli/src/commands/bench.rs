@@ -87,7 +87,9 @@ pub struct RunArgs {
     pub methods: Option<String>,
     /// A study: `ablation` (Table 3's shape) or `robustness` (Table 8's shape), each a set
     /// of NeSyCR variants under one stated error model, on Combination/medium with 3
-    /// repeats unless `--scenarios` and `--repeats` say otherwise. Needs `--vlm oracle`.
+    /// repeats; or `complexity-gap` (Figure 4(b)'s shape), NeSyCR and the controls on the
+    /// auxiliary complexity-gap suite with 1 repeat; unless `--scenarios`, `--repeats` and
+    /// `--suite` say otherwise. Needs `--vlm oracle`.
     #[arg(long, value_name = "NAME", conflicts_with = "methods")]
     pub study: Option<String>,
     /// Scenarios: `all`, or ids and id prefixes, comma-separated (`comb_medium`). Default
@@ -262,11 +264,7 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
         args.policy_timeout
     );
     let study = args.study.as_deref().map(Study::parse).transpose()?;
-    let repeats = args.repeats.unwrap_or(if study.is_some() {
-        Study::DEFAULT_REPEATS
-    } else {
-        1
-    });
+    let repeats = args.repeats.unwrap_or(study.map_or(1, Study::default_repeats));
     anyhow::ensure!(repeats >= 1, "--repeats must be at least 1");
     if let Some(r) = args.max_error_rate {
         anyhow::ensure!(
@@ -280,11 +278,10 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
             "--max-cost-usd must be a non-negative number, got {c}"
         );
     }
-    let scenarios = args.scenarios.as_deref().unwrap_or(if study.is_some() {
-        Study::DEFAULT_SCENARIOS
-    } else {
-        "all"
-    });
+    let scenarios = args
+        .scenarios
+        .as_deref()
+        .unwrap_or(study.map_or("all", Study::default_scenarios));
     let mut selection = Selection::parse(scenarios);
     selection.sample = args.sample;
     selection.sample_seed = args.sample_seed;

@@ -19,11 +19,15 @@ pub struct ScenariosArgs {
 /// The `nesy scenarios` subcommands.
 #[derive(Debug, clap::Subcommand)]
 pub enum ScenariosAction {
-    /// Write the 15 configuration files (`<factor>_<complexity>.json`).
+    /// Write the 15 configuration files (`<factor>_<complexity>.json`), or with `--gap` the
+    /// four files of the auxiliary complexity-gap suite (`gap_obst_plus<k>.json`).
     Generate {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
+        /// Write the complexity-gap suite (Figure 4(b); not part of the 440) instead.
+        #[arg(long)]
+        gap: bool,
     },
     /// Print the table of scenario counts (the paper's Table 6).
     List {
@@ -119,9 +123,13 @@ pub fn load_suite(suite: Option<&std::path::Path>) -> anyhow::Result<Vec<ConfigF
 /// Runs `nesy scenarios`.
 pub fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
     match args.action {
-        ScenariosAction::Generate { out } => {
+        ScenariosAction::Generate { out, gap } => {
             let started = Instant::now();
-            let files = scenario::generate_suite();
+            let files = if gap {
+                scenario::generate_gap_suite()
+            } else {
+                scenario::generate_suite()
+            };
             let all = scenario::scenarios(&files);
             // Generating every scene checks that the whole suite is usable.
             for s in &all {

@@ -75,6 +75,7 @@ impl RecordedRun {
                 init: self.target_state.clone(),
                 task: task(&self.target_objects),
                 scene_names: Vec::new(),
+                goal: None,
             },
             config: AdaptConfig {
                 budget: self.budget,

@@ -221,6 +221,13 @@ pub struct Target {
     /// checked (predicates still are).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub scene_names: Vec<Symbol>,
+    /// The target task's goal when its instruction states one beyond what the
+    /// demonstration shows (the complexity-gap suite's added subtasks). It replaces the goal
+    /// derived from the demonstration ([`derive_goal`]) in exploration and in the world
+    /// model [`run`] returns. `None`: the derived goal, as when source and target share their
+    /// subtasks.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goal: Option<Formula>,
 }
 
 /// One recorded event of a run.
@@ -400,7 +407,12 @@ pub async fn run<R: Reasoner>(
     config: &AdaptConfig,
 ) -> Result<Adaptation, AdaptError> {
     let mut trace = Trace::default();
-    let world_model = construct_world_model(reasoner, demo, config, &mut trace).await?;
+    let mut world_model = construct_world_model(reasoner, demo, config, &mut trace).await?;
+    // A goal the target states outright replaces the demonstrated one; without the goal
+    // check there is no goal to replace.
+    if let Some(goal) = target.goal.as_ref().filter(|_| config.goal_check) {
+        world_model.goal = goal.clone();
+    }
     let result = explore(reasoner, &world_model, target, config, &mut trace).await?;
     Ok(Adaptation {
         world_model,

@@ -182,6 +182,7 @@ fn target() -> Target {
         scene_names: ["floor", "orange", "hinge_body", "hinge_lid", "hinge_handle"]
             .map(Symbol::new)
             .to_vec(),
+        goal: None,
     }
 }
 
@@ -527,6 +528,50 @@ fn ablations_change_what_is_checked_and_shown() {
 }
 
 #[test]
+fn a_stated_target_goal_replaces_the_derived_one() {
+    let same = |goal: Option<&str>| Target {
+        init: demo().states[0].clone(),
+        task: task(),
+        scene_names: Vec::new(),
+        goal: goal.map(|g| crate::text::parse_formula(g).unwrap()),
+    };
+    // The demonstrated procedure reaches the derived goal from the demo's own start, so
+    // nothing is asked; a target that also wants the lid closed is a goal violation the
+    // loop must patch, and the world model it returns carries that goal.
+    let mut r = Scripted {
+        induction: good_inductions(),
+        ..Default::default()
+    };
+    let a = pollster::block_on(run(&mut r, &demo(), &same(None), &AdaptConfig::default())).unwrap();
+    assert!(matches!(a.outcome, Outcome::Adapted { iterations: 0, .. }));
+    let stated = "(and (InsideOf orange hinge_body) (Closed hinge_lid))";
+    let mut r = Scripted {
+        induction: good_inductions(),
+        ..Default::default()
+    };
+    let a = pollster::block_on(run(&mut r, &demo(), &same(Some(stated)), &AdaptConfig::default())).unwrap();
+    assert_eq!(
+        a.world_model.goal.to_string(),
+        crate::text::parse_formula(stated).unwrap().to_string()
+    );
+    assert!(matches!(a.outcome, Outcome::Unresolved { .. }), "{:?}", a.outcome);
+    assert_eq!(r.patch_requests.len(), 1);
+    let unmet = format!("{:?}", r.patch_requests[0]);
+    assert!(unmet.contains("Closed") && unmet.contains("hinge_lid"), "{unmet}");
+    // Without the goal check no goal is required, stated or not.
+    let mut r = Scripted {
+        induction: good_inductions(),
+        ..Default::default()
+    };
+    let config = AdaptConfig {
+        goal_check: false,
+        ..AdaptConfig::default()
+    };
+    let a = pollster::block_on(run(&mut r, &demo(), &same(Some(stated)), &config)).unwrap();
+    assert!(matches!(a.outcome, Outcome::Adapted { iterations: 0, .. }));
+}
+
+#[test]
 fn consistent_target_needs_no_patch_and_budget_table() {
     let mut r = Scripted {
         induction: good_inductions(),
@@ -536,6 +581,7 @@ fn consistent_target_needs_no_patch_and_budget_table() {
         init: demo().states[0].clone(),
         task: task(),
         scene_names: Vec::new(),
+        goal: None,
     };
     let a = pollster::block_on(run(&mut r, &demo(), &same, &AdaptConfig::default())).unwrap();
     assert!(matches!(a.outcome, Outcome::Adapted { iterations: 0, .. }));

@@ -15,6 +15,14 @@
 //! subtask out with variant `variant + s × SEED_STRIDE` and the composite offsets with
 //! episode `episode_id + s × SEED_STRIDE`, so the two seeds give two different scenes of the
 //! same configuration, and source and target always share layouts.
+//!
+//! The **complexity-gap suite** ([`generate_gap_suite`], Figure 4(b)) is auxiliary and not
+//! part of the 440: with the Obstruction factor fixed, each configuration demonstrates one
+//! subtask and deploys a target with 0–3 more subtasks of other kinds, every target subtask
+//! obstructed. The files are `gap_obst_plus<k>.json` and the ids
+//! `gap_obst_plus<k>_<NN>_s<seed>`. The demonstrated subtask keeps its kind and variant, so
+//! its objects are the same; it sits at the lone-subtask offset in the demonstration and at
+//! its composite slot in the target.
 
 use std::path::Path;
 
@@ -33,6 +41,14 @@ pub const CONFIG_SCHEMA_VERSION: u32 = 1;
 pub const SEEDS: [u64; 2] = [0, 1];
 /// Offset between the variants (and episodes) of consecutive seeds.
 pub const SEED_STRIDE: u64 = 1000;
+/// The domain factor the complexity-gap suite holds fixed (the paper's Figure 4(b) fixes
+/// Obstruction).
+pub const GAP_FACTOR: Factor = Factor::Obst;
+/// The added-subtask counts of the complexity-gap suite: the target has this many subtasks
+/// beyond the demonstration's one.
+pub const GAP_ADDED: [u8; 4] = [0, 1, 2, 3];
+/// Configurations per added-subtask count in the complexity-gap suite.
+pub const GAP_CONFIGURATIONS: usize = 10;
 
 /// One source/target configuration (the authors' episode).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -42,7 +58,8 @@ pub struct EpisodeConfig {
     pub episode_id: u64,
     /// The demo's subtasks, in instruction order.
     pub source_subtasks: Vec<SubtaskConfig>,
-    /// The deployment's subtasks: the same kinds and variants, other obstruction levels.
+    /// The deployment's subtasks: the same kinds and variants, other obstruction levels, and
+    /// in the complexity-gap suite the file's `added_subtasks` more after them.
     pub target_subtasks: Vec<SubtaskConfig>,
     /// The demonstrating robot.
     pub source_embodiment: Embodiment,
@@ -65,6 +82,10 @@ pub struct ConfigFile {
     pub complexity: Complexity,
     /// Seeds each episode is evaluated with.
     pub seeds: Vec<u64>,
+    /// In a complexity-gap file, the subtasks each target has beyond its demonstration's
+    /// (0–3); absent in the files of the 440 suite.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub added_subtasks: Option<u8>,
     /// The episodes.
     pub episodes: Vec<EpisodeConfig>,
 }
@@ -151,6 +172,11 @@ impl std::fmt::Display for Side {
 /// The file name of a configuration file: `<factor>_<complexity>.json`.
 pub fn config_file_name(factor: Factor, complexity: Complexity) -> String {
     format!("{}_{}.json", factor.as_str(), complexity.as_str())
+}
+
+/// The file name of a complexity-gap file: `gap_<factor>_plus<k>.json`.
+pub fn gap_file_name(factor: Factor, added: u8) -> String {
+    format!("gap_{}_plus{added}.json", factor.as_str())
 }
 
 /// Ordered obstruction changes `comb` draws from, per subtask (source → target).
@@ -248,8 +274,73 @@ pub fn generate_file(factor: Factor, complexity: Complexity) -> ConfigFile {
         factor,
         complexity,
         seeds: SEEDS.to_vec(),
+        added_subtasks: None,
         episodes,
     }
+}
+
+/// Generates the complexity-gap file with `added` subtasks beyond the demonstration's one
+/// (at most 3: a task has at most four subtasks, each kind once).
+///
+/// Configuration `i` draws its kind order, variants and target obstruction levels from one
+/// stream that does not depend on `added`, so the files differ only in how many of the
+/// drawn subtasks the target keeps: configuration `i` demonstrates the same subtask in
+/// every file, and the gap grows by appending subtasks.
+pub fn generate_gap_file(added: u8) -> ConfigFile {
+    let tag = format!("scenarios/gap/{}", GAP_FACTOR.as_str());
+    let episodes = (0..GAP_CONFIGURATIONS)
+        .map(|i| {
+            let mut rng = Stream::new(&tag, i as u64);
+            let mut kinds = SubtaskKind::ALL.to_vec();
+            rng.shuffle(&mut kinds);
+            let drawn: Vec<(SubtaskKind, u64, u8)> = kinds
+                .into_iter()
+                .map(|kind| {
+                    (
+                        kind,
+                        rng.index(SEED_STRIDE as usize) as u64,
+                        1 + rng.index(2) as u8,
+                    )
+                })
+                .collect();
+            let subtask = |&(kind, variant, obst_level): &(SubtaskKind, u64, u8)| SubtaskConfig {
+                kind,
+                variant,
+                obst_level,
+                multi_level: 0,
+            };
+            let target_subtasks: Vec<SubtaskConfig> =
+                drawn.iter().take(1 + usize::from(added)).map(subtask).collect();
+            // The demonstration shows the first subtask unobstructed (Obstruction: a clean
+            // source, an obstructed target).
+            let source_subtasks = vec![SubtaskConfig {
+                obst_level: 0,
+                ..target_subtasks[0]
+            }];
+            EpisodeConfig {
+                episode_id: i as u64,
+                source_subtasks,
+                target_subtasks,
+                source_embodiment: Embodiment::Finger,
+                target_embodiment: Embodiment::Finger,
+                embodiment_in_state: GAP_FACTOR.names_embodiment(),
+            }
+        })
+        .collect();
+    ConfigFile {
+        schema_version: CONFIG_SCHEMA_VERSION,
+        factor: GAP_FACTOR,
+        complexity: Complexity::Low,
+        seeds: SEEDS.to_vec(),
+        added_subtasks: Some(added),
+        episodes,
+    }
+}
+
+/// Generates the four complexity-gap files (0 to 3 added subtasks): 10 configurations × 2
+/// seeds each, 80 scenarios, none of them among the 440.
+pub fn generate_gap_suite() -> Vec<ConfigFile> {
+    GAP_ADDED.iter().map(|&k| generate_gap_file(k)).collect()
 }
 
 /// Generates all 15 configuration files, factor-major.
@@ -268,6 +359,15 @@ pub fn config_schema() -> String {
 }
 
 impl ConfigFile {
+    /// The file's name in a suite folder: [`config_file_name`], or [`gap_file_name`] for a
+    /// complexity-gap file.
+    pub fn file_name(&self) -> String {
+        match self.added_subtasks {
+            None => config_file_name(self.factor, self.complexity),
+            Some(added) => gap_file_name(self.factor, added),
+        }
+    }
+
     /// Pretty JSON with a trailing newline.
     pub fn to_json_pretty(&self) -> String {
         let mut text = serde_json::to_string_pretty(self).unwrap_or_default();
@@ -298,7 +398,8 @@ impl ConfigFile {
     }
 
     /// Checks the version, the subtask lists of every episode, and that source and target
-    /// share kinds and variants.
+    /// share kinds and variants (in a complexity-gap file: that the target starts with the
+    /// source's subtasks, in order, and has `added_subtasks` more).
     pub fn validate(&self, origin: &str) -> Result<(), ScenarioError> {
         let invalid = |field: String, expected: &str, found: String| ScenarioError::Invalid {
             path: origin.to_owned(),
@@ -338,6 +439,21 @@ impl ConfigFile {
             let key = |s: &SubtaskConfig| (s.kind, s.variant);
             let mut a: Vec<_> = episode.source_subtasks.iter().map(key).collect();
             let mut b: Vec<_> = episode.target_subtasks.iter().map(key).collect();
+            if let Some(added) = self.added_subtasks {
+                let wanted = a.len() + usize::from(added);
+                if b.len() != wanted || b[..a.len()] != a[..] {
+                    return Err(invalid(
+                        format!("episodes[{e}].target_subtasks"),
+                        &format!(
+                            "the source's {} subtask(s) in order, then {} more (added_subtasks)",
+                            a.len(),
+                            added
+                        ),
+                        format!("{b:?} (source {a:?})"),
+                    ));
+                }
+                continue;
+            }
             a.sort();
             b.sort();
             if a != b {
@@ -361,7 +477,7 @@ pub fn write_suite(files: &[ConfigFile], dir: &Path) -> Result<Vec<std::path::Pa
     files
         .iter()
         .map(|file| {
-            let path = dir.join(config_file_name(file.factor, file.complexity));
+            let path = dir.join(file.file_name());
             std::fs::write(&path, file.to_json_pretty()).map_err(|source| ScenarioError::Io {
                 path: path.display().to_string(),
                 source,
@@ -371,7 +487,8 @@ pub fn write_suite(files: &[ConfigFile], dir: &Path) -> Result<Vec<std::path::Pa
         .collect()
 }
 
-/// Reads every `<factor>_<complexity>.json` present in `dir` (at least one must exist).
+/// Reads every `<factor>_<complexity>.json` and `gap_<factor>_plus<k>.json` present in `dir`
+/// (at least one must exist).
 pub fn read_suite(dir: &Path) -> Result<Vec<ConfigFile>, ScenarioError> {
     let mut files = Vec::new();
     for factor in Factor::ALL {
@@ -381,7 +498,7 @@ pub fn read_suite(dir: &Path) -> Result<Vec<ConfigFile>, ScenarioError> {
                 continue;
             }
             let file = ConfigFile::from_file(&path)?;
-            if (file.factor, file.complexity) != (factor, complexity) {
+            if (file.factor, file.complexity, file.added_subtasks) != (factor, complexity, None) {
                 return Err(ScenarioError::Invalid {
                     path: path.display().to_string(),
                     field: "factor/complexity".into(),
@@ -392,12 +509,32 @@ pub fn read_suite(dir: &Path) -> Result<Vec<ConfigFile>, ScenarioError> {
             files.push(file);
         }
     }
+    for added in GAP_ADDED {
+        let path = dir.join(gap_file_name(GAP_FACTOR, added));
+        if !path.exists() {
+            continue;
+        }
+        let file = ConfigFile::from_file(&path)?;
+        if (file.factor, file.added_subtasks) != (GAP_FACTOR, Some(added)) {
+            return Err(ScenarioError::Invalid {
+                path: path.display().to_string(),
+                field: "factor/added_subtasks".into(),
+                expected: format!("{GAP_FACTOR}/{added} (from the file name)"),
+                found: format!(
+                    "{}/{}",
+                    file.factor,
+                    file.added_subtasks.map_or("absent".to_owned(), |k| k.to_string())
+                ),
+            });
+        }
+        files.push(file);
+    }
     if files.is_empty() {
         return Err(ScenarioError::Io {
             path: dir.display().to_string(),
             source: std::io::Error::new(
                 std::io::ErrorKind::NotFound,
-                "no <factor>_<complexity>.json configuration files (write them with `nesy scenarios generate`)",
+                "no <factor>_<complexity>.json or gap_<factor>_plus<k>.json configuration files (write them with `nesy scenarios generate`)",
             ),
         });
     }
@@ -407,12 +544,16 @@ pub fn read_suite(dir: &Path) -> Result<Vec<ConfigFile>, ScenarioError> {
 /// One evaluation scenario: a configuration and a seed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scenario {
-    /// `<factor>_<complexity>_<NN>_s<seed>`, e.g. `comb_high_07_s1`.
+    /// `<factor>_<complexity>_<NN>_s<seed>`, e.g. `comb_high_07_s1`, or
+    /// `gap_<factor>_plus<k>_<NN>_s<seed>` in the complexity-gap suite.
     pub id: String,
     /// The domain factor.
     pub factor: Factor,
-    /// The complexity.
+    /// The complexity (the file's; `low` in the complexity-gap suite).
     pub complexity: Complexity,
+    /// Subtasks the target has beyond the demonstration's, in the complexity-gap suite
+    /// (`None` in the 440).
+    pub added_subtasks: Option<u8>,
     /// The configuration.
     pub episode: EpisodeConfig,
     /// The seed.
@@ -442,6 +583,11 @@ pub fn scenario_id(factor: Factor, complexity: Complexity, episode_id: u64, seed
         factor.as_str(),
         complexity.as_str()
     )
+}
+
+/// The id of a complexity-gap scenario.
+pub fn gap_scenario_id(factor: Factor, added: u8, episode_id: u64, seed: u64) -> String {
+    format!("gap_{}_plus{added}_{episode_id:02}_s{seed}", factor.as_str())
 }
 
 impl Scenario {
@@ -490,9 +636,13 @@ pub fn scenarios(files: &[ConfigFile]) -> Vec<Scenario> {
         .flat_map(|file| {
             file.episodes.iter().flat_map(move |episode| {
                 file.seeds.iter().map(move |&seed| Scenario {
-                    id: scenario_id(file.factor, file.complexity, episode.episode_id, seed),
+                    id: match file.added_subtasks {
+                        Some(added) => gap_scenario_id(file.factor, added, episode.episode_id, seed),
+                        None => scenario_id(file.factor, file.complexity, episode.episode_id, seed),
+                    },
                     factor: file.factor,
                     complexity: file.complexity,
+                    added_subtasks: file.added_subtasks,
                     episode: episode.clone(),
                     seed,
                 })
@@ -629,6 +779,65 @@ mod tests {
                 assert_eq!(count(Embodiment::Finger, Embodiment::Finger), none);
             }
         }
+    }
+
+    #[test]
+    fn the_gap_suite_appends_subtasks_to_a_shared_demonstration() {
+        let files = generate_gap_suite();
+        assert_eq!(files.len(), GAP_ADDED.len());
+        for (file, &added) in files.iter().zip(&GAP_ADDED) {
+            file.validate("generated").unwrap();
+            assert_eq!(file.added_subtasks, Some(added));
+            assert_eq!(file.file_name(), format!("gap_obst_plus{added}.json"));
+            assert_eq!(file.episodes.len(), GAP_CONFIGURATIONS);
+            for (e, base) in file.episodes.iter().zip(&files[0].episodes) {
+                // The same demonstration at every gap; the target keeps it first.
+                assert_eq!(e.source_subtasks, base.source_subtasks);
+                assert_eq!(e.source_subtasks.len(), 1);
+                assert_eq!(e.target_subtasks.len(), 1 + usize::from(added));
+                assert_eq!(e.target_subtasks[0].kind, e.source_subtasks[0].kind);
+                assert_eq!(e.target_subtasks[0].variant, e.source_subtasks[0].variant);
+                // Obstruction: a clean demonstration, every target subtask obstructed.
+                assert_eq!(e.source_subtasks[0].obst_level, 0);
+                assert!(e.target_subtasks.iter().all(|t| t.obst_level >= 1));
+                assert!(
+                    base.target_subtasks
+                        .iter()
+                        .zip(&e.target_subtasks)
+                        .all(|(a, b)| a == b)
+                );
+            }
+        }
+        let all = scenarios(&files);
+        assert_eq!(all.len(), 80);
+        let s = find(&files, "gap_obst_plus2_03_s1").unwrap();
+        assert_eq!((s.added_subtasks, s.seed), (Some(2), 1));
+        let scenes = s.scenes().unwrap();
+        assert_eq!(scenes.target.scene.goals.len(), 3);
+        assert_eq!(scenes.source.scene.goals.len(), 1);
+        // None of them is among the 440.
+        let main = scenarios(&generate_suite());
+        assert!(
+            main.iter()
+                .all(|m| m.added_subtasks.is_none() && !m.id.starts_with("gap_"))
+        );
+        // A target that does not start with the demonstration is refused, naming the field.
+        let mut bad = files[1].clone();
+        bad.episodes[4].target_subtasks.swap(0, 1);
+        let err = ConfigFile::from_json_str(&bad.to_json_pretty(), "g.json")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("g.json") && err.contains("episodes[4].target_subtasks"),
+            "{err}"
+        );
+        let back = ConfigFile::from_json_str(&files[3].to_json_pretty(), "g.json").unwrap();
+        assert_eq!(back, files[3]);
+        assert!(
+            !generate_file(Factor::Obst, Complexity::Low)
+                .to_json_pretty()
+                .contains("added_subtasks")
+        );
     }
 
     #[test]

@@ -14,7 +14,7 @@
 //! Goal violations (every step applies, the goal does not hold) get a plan to the unmet
 //! goal literals appended after the last action.
 
-use nesy_core::adapt::{ViolationInfo, ViolationKind, resolves};
+use nesy_core::adapt::{Problem, ViolationInfo, ViolationKind, resolves};
 use nesy_core::exec::{ExecError, Report, UnmetPrecondition};
 use nesy_core::formula::{AtomPattern, Effect, Formula};
 use nesy_core::operator::Operator;
@@ -357,7 +357,25 @@ fn propose_checked(
             let Some(last) = procedure.last() else {
                 return Err(OraclePatchError::Unresolvable("the procedure is empty".into()));
             };
-            match planning.plan(&error_state, &goal_of(&unmet)) {
+            // A goal literal that held when the request was made is not among the unmet
+            // ones, so a plan to the unmet literals alone may undo it (open a drawer the goal
+            // wants closed). The verifier's feedback names such literals; like a model
+            // reading it, the next plan reaches them too.
+            let mut wanted = unmet.clone();
+            for f in &req.feedback {
+                if let Problem::NotResolved {
+                    failing_step: None,
+                    unmet: left,
+                } = &f.problem
+                {
+                    for u in left {
+                        if !wanted.iter().any(|w| w.literal == u.literal) {
+                            wanted.push(u.clone());
+                        }
+                    }
+                }
+            }
+            match planning.plan(&error_state, &goal_of(&wanted)) {
                 Ok((plan, _)) => {
                     let mut replace = vec![last.clone()];
                     replace.extend(plan);
@@ -604,6 +622,81 @@ mod tests {
         let report = verify_procedure(&init, &patched, Some(&goal));
         assert!(report.first_failure.is_none());
         assert!(report.goal.is_some_and(|g| g.satisfied), "{patched:?}");
+    }
+
+    /// A goal patch plans to the unmet literals; one that held when asked (the lid closed)
+    /// can be undone by that plan, and the verifier's rejection names it. The next proposal
+    /// reaches it too.
+    #[test]
+    fn a_goal_patch_also_reaches_what_the_last_rejection_left_unmet() {
+        let world = WorldDomain::builtin().unwrap();
+        let init = parse_state_list(
+            "- (Closed hinge_lid)\n- (GripperOpen)\n- (OnTopOf hinge_body floor)\n- (OnTopOf apple floor)",
+        )
+        .unwrap();
+        let names = ["apple", "hinge_body", "hinge_lid", "hinge_handle", "floor"];
+        let universe = world.universe(names);
+        let planning = Planning {
+            universe: universe.clone(),
+            schemas: world.schemas_for(Embodiment::Finger, &universe),
+            target: Embodiment::Finger,
+            config: &PlannerConfig::default(),
+        };
+        let (procedure, end) = planning
+            .plan(&init, &parse_formula("(GripperSurrounding apple)").unwrap())
+            .unwrap();
+        let inside = parse_formula("(InsideOf apple hinge_body)").unwrap();
+        let closed = parse_formula("(Closed hinge_lid)").unwrap();
+        let goal = Formula::And(vec![inside.clone(), closed.clone()]);
+        let unmet = |f: &Formula| UnmetPrecondition {
+            literal: f.clone(),
+            atoms: Vec::new(),
+        };
+        let patched_with = |feedback: Vec<nesy_core::adapt::Feedback>| {
+            let ctx = PatchContext {
+                request: PatchRequest {
+                    iteration: 0,
+                    task: TaskContext {
+                        instruction: "Put the apple in the hinge box and close it.".into(),
+                        objects: names.iter().map(|n| Symbol::new(n)).collect::<Vec<_>>(),
+                        tier: Tier::Full,
+                        vocabulary: Vocabulary::default(),
+                    },
+                    kind: ViolationKind::Goal,
+                    executed: procedure.clone(),
+                    procedure: procedure.clone(),
+                    erroneous: None,
+                    remaining: Vec::new(),
+                    failing_step: None,
+                    initial_state: init.clone(),
+                    error_state: end.clone(),
+                    unmet: vec![unmet(&inside)],
+                    feedback,
+                },
+                target_embodiment: Embodiment::Finger,
+            };
+            let patch = propose(world, &ctx, &PlannerConfig::default()).unwrap();
+            assert_eq!(patch.strategy, Strategy::Append);
+            let mut patched = procedure[..patch.at].to_vec();
+            patched.extend(patch.replace.iter().cloned());
+            verify_procedure(&init, &patched, Some(&goal))
+        };
+        let first = patched_with(Vec::new());
+        assert!(first.first_failure.is_none());
+        assert!(!first.goal.as_ref().unwrap().satisfied, "the lid was left open");
+        let rejection = nesy_core::adapt::Feedback {
+            attempt: 0,
+            reply: String::new(),
+            problem: Problem::NotResolved {
+                failing_step: None,
+                unmet: vec![unmet(&closed)],
+            },
+            message: "After the patch every action applies but these goal conditions still do not hold"
+                .into(),
+        };
+        let second = patched_with(vec![rejection]);
+        assert!(second.first_failure.is_none());
+        assert!(second.goal.is_some_and(|g| g.satisfied));
     }
 
     /// Without identification and with a missed localisation, the request is re-aimed at a

@@ -71,6 +71,7 @@ pub fn target() -> Target {
         ]),
         task: task(Tier::Full),
         scene_names: Vec::new(),
+        goal: None,
     }
 }
 
