@@ -33,6 +33,24 @@ fn run_args(run: &Path, demos: &Path, extra: &[&str]) -> Vec<String> {
     args
 }
 
+/// `nesy bench run RUN --study STUDY --scenarios IDS --vlm oracle --demos DEMOS` and `extra`.
+fn study_run(run: &Path, study: &str, scenarios: &str, demos: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args: Vec<String> = ["bench", "run"].map(String::from).to_vec();
+    args.push(run.display().to_string());
+    for (flag, value) in [
+        ("--study", study),
+        ("--scenarios", scenarios),
+        ("--vlm", "oracle"),
+    ] {
+        args.push(flag.into());
+        args.push(value.into());
+    }
+    args.push("--demos".into());
+    args.push(demos.display().to_string());
+    args.extend(extra.iter().map(|s| s.to_string()));
+    common::nesy(&args)
+}
+
 fn lines(path: &Path) -> usize {
     std::fs::read_dir(path.join("results"))
         .map(|d| {
@@ -230,21 +248,7 @@ fn the_ablation_study_runs_its_rows_and_reports_them_in_table_3_shape() {
     let scratch = common::scratch();
     let run = scratch.path().join("ablation");
     let demos = scratch.path().join("demos");
-    let out = common::nesy(&[
-        "bench".into(),
-        "run".into(),
-        run.display().to_string(),
-        "--study".into(),
-        "ablation".into(),
-        "--scenarios".into(),
-        "comb_medium_07_s1".into(),
-        "--repeats".into(),
-        "2".into(),
-        "--vlm".into(),
-        "oracle".into(),
-        "--demos".into(),
-        demos.display().to_string(),
-    ]);
+    let out = study_run(&run, "ablation", "comb_medium_07_s1", &demos, &["--repeats", "2"]);
     assert_eq!(
         out.status.code(),
         Some(0),
@@ -302,19 +306,13 @@ fn the_complexity_gap_study_reports_sr_and_pd_by_added_subtasks() {
     let scratch = common::scratch();
     let run = scratch.path().join("gap");
     let demos = scratch.path().join("demos");
-    let out = common::nesy(&[
-        "bench".into(),
-        "run".into(),
-        run.display().to_string(),
-        "--study".into(),
-        "complexity-gap".into(),
-        "--scenarios".into(),
-        "gap_obst_plus0_03_s0,gap_obst_plus1_03_s0".into(),
-        "--vlm".into(),
-        "oracle".into(),
-        "--demos".into(),
-        demos.display().to_string(),
-    ]);
+    let out = study_run(
+        &run,
+        "complexity-gap",
+        "gap_obst_plus0_03_s0,gap_obst_plus1_03_s0",
+        &demos,
+        &[],
+    );
     assert_eq!(
         out.status.code(),
         Some(0),

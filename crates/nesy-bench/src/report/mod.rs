@@ -915,7 +915,7 @@ fn series_titles(variants: &[String]) -> Vec<String> {
 fn plot_cells(tables: &Tables, banner: Option<&str>) -> plot::Canvas {
     let w = 1500usize;
     let series = series_titles(&tables.variants);
-    let extra = (plot::legend_lines(w, 70, &series) - 1).max(0) * plot::LEGEND_LINE;
+    let extra = plot::legend_overflow(w, 70, &series, 1);
     let h = 860 + extra as usize;
     let mut c = plot::canvas_with_header(
         w,
@@ -1006,7 +1006,7 @@ fn two_panel_lines(f: SrPd, banner: Option<&str>) -> plot::Canvas {
     } = f;
     let w = 1100usize;
     // Room for every legend line: a run's variant names can be long.
-    let extra = (plot::legend_lines(w, 70, series) - 1).max(0) * plot::LEGEND_LINE;
+    let extra = plot::legend_overflow(w, 70, series, 1);
     let h = 560 + extra as usize;
     let mut c = plot::canvas_with_header(w, h, header, banner.map(short_banner));
     for (i, (title, values)) in [("SR (%)", sr), ("PD (%, successful units)", pd)]

@@ -330,10 +330,16 @@ fn legend_layout(width: usize, x: i64, series: &[String]) -> Vec<(i64, i64)> {
 
 /// How many lines the legend of `series` takes at `x` on a canvas `width` wide, so a
 /// figure can make room for it before drawing.
-pub fn legend_lines(width: usize, x: i64, series: &[String]) -> i64 {
+fn legend_lines(width: usize, x: i64, series: &[String]) -> i64 {
     legend_layout(width, x, series)
         .last()
         .map_or(0, |&(_, dy)| dy / LEGEND_LINE + 1)
+}
+
+/// The pixels a figure adds to its height so that the legend of `series` at `x` fits, when
+/// its layout leaves room for `room` lines.
+pub fn legend_overflow(width: usize, x: i64, series: &[String], room: i64) -> i64 {
+    (legend_lines(width, x, series) - room).max(0) * LEGEND_LINE
 }
 
 /// Draws a legend of `series` in a row starting at (x, y).
@@ -439,6 +445,8 @@ mod tests {
         // Each 40-character name is 336 px with its swatch: one per line on a 400 px canvas.
         let long: Vec<String> = (0..3).map(|i| format!("{i:0>40}")).collect();
         assert_eq!(legend_lines(400, 10, &long), 3);
+        assert_eq!(legend_overflow(400, 10, &long, 2), LEGEND_LINE);
+        assert_eq!(legend_overflow(400, 10, &short, 2), 0);
         let at = legend_layout(400, 10, &long);
         assert!(at.iter().all(|&(x, _)| x == 10), "{at:?}");
         assert_eq!(

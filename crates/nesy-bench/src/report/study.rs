@@ -44,22 +44,36 @@ pub(super) struct AddedStats {
     pd: MeanSe,
 }
 
-/// SR averaged per scenario over its repeats, then mean × 100 ± SE over scenarios.
-fn scenario_sr(records: &[&UnitRecord]) -> (usize, MeanSe) {
+/// `pick` averaged per scenario over its repeats, then mean × 100 ± SE over scenarios; and
+/// how many scenarios that is.
+fn per_scenario(records: &[&UnitRecord], pick: impl Fn(&UnitRecord) -> f64) -> (usize, MeanSe) {
     let mut by_scenario: BTreeMap<&str, Vec<f64>> = BTreeMap::new();
     for r in records {
         by_scenario
             .entry(r.key.scenario.as_str())
             .or_default()
-            .push(r.scores.sr);
+            .push(pick(r));
     }
-    let sr = tally(
+    let mean = tally(
         by_scenario
             .values()
             .map(|v| v.iter().sum::<f64>() / v.len() as f64),
     )
     .percent();
-    (by_scenario.len(), sr)
+    (by_scenario.len(), mean)
+}
+
+/// PD × 100 ± SE over the units that succeeded, as the paper reports it.
+fn success_pd(records: &[&UnitRecord]) -> MeanSe {
+    tally(records.iter().filter(|r| r.scores.sr == 1.0).map(|r| r.scores.pd)).percent()
+}
+
+/// A figure's point for a mean ± SE: none without units, no whisker for a single one.
+fn plotted(m: &MeanSe) -> Option<Value> {
+    (m.n > 0).then_some(Value {
+        mean: m.mean,
+        se: if m.n > 1 { m.se } else { f64::NAN },
+    })
 }
 
 /// The study's rows, in the study's order.
@@ -100,18 +114,8 @@ impl StudyTable {
                 }
                 let scored: Vec<&UnitRecord> =
                     mine.iter().copied().filter(|r| r.status.is_scored()).collect();
-                let mut by_scenario: BTreeMap<&str, Vec<&UnitRecord>> = BTreeMap::new();
-                for r in &scored {
-                    by_scenario.entry(r.key.scenario.as_str()).or_default().push(r);
-                }
-                let scenario_mean = |pick: &dyn Fn(&UnitRecord) -> f64| {
-                    tally(
-                        by_scenario
-                            .values()
-                            .map(|rs| rs.iter().map(|r| pick(r)).sum::<f64>() / rs.len() as f64),
-                    )
-                    .percent()
-                };
+                let (scenarios, sr) = per_scenario(&scored, |r| r.scores.sr);
+                let (_, gc) = per_scenario(&scored, |r| r.scores.gc);
                 let translated: Vec<_> = scored.iter().filter_map(|r| r.states.as_ref()).collect();
                 let agreement = (!translated.is_empty()).then(|| {
                     let n = translated.len() as f64;
@@ -129,20 +133,19 @@ impl StudyTable {
                 let by_added = by_added
                     .into_iter()
                     .map(|(k, rs)| {
-                        let (scenarios, sr) = scenario_sr(&rs);
-                        let pd =
-                            tally(rs.iter().filter(|r| r.scores.sr == 1.0).map(|r| r.scores.pd)).percent();
+                        let (scenarios, sr) = per_scenario(&rs, |r| r.scores.sr);
+                        let pd = success_pd(&rs);
                         (k, AddedStats { scenarios, sr, pd })
                     })
                     .collect();
                 RowStats {
                     by_added,
                     id,
-                    scenarios: by_scenario.len(),
+                    scenarios,
                     units: scored.len(),
-                    sr: scenario_mean(&|r| r.scores.sr),
-                    gc: scenario_mean(&|r| r.scores.gc),
-                    pd: tally(scored.iter().filter(|r| r.scores.sr == 1.0).map(|r| r.scores.pd)).percent(),
+                    sr,
+                    gc,
+                    pd: success_pd(&scored),
                     calls: tally(scored.iter().map(|r| r.effort.calls as f64)),
                     statuses,
                     agreement,
@@ -322,12 +325,7 @@ impl StudyTable {
                 .map(|r| {
                     added
                         .iter()
-                        .map(|k| {
-                            r.by_added.get(k).map(f).filter(|m| m.n > 0).map(|m| Value {
-                                mean: m.mean,
-                                se: if m.n > 1 { m.se } else { f64::NAN },
-                            })
-                        })
+                        .map(|k| r.by_added.get(k).map(f).and_then(plotted))
                         .collect()
                 })
                 .collect()
@@ -381,7 +379,7 @@ impl StudyTable {
         let w = 1200usize;
         let series: Vec<String> = self.rows.iter().map(|r| r.row.label.to_owned()).collect();
         // The layout leaves room for two legend lines; more lengthen the canvas.
-        let extra = (plot::legend_lines(w, 70, &series) - 2).max(0) * plot::LEGEND_LINE;
+        let extra = plot::legend_overflow(w, 70, &series, 2);
         let h = 560 + extra as usize;
         let header = format!("{} - SYNTHETIC", self.study.title());
         let mut c = plot::canvas_with_header(
@@ -395,16 +393,10 @@ impl StudyTable {
             "GC (%)".to_owned(),
             "PD (%, successful)".to_owned(),
         ];
-        let value = |m: &MeanSe| {
-            (m.n > 0).then_some(Value {
-                mean: m.mean,
-                se: if m.n > 1 { m.se } else { f64::NAN },
-            })
-        };
         let values: Vec<Vec<Option<Value>>> = self
             .rows
             .iter()
-            .map(|r| vec![value(&r.sr), value(&r.gc), value(&r.pd)])
+            .map(|r| vec![plotted(&r.sr), plotted(&r.gc), plotted(&r.pd)])
             .collect();
         plot::draw_bars(
             &mut c,

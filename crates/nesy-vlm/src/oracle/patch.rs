@@ -105,7 +105,25 @@ struct Planning<'a> {
     config: &'a PlannerConfig,
 }
 
-impl Planning<'_> {
+impl<'a> Planning<'a> {
+    /// The true domain's schemas for the `target` end effector over a typed universe of
+    /// `names`.
+    fn over<'n>(
+        world: &WorldDomain,
+        names: impl IntoIterator<Item = &'n str>,
+        target: Embodiment,
+        config: &'a PlannerConfig,
+    ) -> Planning<'a> {
+        let universe = world.universe(names);
+        let schemas = world.schemas_for(target, &universe);
+        Planning {
+            universe,
+            schemas,
+            target,
+            config,
+        }
+    }
+
     /// Plans from `state` to `goal`; returns the printable actions and the state after them.
     fn plan(&self, state: &State, goal: &Formula) -> Result<(Vec<Operator>, State), String> {
         let emb = Atom::new(self.target.state_predicate(), &[]);
@@ -231,14 +249,7 @@ pub fn plan_to_goal(
 ) -> Result<Vec<Operator>, String> {
     let mut names: Vec<Symbol> = objects.to_vec();
     names.extend(state.objects());
-    let universe = world.universe(names.iter().map(|s| s.as_str()));
-    let schemas = world.schemas_for(embodiment, &universe);
-    let planning = Planning {
-        universe,
-        schemas,
-        target: embodiment,
-        config,
-    };
+    let planning = Planning::over(world, names.iter().map(|s| s.as_str()), embodiment, config);
     planning.plan(state, goal).map(|(ops, _)| ops)
 }
 
@@ -314,14 +325,12 @@ fn propose_checked(
     for op in &req.procedure {
         names.extend(op.constants());
     }
-    let universe = world.universe(names.iter().map(|s| s.as_str()));
-    let schemas = world.schemas_for(ctx.target_embodiment, &universe);
-    let planning = Planning {
-        universe,
-        schemas,
-        target: ctx.target_embodiment,
+    let planning = Planning::over(
+        world,
+        names.iter().map(|s| s.as_str()),
+        ctx.target_embodiment,
         config,
-    };
+    );
     let procedure = &req.procedure;
 
     // Identification ablated: find the violation ourselves.
@@ -566,62 +575,89 @@ mod tests {
 
     use super::*;
 
+    /// The apple-and-hinge-box scene every test here plans in.
+    const HINGE_SCENE: [&str; 5] = ["apple", "hinge_body", "hinge_lid", "hinge_handle", "floor"];
+
+    /// The finger robot's planning over the hinge-box scene.
+    fn hinge_planning(config: &PlannerConfig) -> Planning<'_> {
+        Planning::over(
+            WorldDomain::builtin().unwrap(),
+            HINGE_SCENE,
+            Embodiment::Finger,
+            config,
+        )
+    }
+
+    /// The request after `procedure` ran from `init` to `end` with every action applied and
+    /// the `unmet` goal literals not holding, with the verifier's `feedback` on earlier
+    /// proposals.
+    fn goal_violation(
+        procedure: &[Operator],
+        init: &State,
+        end: &State,
+        unmet: &[&Formula],
+        feedback: Vec<nesy_core::adapt::Feedback>,
+    ) -> PatchContext {
+        PatchContext {
+            request: PatchRequest {
+                iteration: 0,
+                task: TaskContext {
+                    instruction: "Put the apple in the hinge box and close it.".into(),
+                    objects: HINGE_SCENE.iter().map(|n| Symbol::new(n)).collect::<Vec<_>>(),
+                    tier: Tier::Full,
+                    vocabulary: Vocabulary::default(),
+                },
+                kind: ViolationKind::Goal,
+                executed: procedure.to_vec(),
+                procedure: procedure.to_vec(),
+                erroneous: None,
+                remaining: Vec::new(),
+                failing_step: None,
+                initial_state: init.clone(),
+                error_state: end.clone(),
+                unmet: unmet.iter().map(|f| literal(f)).collect(),
+                feedback,
+            },
+            target_embodiment: Embodiment::Finger,
+        }
+    }
+
+    fn literal(f: &Formula) -> UnmetPrecondition {
+        UnmetPrecondition {
+            literal: f.clone(),
+            atoms: Vec::new(),
+        }
+    }
+
+    /// The oracle's proposal for `ctx`, which must append, spliced into `procedure` and
+    /// verified from `init` against `goal`.
+    fn appended(ctx: &PatchContext, procedure: &[Operator], init: &State, goal: &Formula) -> Report {
+        let patch = propose(WorldDomain::builtin().unwrap(), ctx, &PlannerConfig::default()).unwrap();
+        assert_eq!(patch.strategy, Strategy::Append);
+        let mut patched = procedure[..patch.at].to_vec();
+        patched.extend(patch.replace.iter().cloned());
+        verify_procedure(init, &patched, Some(goal))
+    }
+
     /// A procedure that ends with every action applied but the goal `(Closed hinge_lid)`
     /// unmet (the lid was left open) gets a plan appended that closes it, and the check
     /// accepts it: the goal literals hold after the patched procedure.
     #[test]
     fn a_goal_violation_gets_an_appended_plan_that_reaches_the_goal() {
-        let world = WorldDomain::builtin().unwrap();
         let init = parse_state_list(
             "- (Open hinge_lid)\n- (GripperOpen)\n- (OnTopOf hinge_body floor)\n- (OnTopOf apple floor)",
         )
         .unwrap();
-        let names = ["apple", "hinge_body", "hinge_lid", "hinge_handle", "floor"];
-        let universe = world.universe(names);
-        let planning = Planning {
-            universe: universe.clone(),
-            schemas: world.schemas_for(Embodiment::Finger, &universe),
-            target: Embodiment::Finger,
-            config: &PlannerConfig::default(),
-        };
-        let (procedure, end) = planning
+        let config = PlannerConfig::default();
+        let (procedure, end) = hinge_planning(&config)
             .plan(&init, &parse_formula("(InsideOf apple hinge_body)").unwrap())
             .unwrap();
         let goal = parse_formula("(Closed hinge_lid)").unwrap();
         assert!(!holds(&end, &goal));
-        let request = PatchRequest {
-            iteration: 0,
-            task: TaskContext {
-                instruction: "Put the apple in the hinge box and close it.".into(),
-                objects: names.iter().map(|n| Symbol::new(n)).collect::<Vec<_>>(),
-                tier: Tier::Full,
-                vocabulary: Vocabulary::default(),
-            },
-            kind: ViolationKind::Goal,
-            executed: procedure.clone(),
-            procedure: procedure.clone(),
-            erroneous: None,
-            remaining: Vec::new(),
-            failing_step: None,
-            initial_state: init.clone(),
-            error_state: end,
-            unmet: vec![UnmetPrecondition {
-                literal: goal.clone(),
-                atoms: Vec::new(),
-            }],
-            feedback: Vec::new(),
-        };
-        let ctx = PatchContext {
-            request,
-            target_embodiment: Embodiment::Finger,
-        };
-        let patch = propose(world, &ctx, &PlannerConfig::default()).unwrap();
-        assert_eq!(patch.strategy, Strategy::Append);
-        let mut patched = procedure[..patch.at].to_vec();
-        patched.extend(patch.replace.iter().cloned());
-        let report = verify_procedure(&init, &patched, Some(&goal));
+        let ctx = goal_violation(&procedure, &init, &end, &[&goal], Vec::new());
+        let report = appended(&ctx, &procedure, &init, &goal);
         assert!(report.first_failure.is_none());
-        assert!(report.goal.is_some_and(|g| g.satisfied), "{patched:?}");
+        assert!(report.goal.is_some_and(|g| g.satisfied), "{procedure:?}");
     }
 
     /// A goal patch plans to the unmet literals; one that held when asked (the lid closed)
@@ -629,59 +665,23 @@ mod tests {
     /// reaches it too.
     #[test]
     fn a_goal_patch_also_reaches_what_the_last_rejection_left_unmet() {
-        let world = WorldDomain::builtin().unwrap();
         let init = parse_state_list(
             "- (Closed hinge_lid)\n- (GripperOpen)\n- (OnTopOf hinge_body floor)\n- (OnTopOf apple floor)",
         )
         .unwrap();
-        let names = ["apple", "hinge_body", "hinge_lid", "hinge_handle", "floor"];
-        let universe = world.universe(names);
-        let planning = Planning {
-            universe: universe.clone(),
-            schemas: world.schemas_for(Embodiment::Finger, &universe),
-            target: Embodiment::Finger,
-            config: &PlannerConfig::default(),
-        };
-        let (procedure, end) = planning
+        let config = PlannerConfig::default();
+        let (procedure, end) = hinge_planning(&config)
             .plan(&init, &parse_formula("(GripperSurrounding apple)").unwrap())
             .unwrap();
         let inside = parse_formula("(InsideOf apple hinge_body)").unwrap();
         let closed = parse_formula("(Closed hinge_lid)").unwrap();
         let goal = Formula::And(vec![inside.clone(), closed.clone()]);
-        let unmet = |f: &Formula| UnmetPrecondition {
-            literal: f.clone(),
-            atoms: Vec::new(),
-        };
-        let patched_with = |feedback: Vec<nesy_core::adapt::Feedback>| {
-            let ctx = PatchContext {
-                request: PatchRequest {
-                    iteration: 0,
-                    task: TaskContext {
-                        instruction: "Put the apple in the hinge box and close it.".into(),
-                        objects: names.iter().map(|n| Symbol::new(n)).collect::<Vec<_>>(),
-                        tier: Tier::Full,
-                        vocabulary: Vocabulary::default(),
-                    },
-                    kind: ViolationKind::Goal,
-                    executed: procedure.clone(),
-                    procedure: procedure.clone(),
-                    erroneous: None,
-                    remaining: Vec::new(),
-                    failing_step: None,
-                    initial_state: init.clone(),
-                    error_state: end.clone(),
-                    unmet: vec![unmet(&inside)],
-                    feedback,
-                },
-                target_embodiment: Embodiment::Finger,
-            };
-            let patch = propose(world, &ctx, &PlannerConfig::default()).unwrap();
-            assert_eq!(patch.strategy, Strategy::Append);
-            let mut patched = procedure[..patch.at].to_vec();
-            patched.extend(patch.replace.iter().cloned());
-            verify_procedure(&init, &patched, Some(&goal))
-        };
-        let first = patched_with(Vec::new());
+        let first = appended(
+            &goal_violation(&procedure, &init, &end, &[&inside], Vec::new()),
+            &procedure,
+            &init,
+            &goal,
+        );
         assert!(first.first_failure.is_none());
         assert!(!first.goal.as_ref().unwrap().satisfied, "the lid was left open");
         let rejection = nesy_core::adapt::Feedback {
@@ -689,12 +689,17 @@ mod tests {
             reply: String::new(),
             problem: Problem::NotResolved {
                 failing_step: None,
-                unmet: vec![unmet(&closed)],
+                unmet: vec![literal(&closed)],
             },
             message: "After the patch every action applies but these goal conditions still do not hold"
                 .into(),
         };
-        let second = patched_with(vec![rejection]);
+        let second = appended(
+            &goal_violation(&procedure, &init, &end, &[&inside], vec![rejection]),
+            &procedure,
+            &init,
+            &goal,
+        );
         assert!(second.first_failure.is_none());
         assert!(second.goal.is_some_and(|g| g.satisfied));
     }
@@ -704,20 +709,13 @@ mod tests {
     /// request is never re-aimed.
     #[test]
     fn a_missed_localisation_patches_another_step_that_fails_in_the_initial_state() {
-        let world = WorldDomain::builtin().unwrap();
         let demo_init = parse_state_list(
             "- (Open hinge_lid)\n- (GripperOpen)\n- (FingerGripper)\n- (OnTopOf hinge_body floor)\n- (OnTopOf apple floor)",
         )
         .unwrap();
-        let names = ["apple", "hinge_body", "hinge_lid", "hinge_handle", "floor"];
-        let universe = world.universe(names);
-        let planning = Planning {
-            universe: universe.clone(),
-            schemas: world.schemas_for(Embodiment::Finger, &universe),
-            target: Embodiment::Finger,
-            config: &PlannerConfig::default(),
-        };
-        let (procedure, _) = planning
+        let names = HINGE_SCENE;
+        let config = PlannerConfig::default();
+        let (procedure, _) = hinge_planning(&config)
             .plan(&demo_init, &parse_formula("(InsideOf apple hinge_body)").unwrap())
             .unwrap();
         // The target's lid is closed.
