@@ -4,7 +4,9 @@
 //! - [`Study::Ablation`] (Table 3's shape): the full loop and the loop without proposal
 //!   verification (`verification`, Eq. 8), without counterfactual identification
 //!   (`conflict`, Eq. 6), without both, and without the world-model check (`dynamics`,
-//!   Eq. 4, in reading A), every row under the same synthetic noise on the offline
+//!   Eq. 4) in two readings: (A) induced operators are never checked against the
+//!   demonstration; (B) the symbolic tool checks nothing at all and the revised procedure
+//!   is compiled unverified. Every row runs under the same synthetic noise on the offline
 //!   responder's answers.
 //! - [`Study::Robustness`] (Table 8's shape): states translated by the offline responder
 //!   with none, 10 % of the relations dropped or 10 % false relations injected along the
@@ -171,7 +173,16 @@ impl Study {
                     StudyRow {
                         label: "w/o dynamics (Eq. 4), reading A",
                         variant: noisy().with("world-model", "off"),
-                        reading: "reading A: induced operators exist but are never checked against the demonstration (the first parsable reply per transition is kept). Reading B (no symbolic operators, no executor) is not built",
+                        reading: "reading A: induced operators exist but are never checked against the demonstration (the first parsable reply per transition is kept); identification and verification still run on them",
+                    },
+                    StudyRow {
+                        label: "w/o dynamics (Eq. 4), reading B",
+                        variant: noisy()
+                            .with("world-model", "off")
+                            .with("identification", "off")
+                            .with("verification", "off")
+                            .with("on-unresolved", "compile-last"),
+                        reading: "reading B, as the loop can express it: the symbolic tool checks nothing. Induced operators stay the model's own unchecked account of the demonstration; nothing identifies or verifies, so the loop makes one revision with no signal; the revised procedure is compiled and executed whatever the executor would say of it. Offline, the responder localises the failure with its own unchecked operators, missing at the stated rate",
                     },
                 ]
             }
@@ -275,6 +286,29 @@ mod tests {
             assert_eq!(row.variant.option("noise"), Some(ABLATION_NOISE));
         }
         assert!(Study::parse("ablations").is_err());
+    }
+
+    #[test]
+    fn reading_b_leaves_the_symbolic_tool_no_check_and_compiles_unverified() {
+        use crate::methods::nesycr::{NeSyCr, OnUnresolved};
+        let settings_of = |reading: &str| {
+            let row = Study::Ablation
+                .rows()
+                .into_iter()
+                .find(|r| r.label.contains(reading))
+                .unwrap();
+            NeSyCr::full().settings(&row.variant).unwrap()
+        };
+        let b = settings_of("reading B");
+        let a = b.adapt.ablation;
+        assert!(!a.world_model && !a.identification && !a.verification);
+        assert_eq!(b.on_unresolved, OnUnresolved::CompileLast);
+        // Reading A keeps identification and verification, and never compiles an
+        // unresolved procedure.
+        let reading_a = settings_of("reading A");
+        let a = reading_a.adapt.ablation;
+        assert!(!a.world_model && a.identification && a.verification);
+        assert_eq!(reading_a.on_unresolved, OnUnresolved::Fail);
     }
 
     #[test]

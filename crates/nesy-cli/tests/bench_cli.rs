@@ -240,7 +240,7 @@ fn methods_plan_and_bad_input() {
     assert!(String::from_utf8_lossy(&offline.stderr).contains("cannot answer them honestly"));
 }
 
-/// `--study ablation` on one Combination/medium scenario: the five rows under one error
+/// `--study ablation` on one Combination/medium scenario: the six rows under one error
 /// model, the table with its SYNTHETIC banner, the CSV and the figure; a state knob without
 /// translated states and an unknown study are refused.
 #[test]
@@ -255,8 +255,8 @@ fn the_ablation_study_runs_its_rows_and_reports_them_in_table_3_shape() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    // Five rows × two repeats.
-    assert_eq!(lines(&run), 10);
+    // Six rows × two repeats.
+    assert_eq!(lines(&run), 12);
     let report = std::fs::read_to_string(run.join("report.md")).unwrap();
     assert!(report.contains("## Ablations (Table 3 shape)"), "{report}");
     assert!(
@@ -264,8 +264,9 @@ fn the_ablation_study_runs_its_rows_and_reports_them_in_table_3_shape() {
         "{report}"
     );
     assert!(report.contains("reading A"), "{report}");
+    assert!(report.contains("reading B"), "{report}");
     let csv = table(&run, "study.csv");
-    assert_eq!(csv.lines().count(), 6, "{csv}");
+    assert_eq!(csv.lines().count(), 7, "{csv}");
     assert!(
         csv.lines().nth(1).unwrap().starts_with("ablation,NeSyCR,"),
         "{csv}"
