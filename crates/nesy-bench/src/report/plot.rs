@@ -308,20 +308,52 @@ pub fn draw_lines(canvas: &mut Canvas, f: Frame, lines: &Lines) {
 /// Height of one legend line, in pixels.
 pub const LEGEND_LINE: i64 = 16;
 
+/// `name` split at spaces into lines of at most `room` characters; a word longer than a
+/// line is cut where the line ends.
+fn wrap_name(name: &str, room: usize) -> Vec<String> {
+    let room = room.max(1);
+    let mut lines: Vec<String> = Vec::new();
+    let mut line = String::new();
+    for word in name.split(' ') {
+        let mut word: Vec<char> = word.chars().collect();
+        let used = line.chars().count();
+        if used > 0 && used + 1 + word.len() > room {
+            lines.push(std::mem::take(&mut line));
+        }
+        while word.len() > room {
+            let rest = word.split_off(room);
+            lines.push(word.into_iter().collect());
+            word = rest;
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.extend(word);
+    }
+    lines.push(line);
+    lines
+}
+
 /// Where each legend entry starts, relative to the legend's origin at `x` on a canvas
-/// `width` wide: entries that would run past the right edge start a new line.
-fn legend_layout(width: usize, x: i64, series: &[String]) -> Vec<(i64, i64)> {
+/// `width` wide, and its text lines: entries that would run past the right edge start a new
+/// line, and a name wider than a whole line is wrapped onto lines of its own.
+fn legend_layout(width: usize, x: i64, series: &[String]) -> Vec<(i64, i64, Vec<String>)> {
     let right = width as i64 - 8;
-    let (mut cx, mut cy) = (x, 0);
+    let room = ((right - x - 16) / 8).max(1) as usize;
+    let (mut cx, mut cy, mut row_lines) = (x, 0, 1);
     series
         .iter()
         .map(|name| {
-            let entry = 16 + name.chars().count() as i64 * 8;
+            let lines = wrap_name(name, room);
+            let widest = lines.iter().map(|l| l.chars().count()).max().unwrap_or(0);
+            let entry = 16 + widest as i64 * 8;
             if cx > x && cx + entry > right {
                 cx = x;
-                cy += LEGEND_LINE;
+                cy += row_lines * LEGEND_LINE;
+                row_lines = 1;
             }
-            let at = (cx, cy);
+            row_lines = row_lines.max(lines.len() as i64);
+            let at = (cx, cy, lines);
             cx += entry + 20;
             at
         })
@@ -331,9 +363,18 @@ fn legend_layout(width: usize, x: i64, series: &[String]) -> Vec<(i64, i64)> {
 /// How many lines the legend of `series` takes at `x` on a canvas `width` wide, so a
 /// figure can make room for it before drawing.
 fn legend_lines(width: usize, x: i64, series: &[String]) -> i64 {
-    legend_layout(width, x, series)
-        .last()
-        .map_or(0, |&(_, dy)| dy / LEGEND_LINE + 1)
+    let layout = legend_layout(width, x, series);
+    let Some((_, last_y, _)) = layout.last() else {
+        return 0;
+    };
+    // The last row is as tall as its tallest entry.
+    let last_row = layout
+        .iter()
+        .filter(|(_, y, _)| y == last_y)
+        .map(|(_, _, lines)| lines.len() as i64)
+        .max()
+        .unwrap_or(1);
+    last_y / LEGEND_LINE + last_row
 }
 
 /// The pixels a figure adds to its height so that the legend of `series` at `x` fits, when
@@ -345,16 +386,15 @@ pub fn legend_overflow(width: usize, x: i64, series: &[String], room: i64) -> i6
 /// Draws a legend of `series` in a row starting at (x, y).
 ///
 /// Entries that would run past the canvas's right edge start a new line
-/// [`LEGEND_LINE`] pixels lower, so long labels stay readable instead of being clipped.
+/// [`LEGEND_LINE`] pixels lower, and a name wider than a whole line is wrapped, so long
+/// labels stay readable instead of being clipped.
 pub fn legend(canvas: &mut Canvas, x: i64, y: i64, series: &[String]) {
-    for (s, (name, (cx, dy))) in series
-        .iter()
-        .zip(legend_layout(canvas.width(), x, series))
-        .enumerate()
-    {
+    for (s, (cx, dy, lines)) in legend_layout(canvas.width(), x, series).into_iter().enumerate() {
         let cy = y + dy;
         canvas.rect(cx, cy, cx + 12, cy + 10, PALETTE[s % PALETTE.len()]);
-        canvas.text(cx + 16, cy + 1, name, BLACK, 1);
+        for (i, line) in lines.iter().enumerate() {
+            canvas.text(cx + 16, cy + 1 + i as i64 * LEGEND_LINE, line, BLACK, 1);
+        }
     }
 }
 
@@ -448,10 +488,25 @@ mod tests {
         assert_eq!(legend_overflow(400, 10, &long, 2), LEGEND_LINE);
         assert_eq!(legend_overflow(400, 10, &short, 2), 0);
         let at = legend_layout(400, 10, &long);
-        assert!(at.iter().all(|&(x, _)| x == 10), "{at:?}");
+        assert!(at.iter().all(|(x, _, _)| *x == 10), "{at:?}");
         assert_eq!(
-            at.iter().map(|&(_, y)| y).collect::<Vec<_>>(),
+            at.iter().map(|(_, y, _)| *y).collect::<Vec<_>>(),
             vec![0, LEGEND_LINE, 2 * LEGEND_LINE]
         );
+    }
+
+    #[test]
+    fn a_name_wider_than_a_line_wraps_onto_lines_of_its_own() {
+        // 45 characters fit beside the swatch on a 400 px canvas at x = 10.
+        let name = format!("NeSyCR [{}, {}]", "x".repeat(30), "y".repeat(60));
+        let series = vec![name.clone(), "after".to_owned()];
+        let at = legend_layout(400, 10, &series);
+        let lines = &at[0].2;
+        assert_eq!(lines.len(), 3, "{lines:?}");
+        assert!(lines.iter().all(|l| l.chars().count() <= 45), "{lines:?}");
+        assert_eq!(lines.concat().replace(' ', ""), name.replace(' ', ""));
+        // The next entry starts below the wrapped one, and the legend counts every line.
+        assert_eq!((at[1].0, at[1].1), (10, 3 * LEGEND_LINE));
+        assert_eq!(legend_lines(400, 10, &series), 4);
     }
 }
