@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use nesy_core::benchmark::{Complexity, Factor};
+use nesy_core::benchmark::Factor;
 use nesy_core::format_procedure;
 use nesy_pipeline::{
     AdaptOptions, CodegenMode, DemoInput, DemoKeyframes, StateSource, SynthError, SynthesisRequest,
@@ -1122,11 +1122,6 @@ pub fn default_run_id() -> String {
         .replace('T', "-")
         .trim_end_matches('Z')
         .to_owned()
-}
-
-/// The complexity of a scenario id (for plans and reports of runs without records).
-pub fn complexity_of(id: &str) -> Option<Complexity> {
-    nesy_core::benchmark::parse_scenario_id(id).map(|(_, c)| c)
 }
 
 /// A digest of a file's bytes, for artifacts named in reports.

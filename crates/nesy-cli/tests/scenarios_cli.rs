@@ -1,5 +1,5 @@
 //! `nesy scenarios` and `nesy record` through the binary: the paper's Table 6 counts, the
-//! written suite read back, a scene shown from either source, a recorded demo read back, bad
+//! written suite read back, the complexity-gap suite listed apart, a scene shown from either source, a recorded demo read back, bad
 //! input named with its file, and a reader that closes the pipe early.
 
 mod common;
@@ -74,6 +74,33 @@ fn a_generated_suite_reads_back_to_the_same_scenarios() {
         let scene = SceneSpec::from_json_str(&shown, side).expect("a valid scene.json");
         assert!(!scene.goals.is_empty(), "{side}: the scene carries its goals");
     }
+}
+
+/// A folder of complexity-gap files lists its 80 scenarios by added subtasks, labelled as
+/// outside the 440, and none of them under a Table 6 row; their ids read back.
+#[test]
+fn a_gap_suite_lists_by_added_subtasks_not_under_table_6() {
+    let dir = common::scratch();
+    let suite = dir.path().join("gap");
+    let suite_arg = suite.to_str().unwrap();
+    let (code, stdout, stderr) = nesy(&["scenarios", "generate", "--gap", "--out", suite_arg]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert_eq!(stdout.lines().count(), 4, "{stdout}");
+    let (code, table, stderr) = nesy(&["scenarios", "list", "--suite", suite_arg]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(table.contains("not part of the 440"), "{table}");
+    for added in 0..4 {
+        assert_eq!(row(&table, &format!("+{added} ")), [20], "{table}");
+    }
+    assert_eq!(row(&table, "Total gap scenarios"), [80]);
+    assert!(
+        !table.contains("Total scenarios") && !table.contains("obst "),
+        "{table}"
+    );
+    let (code, ids, stderr) = nesy(&["scenarios", "list", "--ids", "--suite", suite_arg]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert_eq!(ids.lines().count(), 80);
+    assert!(ids.lines().all(|id| id.starts_with("gap_obst_plus")), "{ids}");
 }
 
 #[test]

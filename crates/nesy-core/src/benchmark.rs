@@ -212,11 +212,29 @@ pub fn iteration_budget(factor: Factor, complexity: Complexity) -> usize {
     }
 }
 
-/// The factor and complexity a scenario id starts with: `<factor>_<complexity>_…`, e.g.
-/// `obst_low_03_s0`; `None` for any other name.
+/// The factor and complexity of a scenario id; `None` for any other name.
+///
+/// - A scenario of the 440 starts with `<factor>_<complexity>_`, e.g. `obst_low_03_s0`.
+/// - A scenario of the auxiliary complexity-gap suite starts with `gap_<factor>_plus<k>_`,
+///   e.g. `gap_obst_plus2_03_s1`. Its demonstration has one subtask and its target `1 + k`,
+///   so its complexity is [`Complexity::of_subtask_count`] of `1 + k`: the budget follows
+///   the task that has to be solved.
+///
+/// ```
+/// use nesy_core::benchmark::{parse_scenario_id, Complexity, Factor};
+/// assert_eq!(parse_scenario_id("comb_high_07_s1"), Some((Factor::Comb, Complexity::High)));
+/// assert_eq!(parse_scenario_id("gap_obst_plus3_00_s0"), Some((Factor::Obst, Complexity::High)));
+/// assert_eq!(parse_scenario_id("pick_place"), None);
+/// ```
 pub fn parse_scenario_id(id: &str) -> Option<(Factor, Complexity)> {
     let mut parts = id.split(['_', '-', '/']);
-    let factor = Factor::from_name(parts.next()?)?;
+    let first = parts.next()?;
+    if first == "gap" {
+        let factor = Factor::from_name(parts.next()?)?;
+        let added: usize = parts.next()?.strip_prefix("plus")?.parse().ok()?;
+        return Some((factor, Complexity::of_subtask_count(1 + added)));
+    }
+    let factor = Factor::from_name(first)?;
     let complexity = Complexity::from_name(parts.next()?)?;
     Some((factor, complexity))
 }
@@ -244,6 +262,22 @@ mod tests {
             assert_eq!(serde_json::to_value(c).unwrap(), c.as_str());
         }
         assert_eq!(parse_scenario_id("pick_place"), None);
+        assert_eq!(parse_scenario_id("gap_obst"), None);
+        assert_eq!(parse_scenario_id("gap_obst_minus1_00_s0"), None);
+        assert_eq!(parse_scenario_id("gap_nope_plus1_00_s0"), None);
+        let gap: Vec<_> = (0..4)
+            .map(|k| parse_scenario_id(&format!("gap_obst_plus{k}_05_s1")))
+            .collect();
+        assert_eq!(
+            gap,
+            [
+                Complexity::Low,
+                Complexity::Low,
+                Complexity::Medium,
+                Complexity::High
+            ]
+            .map(|c| Some((Factor::Obst, c)))
+        );
         assert_eq!(
             parse_scenario_id("obst_low_03_s0"),
             Some((Factor::Obst, Complexity::Low))

@@ -549,7 +549,10 @@ pub struct Scenario {
     pub id: String,
     /// The domain factor.
     pub factor: Factor,
-    /// The complexity (the file's; `low` in the complexity-gap suite).
+    /// The complexity (the file's). In the complexity-gap suite it is `low` for every file
+    /// and stands for nothing: the id parses to the target's complexity
+    /// ([`nesy_core::benchmark::parse_scenario_id`]), which sets the budget, and
+    /// [`CountTable`] counts these scenarios by added subtasks instead.
     pub complexity: Complexity,
     /// Subtasks the target has beyond the demonstration's, in the complexity-gap suite
     /// (`None` in the 440).
@@ -659,11 +662,17 @@ pub fn find(files: &[ConfigFile], id: &str) -> Result<Scenario, ScenarioError> {
         .ok_or_else(|| ScenarioError::UnknownScenario { id: id.to_owned() })
 }
 
-/// Scenario counts by factor and complexity.
+/// Scenario counts by factor and complexity (the paper's Table 6), and the complexity-gap
+/// scenarios apart.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct CountTable {
-    /// `(factor, [low, medium, high])`, in [`Factor::ALL`] order.
+    /// `(factor, [low, medium, high])`, in [`Factor::ALL`] order, over the scenarios of the
+    /// 440 only.
     pub by_factor: Vec<(Factor, [usize; 3])>,
+    /// `(added subtasks, scenarios)` of the auxiliary complexity-gap suite, ascending; empty
+    /// when none were counted. These are kept out of `by_factor`: their file complexity is a
+    /// placeholder, not a row of Table 6.
+    pub gap: Vec<(u8, usize)>,
 }
 
 impl CountTable {
@@ -673,13 +682,24 @@ impl CountTable {
             .iter()
             .map(|&f| {
                 let mut row = [0; 3];
-                for s in scenarios.iter().filter(|s| s.factor == f) {
+                for s in scenarios
+                    .iter()
+                    .filter(|s| s.factor == f && s.added_subtasks.is_none())
+                {
                     row[s.complexity as usize] += 1;
                 }
                 (f, row)
             })
             .collect();
-        CountTable { by_factor }
+        let mut gap: Vec<(u8, usize)> = Vec::new();
+        for added in scenarios.iter().filter_map(|s| s.added_subtasks) {
+            match gap.iter_mut().find(|(k, _)| *k == added) {
+                Some((_, n)) => *n += 1,
+                None => gap.push((added, 1)),
+            }
+        }
+        gap.sort_unstable();
+        CountTable { by_factor, gap }
     }
 
     /// The rows of the paper's Table 6 (factors grouped), with per-complexity counts.
@@ -704,9 +724,30 @@ impl CountTable {
         t
     }
 
-    /// The table as text: one row per factor, then the paper's grouping, then totals.
+    /// The table as text: one row per factor, then the paper's grouping, then totals; then,
+    /// if any were counted, the complexity-gap scenarios by added subtasks, labelled as not
+    /// part of the 440. A suite of complexity-gap files only prints that part alone.
     pub fn render(&self) -> String {
         let mut out = String::new();
+        if self.totals().iter().sum::<usize>() > 0 || self.gap.is_empty() {
+            self.render_main(&mut out);
+        }
+        if !self.gap.is_empty() {
+            if !out.is_empty() {
+                out.push('\n');
+            }
+            out.push_str("complexity-gap suite (auxiliary, Figure 4(b); not part of the 440)\n");
+            out.push_str(&format!("{:<34}{:>7}\n", "added subtasks", "total"));
+            for &(added, n) in &self.gap {
+                out.push_str(&format!("{:<34}{n:>7}\n", format!("+{added}")));
+            }
+            let total: usize = self.gap.iter().map(|(_, n)| n).sum();
+            out.push_str(&format!("{:<34}{total:>7}\n", "Total gap scenarios"));
+        }
+        out
+    }
+
+    fn render_main(&self, out: &mut String) {
         let line = |out: &mut String, name: &str, row: [usize; 3]| {
             let total: usize = row.iter().sum();
             out.push_str(&format!(
@@ -719,14 +760,13 @@ impl CountTable {
             "factor", "low", "medium", "high", "total"
         ));
         for &(f, row) in &self.by_factor {
-            line(&mut out, f.as_str(), row);
+            line(out, f.as_str(), row);
         }
         out.push('\n');
         for (name, row) in self.paper_rows() {
-            line(&mut out, name, row);
+            line(out, name, row);
         }
-        line(&mut out, "Total scenarios", self.totals());
-        out
+        line(out, "Total scenarios", self.totals());
     }
 }
 
@@ -837,6 +877,50 @@ mod tests {
             !generate_file(Factor::Obst, Complexity::Low)
                 .to_json_pretty()
                 .contains("added_subtasks")
+        );
+    }
+
+    #[test]
+    fn gap_scenarios_are_counted_apart_from_table_6_and_parse_to_their_target_complexity() {
+        let gap = scenarios(&generate_gap_suite());
+        for s in &gap {
+            let added = s.added_subtasks.unwrap();
+            let target_subtasks = s.episode.target_subtasks.len();
+            assert_eq!(target_subtasks, 1 + usize::from(added), "{}", s.id);
+            assert_eq!(
+                nesy_core::benchmark::parse_scenario_id(&s.id),
+                Some((GAP_FACTOR, Complexity::of_subtask_count(target_subtasks))),
+                "{}",
+                s.id
+            );
+        }
+        let mut mixed = scenarios(&generate_suite());
+        mixed.extend(gap.iter().cloned());
+        let table = CountTable::of(&mixed);
+        assert_eq!(table.totals(), [160, 160, 120], "Table 6 holds only the 440");
+        assert_eq!(table.gap, vec![(0, 20), (1, 20), (2, 20), (3, 20)]);
+        let text = table.render();
+        assert!(
+            text.contains("Total scenarios                      160     160   120    440"),
+            "{text}"
+        );
+        assert!(
+            text.contains("not part of the 440")
+                && text
+                    .lines()
+                    .any(|l| l.split_whitespace().eq(["Total", "gap", "scenarios", "80"])),
+            "{text}"
+        );
+        // A suite folder of gap files alone prints only the gap counts.
+        let alone = CountTable::of(&gap).render();
+        assert!(
+            !alone.contains("Total scenarios") && alone.contains("+3"),
+            "{alone}"
+        );
+        assert!(
+            !CountTable::of(&scenarios(&generate_suite()))
+                .render()
+                .contains("gap")
         );
     }
 
