@@ -98,7 +98,7 @@ const fn s(
 use Kind::{Box as B, Item as I, Surface as S};
 use Motion::*;
 
-/// Every schema of `nesy-world.pddl` (finger, then vacuum); `tests/codegen_domain.rs`
+/// Every schema of `nesy-world.pddl` (finger, then vacuum); `tests/integration/codegen_domain.rs`
 /// checks the table against the file.
 const SCHEMAS: &[Schema] = &[
     s("move-to-surround", MoveToObject, &[I], None),

@@ -1,6 +1,6 @@
 //! The robot API as the code-generation prompts show it: the import block and the
 //! docstrings (`prompts/api/*.py`), in nesy's own words, matching nesy-sim's signatures and
-//! defaults (`tests/api_docs.rs` checks them against the `robot` module nesy-policy
+//! defaults (`tests/integration/prompts.rs` checks them against the `robot` module nesy-policy
 //! provides).
 
 /// Perception functions, in the order of the paper's perception table.

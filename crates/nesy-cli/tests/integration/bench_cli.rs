@@ -1,0 +1,358 @@
+//! `nesy bench` end to end through the binary, on a handful of low-complexity scenarios: a run
+//! killed with SIGKILL resumes and redoes only its unfinished units, four shards merge into
+//! the same tables as the unsharded run, a missing shard is named, and a changed
+//! configuration is refused in the same run directory.
+
+use crate::common;
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const SCENARIOS: &str = "obst_low_00_s0,affo_low_01_s1,grip_low_02_s0";
+const METHODS: &str = "nesycr,imitation,replan";
+
+fn run_args(run: &Path, demos: &Path, extra: &[&str]) -> Vec<String> {
+    let mut args: Vec<String> = [
+        "bench",
+        "run",
+        &run.display().to_string(),
+        "--methods",
+        METHODS,
+        "--scenarios",
+        SCENARIOS,
+        "--vlm",
+        "oracle",
+        "--demos",
+        &demos.display().to_string(),
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args
+}
+
+/// `nesy bench run RUN --study STUDY --scenarios IDS --vlm oracle --demos DEMOS` and `extra`.
+fn study_run(run: &Path, study: &str, scenarios: &str, demos: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args: Vec<String> = ["bench", "run"].map(String::from).to_vec();
+    args.push(run.display().to_string());
+    for (flag, value) in [
+        ("--study", study),
+        ("--scenarios", scenarios),
+        ("--vlm", "oracle"),
+    ] {
+        args.push(flag.into());
+        args.push(value.into());
+    }
+    args.push("--demos".into());
+    args.push(demos.display().to_string());
+    args.extend(extra.iter().map(|s| s.to_string()));
+    common::nesy(&args)
+}
+
+fn lines(path: &Path) -> usize {
+    std::fs::read_dir(path.join("results"))
+        .map(|d| {
+            d.flatten()
+                .map(|e| {
+                    std::fs::read_to_string(e.path())
+                        .unwrap_or_default()
+                        .lines()
+                        .filter(|l| !l.trim().is_empty())
+                        .count()
+                })
+                .sum()
+        })
+        .unwrap_or(0)
+}
+
+fn table(run: &Path, name: &str) -> String {
+    std::fs::read_to_string(run.join("tables").join(name))
+        .unwrap_or_else(|e| panic!("{}: {e}", run.display()))
+}
+
+#[test]
+fn killed_runs_resume_shards_merge_and_configurations_do_not_mix() {
+    let scratch = common::scratch();
+    let demos = scratch.path().join("demos");
+
+    // The reference: one uninterrupted run (it records the demos for everyone).
+    let whole = scratch.path().join("whole");
+    let out = common::nesy(&run_args(&whole, &demos, &[]));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(lines(&whole), 9, "one record per unit");
+    let reference = table(&whole, "table1.csv");
+    let report = std::fs::read_to_string(whole.join("report.md")).unwrap();
+    assert!(report.contains("OFFLINE"), "{report}");
+    for plot in ["sr_gc_pd.png", "domain_gap.png", "complexity.png"] {
+        let bytes = std::fs::read(whole.join("plots").join(plot)).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG", "{plot}");
+    }
+
+    // Running it again does nothing: every unit is final.
+    let again = common::nesy(&run_args(&whole, &demos, &["--json"]));
+    assert!(again.status.success());
+    assert_eq!(lines(&whole), 9, "nothing is redone");
+
+    // Killed with SIGKILL after its first units: the rerun does only the rest.
+    let killed = scratch.path().join("killed");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_nesy"))
+        .args(run_args(&killed, &demos, &["--jobs", "1"]))
+        .current_dir(common::workspace())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(300);
+    while lines(&killed) < 2 && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.kill().unwrap();
+    let _ = child.wait();
+    let before = lines(&killed);
+    assert!((2..9).contains(&before), "killed after {before} record(s)");
+    let resumed = common::nesy(&run_args(&killed, &demos, &["--json"]));
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&resumed.stdout);
+    let summary: serde_json::Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
+    assert_eq!(summary["summary"]["skipped"], before as u64, "{summary}");
+    assert_eq!(summary["summary"]["ran"], (9 - before) as u64, "{summary}");
+    assert_eq!(lines(&killed), 9);
+    assert_eq!(
+        table(&killed, "table1.csv"),
+        reference,
+        "a resumed run gives the same tables"
+    );
+
+    // Four shards, then a merge: the same tables, byte for byte.
+    let sharded = scratch.path().join("sharded");
+    for i in 0..4 {
+        let shard = format!("{i}/4");
+        let out = common::nesy(&run_args(&sharded, &demos, &["--shard", &shard]));
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        if i == 2 {
+            // Three of four shards: the merge names what is missing.
+            let merge = common::nesy(&["bench".into(), "merge".into(), sharded.display().to_string()]);
+            assert_eq!(merge.status.code(), Some(1));
+            let err = String::from_utf8_lossy(&merge.stderr);
+            assert!(err.contains("missing: "), "{err}");
+            assert!(err.contains("no final record"), "{err}");
+        }
+    }
+    let merge = common::nesy(&["bench".into(), "merge".into(), sharded.display().to_string()]);
+    assert!(
+        merge.status.success(),
+        "{}",
+        String::from_utf8_lossy(&merge.stderr)
+    );
+    assert_eq!(
+        table(&sharded, "table1.csv"),
+        reference,
+        "merged shards give the unsharded tables"
+    );
+    assert_eq!(table(&sharded, "status.csv"), table(&whole, "status.csv"));
+
+    // Another configuration in the same directory is refused, naming what differs.
+    let other = common::nesy(&[
+        "bench".into(),
+        "run".into(),
+        whole.display().to_string(),
+        "--methods".into(),
+        "nesycr+verification=off".into(),
+        "--scenarios".into(),
+        SCENARIOS.into(),
+        "--vlm".into(),
+        "oracle".into(),
+        "--demos".into(),
+        demos.display().to_string(),
+    ]);
+    assert_eq!(other.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(
+        err.contains("another configuration") && err.contains("variants"),
+        "{err}"
+    );
+
+    // Status summarises a run.
+    let status = common::nesy(&["bench".into(), "status".into(), whole.display().to_string()]);
+    assert!(String::from_utf8_lossy(&status.stdout).contains("9 of 9 unit(s) final"));
+}
+
+#[test]
+fn methods_plan_and_bad_input() {
+    let methods = common::nesy(&["bench".into(), "methods".into(), "--json".into()]);
+    let list: serde_json::Value = serde_json::from_slice(&methods.stdout).unwrap();
+    let names: Vec<&str> = list
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["name"].as_str().unwrap())
+        .collect();
+    for m in [
+        "nesycr",
+        "nesycr-released",
+        "demo2code",
+        "gpt4v-robotics",
+        "critic-v",
+        "morevqa",
+        "statler",
+        "llm-dm",
+        "code-as-policies",
+        "imitation",
+        "replan",
+    ] {
+        assert!(names.contains(&m), "{names:?}");
+    }
+    let bad = common::nesy(&[
+        "bench".into(),
+        "plan".into(),
+        "--methods".into(),
+        "nesycr+verification=maybe".into(),
+        "--vlm".into(),
+        "oracle".into(),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("expected on or off"));
+    let typo = common::nesy(&[
+        "bench".into(),
+        "plan".into(),
+        "--scenarios".into(),
+        "obst_lwo".into(),
+        "--vlm".into(),
+        "oracle".into(),
+    ]);
+    assert_eq!(typo.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&typo.stderr).contains("no scenario id starts with"));
+    let offline = common::nesy(&[
+        "bench".into(),
+        "plan".into(),
+        "--methods".into(),
+        "code-as-policies".into(),
+        "--vlm".into(),
+        "oracle".into(),
+    ]);
+    assert_eq!(offline.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&offline.stderr).contains("cannot answer them honestly"));
+}
+
+/// `--study ablation` on one Combination/medium scenario: the six rows under one error
+/// model, the table with its SYNTHETIC banner, the CSV and the figure; a state knob without
+/// translated states and an unknown study are refused.
+#[test]
+fn the_ablation_study_runs_its_rows_and_reports_them_in_table_3_shape() {
+    let scratch = common::scratch();
+    let run = scratch.path().join("ablation");
+    let demos = scratch.path().join("demos");
+    let out = study_run(&run, "ablation", "comb_medium_07_s1", &demos, &["--repeats", "2"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Six rows × two repeats.
+    assert_eq!(lines(&run), 12);
+    let report = std::fs::read_to_string(run.join("report.md")).unwrap();
+    assert!(report.contains("## Ablations (Table 3 shape)"), "{report}");
+    assert!(
+        report.contains("SYNTHETIC — no model answered. Error model:"),
+        "{report}"
+    );
+    assert!(report.contains("reading A"), "{report}");
+    assert!(report.contains("reading B"), "{report}");
+    let csv = table(&run, "study.csv");
+    assert_eq!(csv.lines().count(), 7, "{csv}");
+    assert!(
+        csv.lines().nth(1).unwrap().starts_with("ablation,NeSyCR,"),
+        "{csv}"
+    );
+    assert!(run.join("plots/study.png").is_file());
+    let manifest = std::fs::read_to_string(run.join("manifest.json")).unwrap();
+    assert!(manifest.contains("\"study\": \"ablation\""), "{manifest}");
+
+    let stateless = common::nesy(&[
+        "bench".into(),
+        "plan".into(),
+        "--methods".into(),
+        "nesycr+noise=state-drop=0.1".into(),
+        "--vlm".into(),
+        "oracle".into(),
+    ]);
+    assert_eq!(stateless.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&stateless.stderr).contains("add +states=vlm"));
+    let unknown = common::nesy(&[
+        "bench".into(),
+        "plan".into(),
+        "--study".into(),
+        "ablations".into(),
+        "--vlm".into(),
+        "oracle".into(),
+    ]);
+    assert_eq!(unknown.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&unknown.stderr).contains("expected one of ablation, robustness"));
+}
+
+/// `--study complexity-gap` on one configuration of the auxiliary suite at +0 and +1 added
+/// subtasks: four rows, the breakdown by added subtasks in the report, its CSV and figure,
+/// and the records marked with their added subtasks. A loop that takes its goal from the
+/// demonstration cannot succeed once the target asks for a subtask the demonstration never
+/// shows, and neither can the unadapted procedure.
+#[test]
+fn the_complexity_gap_study_reports_sr_and_pd_by_added_subtasks() {
+    let scratch = common::scratch();
+    let run = scratch.path().join("gap");
+    let demos = scratch.path().join("demos");
+    let out = study_run(
+        &run,
+        "complexity-gap",
+        "gap_obst_plus0_03_s0,gap_obst_plus1_03_s0",
+        &demos,
+        &[],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Four rows × two scenarios × one repeat.
+    assert_eq!(lines(&run), 8);
+    let report = std::fs::read_to_string(run.join("report.md")).unwrap();
+    assert!(
+        report.contains("## Complexity gap (Figure 4(b) shape)"),
+        "{report}"
+    );
+    assert!(report.contains("By added subtasks"), "{report}");
+    assert!(
+        report.contains("auxiliary complexity-gap suite (not part of the 440)"),
+        "{report}"
+    );
+    let csv = table(&run, "complexity_gap.csv");
+    assert_eq!(csv.lines().count(), 1 + 4 * 2, "{csv}");
+    let sr_at = |prefix: &str| -> f64 {
+        let line = csv
+            .lines()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("{prefix}: {csv}"));
+        // study,row,variant,added_subtasks,scenarios,sr_mean,…: the row label is quoted.
+        line[prefix.len()..].split(',').nth(1).unwrap().parse().unwrap()
+    };
+    assert_eq!(
+        sr_at("complexity-gap,\"NeSyCR, demonstrated goal\",nesycr,1,"),
+        0.0
+    );
+    assert_eq!(sr_at("complexity-gap,Imitation (control),imitation,1,"), 0.0);
+    assert!(run.join("plots/complexity_gap.png").is_file());
+    let results = std::fs::read_dir(run.join("results"))
+        .unwrap()
+        .flatten()
+        .map(|e| std::fs::read_to_string(e.path()).unwrap())
+        .collect::<String>();
+    assert_eq!(results.matches("\"added_subtasks\":1").count(), 4, "{results}");
+    assert_eq!(results.matches("\"added_subtasks\":0").count(), 4, "{results}");
+}

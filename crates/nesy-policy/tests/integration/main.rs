@@ -1,0 +1,10 @@
+//! The policy runtime: the embedded interpreter, the worker's seccomp filter and the
+//! paper's worked example policies.
+//!
+//! One test binary per crate: every file here is a module of it, so the crate and its
+//! dependencies are linked once. Run one file's tests with
+//! `cargo test -p nesy-policy --test integration <file>::`.
+
+mod runtime;
+mod seccomp;
+mod worked_examples;
