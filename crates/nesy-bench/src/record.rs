@@ -221,6 +221,12 @@ pub struct UnitRecord {
     /// complexity-gap suite (absent for the 440).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub added_subtasks: Option<u8>,
+    /// The scenario's obstruction change, Σ |target obst − source obst| over its subtasks
+    /// (the domain-gap measure of Figure 4(a), taken from the configuration the run used).
+    /// Absent in the complexity-gap suite, whose target has subtasks the demonstration
+    /// lacks, and in records written before the field was kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub obstruction_change: Option<u32>,
     /// The unit's seed.
     pub seed: u64,
     /// Hash of the variant's configuration (a resume refuses records whose hash differs).

@@ -161,6 +161,7 @@ pub(crate) mod tests {
             factor: Factor::Obst,
             complexity: Complexity::Low,
             added_subtasks: None,
+            obstruction_change: None,
             seed: 1,
             config_hash: "h".into(),
             status,

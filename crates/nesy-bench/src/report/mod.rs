@@ -850,20 +850,36 @@ fn time_csv(tables: &Tables) -> String {
     out
 }
 
-/// The domain-gap level of a scenario: Σ|Δ obstruction| over its subtasks, binned, for
-/// the obst, affo and comb factors (`None` for the others).
-pub fn gap_level(record: &UnitRecord, suite: &[nesy_sim::tasks::scenario::Scenario]) -> Option<usize> {
-    if !matches!(record.factor, Factor::Obst | Factor::Affo | Factor::Comb) {
+/// The obstruction change of a scenario: Σ |target obst − source obst| over its subtasks;
+/// `None` for a complexity-gap scenario, whose target has subtasks the demonstration lacks.
+pub fn obstruction_change(scenario: &nesy_sim::tasks::scenario::Scenario) -> Option<u32> {
+    if scenario.added_subtasks.is_some() {
         return None;
     }
-    let s = suite.iter().find(|s| s.id == record.key.scenario)?;
-    let change: u32 = s
-        .episode
-        .source_subtasks
-        .iter()
-        .zip(&s.episode.target_subtasks)
-        .map(|(a, b)| u32::from(a.obst_level.abs_diff(b.obst_level)))
-        .sum();
+    Some(
+        scenario
+            .episode
+            .source_subtasks
+            .iter()
+            .zip(&scenario.episode.target_subtasks)
+            .map(|(a, b)| u32::from(a.obst_level.abs_diff(b.obst_level)))
+            .sum(),
+    )
+}
+
+/// The domain-gap level of a unit: its obstruction change binned, for the obst, affo and
+/// comb factors (`None` for the others and for complexity-gap scenarios). The change is the
+/// one the record carries, so a run over an edited `--suite` is binned by its own
+/// configurations; a record written before records carried it is looked up in `fallback`.
+pub fn gap_level(record: &UnitRecord, fallback: &[nesy_sim::tasks::scenario::Scenario]) -> Option<usize> {
+    if !matches!(record.factor, Factor::Obst | Factor::Affo | Factor::Comb) || record.added_subtasks.is_some()
+    {
+        return None;
+    }
+    let change = match record.obstruction_change {
+        Some(change) => change,
+        None => obstruction_change(fallback.iter().find(|s| s.id == record.key.scenario)?)?,
+    };
     Some(match change {
         0..=2 => 0,
         3..=4 => 1,
@@ -874,13 +890,21 @@ pub fn gap_level(record: &UnitRecord, suite: &[nesy_sim::tasks::scenario::Scenar
 const GAP_LEVELS: [&str; 3] = ["Low", "Moderate", "High"];
 
 fn gap_tallies(variants: &[String], records: &[&UnitRecord]) -> BTreeMap<String, [Aggregate; 3]> {
-    let suite = nesy_sim::tasks::scenario::scenarios(&nesy_sim::tasks::scenario::generate_suite());
+    // Only records from before the change was recorded need the generated suite.
+    let fallback = if records
+        .iter()
+        .any(|r| r.obstruction_change.is_none() && r.added_subtasks.is_none())
+    {
+        nesy_sim::tasks::scenario::scenarios(&nesy_sim::tasks::scenario::generate_suite())
+    } else {
+        Vec::new()
+    };
     let mut out: BTreeMap<String, [Aggregate; 3]> = BTreeMap::new();
     for v in variants {
         out.insert(v.clone(), Default::default());
     }
     for r in records {
-        if let (Some(level), Some(slot)) = (gap_level(r, &suite), out.get_mut(&r.key.variant)) {
+        if let (Some(level), Some(slot)) = (gap_level(r, &fallback), out.get_mut(&r.key.variant)) {
             slot[level].push(r);
         }
     }
@@ -1213,5 +1237,32 @@ mod tests {
         let m = t.mean_se();
         assert!((m.se - (1.0f64 / 3.0).sqrt() / 2.0).abs() < 1e-12);
         assert_eq!(pct(&Tally::default()), "–");
+    }
+
+    /// The level follows the change a record carries, so an edited suite is binned by its
+    /// own configurations; a record without one is looked up in the generated suite; the
+    /// complexity-gap suite and the embodiment factors have no level.
+    #[test]
+    fn gap_levels_follow_the_recorded_obstruction_change() {
+        use crate::store::tests::record;
+        let suite = nesy_sim::tasks::scenario::scenarios(&nesy_sim::tasks::scenario::generate_suite());
+        let real = &suite.iter().find(|s| s.id == "obst_high_03_s0").unwrap();
+        let change = obstruction_change(real).unwrap();
+        assert!(change >= 4, "4 obstructed subtasks: {change}");
+        let mut r = record("obst_high_03_s0", "m", UnitStatus::Succeeded, 1.0);
+        let looked_up = gap_level(&r, &suite);
+        assert_eq!(looked_up, Some(if change <= 4 { 1 } else { 2 }));
+        for (recorded, level) in [(1, 0), (2, 0), (3, 1), (4, 1), (5, 2), (9, 2)] {
+            r.obstruction_change = Some(recorded);
+            assert_eq!(gap_level(&r, &suite), Some(level), "change {recorded}");
+            assert_eq!(gap_level(&r, &[]), Some(level), "no suite needed");
+        }
+        r.factor = Factor::Grip;
+        assert_eq!(gap_level(&r, &suite), None);
+        r.factor = Factor::Obst;
+        r.added_subtasks = Some(2);
+        assert_eq!(gap_level(&r, &suite), None);
+        let gap = nesy_sim::tasks::scenario::scenarios(&nesy_sim::tasks::scenario::generate_gap_suite());
+        assert!(gap.iter().all(|s| obstruction_change(s).is_none()));
     }
 }

@@ -89,6 +89,35 @@ fn killed_runs_resume_shards_merge_and_configurations_do_not_mix() {
         let bytes = std::fs::read(whole.join("plots").join(plot)).unwrap();
         assert_eq!(&bytes[1..4], b"PNG", "{plot}");
     }
+    // Each record carries its scenario's obstruction change, and the domain-gap table bins
+    // exactly those: both subtasks change on the obst and affo scenarios, none on grip.
+    let shard = std::fs::read_dir(whole.join("results"))
+        .unwrap()
+        .flatten()
+        .next()
+        .unwrap();
+    let mut levels = [0; 3];
+    for line in std::fs::read_to_string(shard.path()).unwrap().lines() {
+        let record: serde_json::Value = serde_json::from_str(line).unwrap();
+        let change = record["obstruction_change"].as_u64();
+        if record["factor"] == "grip" {
+            assert_eq!(change, Some(0), "{line}");
+            continue;
+        }
+        let change = change.filter(|&c| c >= 2).unwrap_or_else(|| panic!("{line}"));
+        if record["variant"] == "nesycr" {
+            levels[match change {
+                0..=2 => 0,
+                3..=4 => 1,
+                _ => 2,
+            }] += 1;
+        }
+    }
+    let gap = table(&whole, "domain_gap.csv");
+    for (name, n) in ["Low", "Moderate", "High"].iter().zip(levels) {
+        let row = format!("nesycr,{name},{n},");
+        assert!(gap.lines().any(|l| l.starts_with(&row)), "{row} in\n{gap}");
+    }
 
     // Running it again does nothing: every unit is final.
     let again = common::nesy(&run_args(&whole, &demos, &["--json"]));
