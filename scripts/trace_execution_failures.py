@@ -8,8 +8,8 @@ the two are compared:
 - the preconditions the noise-free world model has and the verified noisy one lacks (a
   literal left out of an induced operator is consistent with a demonstration in which it
   always held, so the demonstration check cannot refuse it);
-- the adapted procedures: repair actions the noise-free run made and the noisy one did not,
-  or the same actions in another order.
+- the adapted procedures: steps the noise-free procedure has and the noisy one lacks (on
+  an Obstruction target, the repair), or the same steps in another order.
 
 Each failure is put in one class. Exit status 1, with the file named, on bad usage or
 unreadable input.
@@ -75,9 +75,11 @@ def classify(noisy: dict, clean: dict, clean_status: str) -> tuple:
         kind = "fails without noise too"
     elif missing:
         obstruction = any(OBSTRUCTION.match(lit) for _, lit in dropped)
-        kind = "repair missing" + (", an obstruction precondition dropped" if obstruction else "")
+        kind = "steps of the noise-free procedure missing" + (
+            ", an obstruction precondition dropped" if obstruction else ""
+        )
     elif ours != theirs:
-        kind = "same repair actions in another order"
+        kind = "same steps in another order"
     else:
         kind = "same procedure"
     return kind, dropped, sorted(missing.elements())
