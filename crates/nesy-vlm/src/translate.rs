@@ -248,7 +248,7 @@ pub const TRANSLATION_ATTEMPTS: usize = 3;
 /// Asks the model for the atoms of one view set and reads the reply with
 /// [`read_translation`]. A reply that cannot be used (not a state list, unknown names, cut
 /// off, null content) goes back to the model with the reason through the shared
-/// [`reply`](crate::reply) policy, up to [`TRANSLATION_ATTEMPTS`] replies; only then is it
+/// [`reply`] policy, up to [`TRANSLATION_ATTEMPTS`] replies; only then is it
 /// [`TranslateError::NoState`].
 pub async fn translate_state(
     client: &VlmClient,

@@ -9,7 +9,7 @@
 //! - [`scenario`]: the 440-scenario suite of source/target pairs.
 //!
 //! Layouts follow the authors' rules and distributions but draw from nesy's own seeded
-//! streams ([`crate::world::rng::Stream`]): a subtask's base layout depends only on its kind
+//! streams (`world::rng::Stream`, internal): a subtask's base layout depends only on its kind
 //! and `variant` (and its offset), and the obstruction on a separate stream of the same
 //! variant, so a source and a target that share a variant differ only by the obstruction.
 

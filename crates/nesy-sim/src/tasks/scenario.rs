@@ -9,7 +9,7 @@
 //!   multi 2.
 //! - Counts per factor: 15/15/10 configurations (low/medium/high), 20/20/20 for `comb`.
 //!
-//! Configurations come from nesy's own seeded streams ([`crate::world::rng::Stream`]); they are
+//! Configurations come from nesy's own seeded streams (`world::rng::Stream`, internal); they are
 //! written as 15 JSON files ([`ConfigFile`], one per factor × complexity) by
 //! `nesy scenarios generate`. A scenario is a configuration plus a seed: seed `s` lays each
 //! subtask out with variant `variant + s × SEED_STRIDE` and the composite offsets with

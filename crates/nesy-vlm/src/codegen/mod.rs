@@ -216,7 +216,7 @@ pub fn build_request(
 /// nothing defines and robot API calls whose arguments do not bind) must pass, and no
 /// function of the other end effector may be called. A reply that fails goes back to the
 /// model with the reason, up to [`CODEGEN_ATTEMPTS`] replies in all, through the shared
-/// [`reply`](crate::reply) policy (a reply cut off at the token cap asks for a briefer
+/// [`reply`] policy (a reply cut off at the token cap asks for a briefer
 /// answer; one with null content says so).
 pub async fn generate_code(
     client: &VlmClient,

@@ -4,7 +4,7 @@
 //! HTTP would, under the retry layer and any cassette, so the replies go through the same
 //! parsers, verification and cassette recording as a real model's.
 //!
-//! - **Operator induction** ([`induce`]): the transition's recorded API call selects the
+//! - **Operator induction** ([`induce`](mod@induce)): the transition's recorded API call selects the
 //!   domain's schemas for that call; the binding whose grounded effects reproduce s_{t+1}
 //!   is printed as the Action Prediction reply.
 //! - **Patches** ([`patch`]): nesy-core's planner over the true domain, from the violation
