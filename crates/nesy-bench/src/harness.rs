@@ -800,12 +800,7 @@ fn agreement(states: &Option<StateSource>) -> Option<Agreement> {
     match states {
         Some(StateSource::Vlm {
             agreement: Some(a), ..
-        }) => Some(Agreement {
-            precision: a.precision,
-            recall: a.recall,
-            f1: a.f1,
-            counts: [0, 0, 0],
-        }),
+        }) => Some(*a),
         _ => None,
     }
 }

@@ -9,6 +9,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::unit::UnitKey;
 
+/// State translation against ground truth, when the states came from the model.
+pub use nesy_pipeline::states::Agreement;
+
 /// How a unit ended. Every unit ends in exactly one status; none is dropped from a table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -190,19 +193,6 @@ pub struct Effort {
     pub sim_s: f64,
     /// Wall seconds of the whole unit.
     pub wall_s: f64,
-}
-
-/// State translation against ground truth, when the states came from the model.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Agreement {
-    /// Translated atoms that are true.
-    pub precision: f64,
-    /// True atoms that were translated.
-    pub recall: f64,
-    /// Harmonic mean.
-    pub f1: f64,
-    /// Atom counts behind them: true positives, predicted, actual.
-    pub counts: [u64; 3],
 }
 
 /// One finished unit.

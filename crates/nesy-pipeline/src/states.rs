@@ -12,7 +12,7 @@ use nesy_core::predicates::Vocabulary;
 use nesy_core::{Atom, State};
 use nesy_sim::api::Embodiment;
 use nesy_vlm::{StateTranslationRequest, VlmReasoner};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::PipelineError;
 use crate::inputs::{DemoInput, DemoKeyframes, TargetInput};
@@ -55,8 +55,9 @@ pub enum StateSource {
     },
 }
 
-/// Agreement of translated states with ground truth (micro-averaged over atoms).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+/// Agreement of translated states with ground truth (micro-averaged over atoms). The
+/// benchmark's unit records carry it as it is.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Agreement {
     /// Translated atoms that are true.
     pub precision: f64,
@@ -64,6 +65,8 @@ pub struct Agreement {
     pub recall: f64,
     /// Harmonic mean.
     pub f1: f64,
+    /// The atom counts behind them: true positives, predicted, actual.
+    pub counts: [u64; 3],
 }
 
 /// The states the adaptation runs on.
@@ -255,6 +258,7 @@ pub async fn symbolic_states(
             precision,
             recall,
             f1,
+            counts: [tp, predicted, actual].map(|n| n as u64),
         }
     });
     Ok(SymbolicStates {

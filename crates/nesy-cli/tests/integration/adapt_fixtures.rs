@@ -179,6 +179,12 @@ fn states_translated_by_the_model_from_the_marked_views() {
     assert_eq!(summary["states"]["source"], "vlm");
     assert_eq!(summary["states"]["translated"], 14);
     assert_eq!(summary["states"]["agreement"]["f1"], 1.0);
+    // The counts behind F1 1.0: every predicted atom true, every expressible atom predicted.
+    let counts: Vec<u64> = serde_json::from_value(summary["states"]["agreement"]["counts"].clone()).unwrap();
+    assert!(
+        counts[0] > 0 && counts.iter().all(|&n| n == counts[0]),
+        "{counts:?}"
+    );
     assert_eq!(summary["usage"]["by_purpose"]["translate"]["calls"], 14);
     assert_eq!(summary["status"], "succeeded");
 }
