@@ -103,9 +103,9 @@ impl ActionKey {
 
 /// [`ActionKey`]'s comparison without printing: the normalised name, and the preconditions
 /// and effects as sets of the formulas themselves. Printing is injective on formulas (the
-/// printed form parses back to the same formula, which `tests/integration/roundtrip.rs` checks), so two
-/// formulas are equal exactly when their canonical printed forms are, and `MatchKey`s are
-/// equal exactly when the corresponding `ActionKey`s are. Matching a SEARCH block against a
+/// printed form parses back to the same formula, which `tests/integration/roundtrip.rs`
+/// checks), so two formulas are equal exactly when their canonical printed forms are, and
+/// `MatchKey`s are equal exactly when the corresponding `ActionKey`s are. Matching a SEARCH block against a
 /// procedure compares every action; only the error message needs the printed forms. The
 /// formula sets are built on first use: most comparisons are settled by the names.
 struct MatchKey<'a> {

@@ -1,6 +1,7 @@
 //! `nesy scenarios` and `nesy record` through the binary: the paper's Table 6 counts, the
-//! written suite read back, the complexity-gap suite listed apart, a scene shown from either source, a recorded demo read back, bad
-//! input named with its file, and a reader that closes the pipe early.
+//! written suite read back, the complexity-gap suite listed apart, a scene shown from either
+//! source, a recorded demo read back, bad input named with its file, and a reader that closes
+//! the pipe early.
 
 use crate::common;
 

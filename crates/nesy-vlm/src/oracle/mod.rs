@@ -4,9 +4,9 @@
 //! HTTP would, under the retry layer and any cassette, so the replies go through the same
 //! parsers, verification and cassette recording as a real model's.
 //!
-//! - **Operator induction** ([`induce`](mod@induce)): the transition's recorded API call selects the
-//!   domain's schemas for that call; the binding whose grounded effects reproduce s_{t+1}
-//!   is printed as the Action Prediction reply.
+//! - **Operator induction** ([`induce`](mod@induce)): the transition's recorded API call
+//!   selects the domain's schemas for that call; the binding whose grounded effects
+//!   reproduce s_{t+1} is printed as the Action Prediction reply.
 //! - **Patches** ([`patch`]): nesy-core's planner over the true domain, from the violation
 //!   state to the unmet preconditions (or a removal of redundant actions, or a conversion to
 //!   the target end effector), printed as a SEARCH/REPLACE reply.

@@ -1,8 +1,9 @@
 //! Few-shot examples, kept as data files under `prompts/examples/` and embedded at compile
 //! time. Every example comes from nesy's own simulated scenes (`prompts/examples/scenes/`):
 //! the induction and state-translation examples hold observer states that
-//! `tests/integration/examples.rs` reproduces by replaying the recorded calls in nesy-sim, and the code
-//! examples are programs that `tests/integration/examples.rs` runs against those scenes.
+//! `tests/integration/examples.rs` reproduces by replaying the recorded calls in nesy-sim,
+//! and the code examples are programs that `tests/integration/examples.rs` runs against
+//! those scenes.
 
 use nesy_core::formula::{Effect, Formula};
 use nesy_core::operator::Operator;

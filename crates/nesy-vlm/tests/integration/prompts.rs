@@ -1,8 +1,8 @@
 //! Every rendered prompt is pinned by a snapshot under `tests/snapshots/` (regenerate with
-//! `UPDATE_SNAPSHOTS=1 cargo test -p nesy-vlm --test integration prompts::`), and the properties the
-//! issue asks of the prompts are asserted directly: the three diagnosis cases, no vacuum
-//! function in the finger prompt, the real handle names, `move_parallel`'s five directions,
-//! docstring signatures identical to the sandbox's `robot` module.
+//! `UPDATE_SNAPSHOTS=1 cargo test -p nesy-vlm --test integration prompts::`), and the
+//! properties the issue asks of the prompts are asserted directly: the three diagnosis
+//! cases, no vacuum function in the finger prompt, the real handle names, `move_parallel`'s
+//! five directions, docstring signatures identical to the sandbox's `robot` module.
 
 use crate::common;
 
