@@ -564,7 +564,7 @@ fn base_record(
         factor: unit.factor(),
         complexity: unit.complexity(),
         added_subtasks: unit.scenario.added_subtasks,
-        obstruction_change: crate::report::obstruction_change(&unit.scenario),
+        obstruction_change: unit.scenario.obstruction_change(),
         seed: unit.seed,
         config_hash: shared
             .manifest

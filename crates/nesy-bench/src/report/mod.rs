@@ -850,23 +850,6 @@ fn time_csv(tables: &Tables) -> String {
     out
 }
 
-/// The obstruction change of a scenario: Σ |target obst − source obst| over its subtasks;
-/// `None` for a complexity-gap scenario, whose target has subtasks the demonstration lacks.
-pub fn obstruction_change(scenario: &nesy_sim::tasks::scenario::Scenario) -> Option<u32> {
-    if scenario.added_subtasks.is_some() {
-        return None;
-    }
-    Some(
-        scenario
-            .episode
-            .source_subtasks
-            .iter()
-            .zip(&scenario.episode.target_subtasks)
-            .map(|(a, b)| u32::from(a.obst_level.abs_diff(b.obst_level)))
-            .sum(),
-    )
-}
-
 /// The domain-gap level of a unit: its obstruction change binned, for the obst, affo and
 /// comb factors (`None` for the others and for complexity-gap scenarios). The change is the
 /// one the record carries, so a run over an edited `--suite` is binned by its own
@@ -878,7 +861,10 @@ pub fn gap_level(record: &UnitRecord, fallback: &[nesy_sim::tasks::scenario::Sce
     }
     let change = match record.obstruction_change {
         Some(change) => change,
-        None => obstruction_change(fallback.iter().find(|s| s.id == record.key.scenario)?)?,
+        None => fallback
+            .iter()
+            .find(|s| s.id == record.key.scenario)?
+            .obstruction_change()?,
     };
     Some(match change {
         0..=2 => 0,
@@ -1247,7 +1233,7 @@ mod tests {
         use crate::store::tests::record;
         let suite = nesy_sim::tasks::scenario::scenarios(&nesy_sim::tasks::scenario::generate_suite());
         let real = &suite.iter().find(|s| s.id == "obst_high_03_s0").unwrap();
-        let change = obstruction_change(real).unwrap();
+        let change = real.obstruction_change().unwrap();
         assert!(change >= 4, "4 obstructed subtasks: {change}");
         let mut r = record("obst_high_03_s0", "m", UnitStatus::Succeeded, 1.0);
         let looked_up = gap_level(&r, &suite);
@@ -1263,6 +1249,6 @@ mod tests {
         r.added_subtasks = Some(2);
         assert_eq!(gap_level(&r, &suite), None);
         let gap = nesy_sim::tasks::scenario::scenarios(&nesy_sim::tasks::scenario::generate_gap_suite());
-        assert!(gap.iter().all(|s| obstruction_change(s).is_none()));
+        assert!(gap.iter().all(|s| s.obstruction_change().is_none()));
     }
 }

@@ -594,6 +594,23 @@ pub fn gap_scenario_id(factor: Factor, added: u8, episode_id: u64, seed: u64) ->
 }
 
 impl Scenario {
+    /// The obstruction change from demonstration to target, Σ |target obst − source obst|
+    /// over the subtasks (the domain-gap measure of Figure 4(a)); `None` for a
+    /// complexity-gap scenario, whose target has subtasks the demonstration lacks.
+    pub fn obstruction_change(&self) -> Option<u32> {
+        if self.added_subtasks.is_some() {
+            return None;
+        }
+        Some(
+            self.episode
+                .source_subtasks
+                .iter()
+                .zip(&self.episode.target_subtasks)
+                .map(|(a, b)| u32::from(a.obst_level.abs_diff(b.obst_level)))
+                .sum(),
+        )
+    }
+
     /// The task configuration of one side, with this scenario's seed applied.
     pub fn task(&self, side: Side) -> TaskConfig {
         let (subtasks, embodiment) = match side {
@@ -691,15 +708,14 @@ impl CountTable {
                 (f, row)
             })
             .collect();
-        let mut gap: Vec<(u8, usize)> = Vec::new();
+        let mut gap = std::collections::BTreeMap::<u8, usize>::new();
         for added in scenarios.iter().filter_map(|s| s.added_subtasks) {
-            match gap.iter_mut().find(|(k, _)| *k == added) {
-                Some((_, n)) => *n += 1,
-                None => gap.push((added, 1)),
-            }
+            *gap.entry(added).or_default() += 1;
         }
-        gap.sort_unstable();
-        CountTable { by_factor, gap }
+        CountTable {
+            by_factor,
+            gap: gap.into_iter().collect(),
+        }
     }
 
     /// The rows of the paper's Table 6 (factors grouped), with per-complexity counts.
