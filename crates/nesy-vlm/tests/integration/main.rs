@@ -1,5 +1,5 @@
 //! The VLM layer: the client and transports, cassettes, prompts, the reasoner, the
-//! fixtures and the offline reference responder on real scenes.
+//! fixtures and the offline reference responder on simulated scenes.
 //!
 //! One test binary per crate: every file here is a module of it, so the crate and its
 //! dependencies are linked once. Run one file's tests with
