@@ -7,8 +7,12 @@
 # through /proc/self/fd/N and the worker re-executes /proc/self/exe).
 #
 # usage: scripts/build-static.sh [--test]
-#   --test   also run `nesy run` on a fixture policy and scene inside an empty chroot that
-#            holds only the binary, the two input files and a /proc mount (needs root).
+#   --test   also run the binary inside an empty chroot that holds only the binary, the input
+#            files of each command and a /proc mount (needs root): `nesy run` on a fixture
+#            policy and scene; the quick-start job, `nesy adapt --execute` on the bundled demo
+#            with the model's answers replayed from its cassette (and the images it references);
+#            and `nesy verify` on a blocksworld domain and problem with a valid and an invalid
+#            plan. Each check prints `== chroot ...: ok`; the first that fails stops the script.
 #
 # Environment:
 #   NESY_STATIC_TARGET_DIR  cargo target dir for the static build (default: target/static).
@@ -33,7 +37,9 @@ out=${NESY_STATIC_OUT:-$target_dir/nesy-static}
 work=$target_dir/inputs
 mkdir -p "$work"
 
-# 1. The stdlib zip, compiled by the same CPython minor version that is linked.
+# 1. The stdlib zip, compiled by the same CPython minor version that is linked. The module set
+#    is derived from the runtime's own Python; scripts/static/check_stdlib_zip.py (run by
+#    `cargo test -p nesy-policy`) checks that the runtime works from the zip alone.
 /usr/bin/python3.11 -I -S scripts/static/stdlib_zip.py "$work/stdlib.zip"
 
 # 2. pyo3 links the static, position-independent libpython and its C dependencies.
@@ -79,11 +85,65 @@ if $run_test; then
   trap 'umount "$root/proc" 2>/dev/null || true; rm -rf "$root"' EXIT
   mkdir -p "$root/proc" "$root/dev"
   cp "$out" "$root/nesy"
+  # nesy run: a worked example policy on its scene.
   cp crates/nesy-policy/policies/pick_place.py "$root/policy.py"
   cp fixtures/scenes/pick_place_finger.json "$root/scene.json"
+  # nesy adapt: the demo, the target scene and the cassette under the same relative paths as
+  # in the checkout (chroot starts in /), plus the images the cassette names, which are kept
+  # as blobs/<sha256>.<ext> beside it.
+  cassette=fixtures/cassettes/adapt-realstyle.json
+  mkdir -p "$root/fixtures/demos" "$root/fixtures/cassettes/blobs"
+  cp -r fixtures/demos/adapt-realstyle "$root/fixtures/demos/"
+  cp "$cassette" "$root/$cassette"
+  { grep -o 'blob:sha256:[0-9a-f]*\.[a-z]*' "$cassette" || true; } | sort -u | while read -r blob; do
+    cp "fixtures/cassettes/blobs/${blob#blob:sha256:}" "$root/fixtures/cassettes/blobs/"
+  done
+  # nesy verify: blocksworld's Sussman anomaly with a valid plan and one that fails at step 1.
+  mkdir -p "$root/pddl"
+  cp fixtures/pddl/blocksworld/domain.pddl fixtures/pddl/blocksworld/sussman.pddl \
+    fixtures/pddl/blocksworld/sussman.valid.plan fixtures/pddl/blocksworld/sussman.unmet.plan "$root/pddl/"
   mount -t proc proc "$root/proc"
-  echo "== chroot contents: $(cd "$root" && find . -path ./proc -prune -o -type f -print | tr '\n' ' ')"
-  chroot "$root" /nesy run --policy /policy.py --scene /scene.json
-  chroot "$root" /nesy run --policy /policy.py --scene /scene.json --json > "$root/result.json"
-  grep -q '"kind": "ok"' "$root/result.json" && echo "== chroot run: ok"
+  echo "== chroot contents (files per top-level entry):" \
+    "$(cd "$root" && find . -path ./proc -prune -o -type f -print | cut -d/ -f2 | sort | uniq -c |
+      awk '{printf "%s (%d) ", $2, $1}')"
+
+  # Runs `nesy ARGS...` in the chroot with its stdout and stderr in $root/NAME.out (shown
+  # afterwards) and sets `status` to its exit status.
+  in_chroot() {
+    local name=$1
+    shift
+    status=0
+    chroot "$root" /nesy "$@" > "$root/$name.out" 2>&1 || status=$?
+    cat "$root/$name.out"
+  }
+  fail() {
+    echo "== chroot $1: FAILED" >&2
+    exit 1
+  }
+
+  in_chroot run run --policy /policy.py --scene /scene.json
+  [ "$status" -eq 0 ] || fail "run (exit $status)"
+  chroot "$root" /nesy run --policy /policy.py --scene /scene.json --json > "$root/result.json" ||
+    fail "run --json (exit $?)"
+  grep -q '"kind": "ok"' "$root/result.json" || fail "run --json (no \"kind\": \"ok\" outcome)"
+  echo "== chroot run: ok"
+
+  in_chroot adapt adapt --demo fixtures/demos/adapt-realstyle \
+    --target fixtures/demos/adapt-realstyle/target.json \
+    --vlm "replay:$cassette" --execute --out /run-adapt
+  [ "$status" -eq 0 ] || fail "adapt --execute (exit $status)"
+  grep -q '^nesy adapt: SUCCEEDED' "$root/adapt.out" || fail "adapt --execute (no SUCCEEDED)"
+  echo "== chroot adapt --execute: ok"
+
+  in_chroot verify-valid verify --domain /pddl/domain.pddl --problem /pddl/sussman.pddl \
+    --plan /pddl/sussman.valid.plan
+  [ "$status" -eq 0 ] || fail "verify, valid plan (exit $status)"
+  grep -qxF 'Plan valid: 6 step(s) executed, goal satisfied.' "$root/verify-valid.out" ||
+    fail "verify, valid plan (unexpected verdict)"
+  in_chroot verify-unmet verify --domain /pddl/domain.pddl --problem /pddl/sussman.pddl \
+    --plan /pddl/sussman.unmet.plan
+  [ "$status" -eq 1 ] || fail "verify, invalid plan (exit $status, expected 1)"
+  grep -qF 'step 1 (pick-up a) (plan line 2)' "$root/verify-unmet.out" ||
+    fail "verify, invalid plan (unexpected verdict)"
+  echo "== chroot verify: ok"
 fi

@@ -46,7 +46,7 @@ impl BaselineError {
     /// cannot be used, or a defect of the request.
     pub fn reasoner_kind(&self) -> ReasonerErrorKind {
         match self {
-            BaselineError::Call { error, .. } => error.reasoner_kind(),
+            BaselineError::Call { error, .. } => nesy_reasoner::failure_kind(error),
             BaselineError::Unreadable { .. } | BaselineError::NoPlan { .. } => ReasonerErrorKind::Reply,
             BaselineError::Prompt(_) => ReasonerErrorKind::Request,
         }

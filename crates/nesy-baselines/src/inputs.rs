@@ -2,7 +2,8 @@
 
 use nesy_core::predicates::{Tier, Vocabulary};
 use nesy_core::state::State;
-use nesy_vlm::{Part, Views};
+use nesy_reasoner::Views;
+use nesy_vlm::Part;
 use serde::Serialize;
 
 /// The six images of one scene: the top, front and back views, as rendered and with the

@@ -223,7 +223,8 @@ impl BaselinePrompts {
             let name = name.to_string();
             move |error| PromptError { name, error }
         };
-        let mut env = nesy_vlm::prompts::template_environment().map_err(error("(syntax configuration)"))?;
+        let mut env =
+            nesy_reasoner::prompts::template_environment().map_err(error("(syntax configuration)"))?;
         for (name, text) in TEMPLATES {
             env.add_template(name, text).map_err(error(name))?;
         }

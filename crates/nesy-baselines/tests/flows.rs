@@ -11,8 +11,9 @@ use nesy_baselines::{
 };
 use nesy_core::predicates::Vocabulary;
 use nesy_core::state::State;
+use nesy_reasoner::Views;
 use nesy_vlm::{
-    BackendKind, BoxFuture, Image, Origin, Transport, TransportError, Views, VlmClient, VlmConfig, VlmError,
+    BackendKind, BoxFuture, Image, Origin, Transport, TransportError, VlmClient, VlmConfig, VlmError,
     WireRequest, WireResponse,
 };
 use serde_json::{Value, json};
@@ -96,14 +97,7 @@ fn client(transport: Arc<Scripted>, max_images: Option<usize>) -> VlmClient {
 }
 
 fn png(seed: u8) -> Image {
-    let mut out = Vec::new();
-    {
-        let mut encoder = png::Encoder::new(&mut out, 2, 2);
-        encoder.set_color(png::ColorType::Rgb);
-        let mut writer = encoder.write_header().unwrap();
-        writer.write_image_data(&[seed; 12]).unwrap();
-    }
-    Image::png(out).unwrap()
+    Image::png(nesy_testkit::png(2, u64::from(seed))).unwrap()
 }
 
 fn six(seed: u8) -> SixViews {
@@ -237,7 +231,14 @@ fn demo2code_observes_every_keyframe_then_plans_for_the_target() {
     assert!(!user.contains("VacuumAttached"), "{user}");
     assert_eq!(images(&messages(&actions[0])[1]), 6);
     let system = text_of(&messages(&actions[0])[0]);
-    assert!(system.contains(nesy_vlm::prompts::PHYSICAL_CONSTRAINTS.lines().next().unwrap()));
+    assert!(
+        system.contains(
+            nesy_reasoner::prompts::PHYSICAL_CONSTRAINTS
+                .lines()
+                .next()
+                .unwrap()
+        )
+    );
     assert!(
         actions
             .iter()

@@ -22,15 +22,17 @@ use std::time::Instant;
 use nesy_core::benchmark::Factor;
 use nesy_core::format_procedure;
 use nesy_pipeline::{
-    AdaptOptions, CodegenMode, DemoInput, DemoKeyframes, StateSource, SynthError, SynthesisRequest,
-    TargetInput, derive_setting, execute, output, synth, vlm,
+    AdaptOptions, CodegenMode, DemoInput, DemoKeyframes, SandboxChecks, StateSource, SynthError,
+    SynthesisRequest, TargetInput, derive_setting, execute, output, synth, vlm,
 };
 use nesy_policy::{Limits, WorkerCommand};
+use nesy_reasoner::VlmReasoner;
+use nesy_reasoner::codegen::CodeGenerationRequest;
 use nesy_sim::tasks::scenario::{self, ConfigFile, Scenario, Side};
 use nesy_vlm::cassette::CassetteFile;
 use nesy_vlm::{
-    CassetteMode, CassetteOptions, CassetteTransport, CodeGenerationRequest, ConfigOverrides, ProcessEnv,
-    Transport, VlmClient, VlmConfig, VlmReasoner,
+    CassetteMode, CassetteOptions, CassetteTransport, ConfigOverrides, ProcessEnv, Transport, VlmClient,
+    VlmConfig,
 };
 use serde::Serialize;
 use tokio::sync::Semaphore;
@@ -285,7 +287,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, BenchError> {
 }
 
 /// The noise knobs of a variant's `noise` setting (`;` or `,` between knobs).
-pub fn noise_of(spec: &str) -> Result<nesy_vlm::OracleNoise, BenchError> {
+pub fn noise_of(spec: &str) -> Result<nesy_oracle::OracleNoise, BenchError> {
     spec.replace(';', ",")
         .parse()
         .map_err(|e| BenchError::Usage(format!("noise={spec:?}: {e}")))
@@ -629,13 +631,14 @@ async fn scenario_inputs(shared: &Arc<Shared>, scenario: &Scenario) -> Result<Ar
     .clone()
 }
 
-/// The unit's client: its responder under the meter.
-fn unit_client(shared: &Shared, unit: &Unit) -> Result<UnitClient, (UnitStatus, String)> {
+/// The unit's client: its responder under the meter. The offline responder is given the
+/// demonstration's recorded robot calls.
+fn unit_client(shared: &Shared, unit: &Unit, demo: &DemoInput) -> Result<UnitClient, (UnitStatus, String)> {
     let config = &shared.config;
     let (client_config, base): (VlmConfig, Arc<dyn Transport>) = match &config.responder {
         ResponderSetup::Oracle => {
             let noise = unit.variant.option("noise").unwrap_or("").replace(';', ",");
-            let transport = vlm::oracle_transport(&noise, unit.seed)
+            let transport = vlm::oracle_transport(&noise, unit.seed, demo.recorded_calls())
                 .map_err(|e| (UnitStatus::MethodError, e.to_string()))?;
             let transport: Arc<dyn Transport> = if config.record_cassettes {
                 let path = cassette_path(unit, &config.run_dir.join("cassettes"));
@@ -749,7 +752,8 @@ async fn make_code(
         CodegenMode::Vlm => {
             let reasoner = VlmReasoner::new(client.clone())
                 .map_err(|e| (UnitStatus::MethodError, e.to_string()))?
-                .with_embodiments(inputs.setting.source_embodiment, inputs.setting.target_embodiment);
+                .with_embodiments(inputs.setting.source_embodiment, inputs.setting.target_embodiment)
+                .with_program_check(Arc::new(SandboxChecks));
             let request = CodeGenerationRequest {
                 instruction,
                 objects: target.objects.clone(),
@@ -844,7 +848,7 @@ async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
         variant: unit.variant.clone(),
         seed: unit.seed,
     };
-    let (client, counts) = match unit_client(shared, unit) {
+    let (client, counts) = match unit_client(shared, unit, &inputs.demo) {
         Ok(c) => c,
         Err((status, e)) => return failed_record(shared, unit, status, e, effort),
     };

@@ -114,7 +114,7 @@ impl Provenance {
             nesy_version: env!("CARGO_PKG_VERSION").to_owned(),
             git_commit: GIT_COMMIT.to_owned(),
             sim_fingerprint: nesy_sim::FINGERPRINT.to_owned(),
-            prompts_fingerprint: nesy_vlm::Prompts::fingerprint(),
+            prompts_fingerprint: nesy_reasoner::prompts::Prompts::fingerprint(),
             host: host_name(),
             machine: machine(),
         }

@@ -8,12 +8,13 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use nesy_core::State;
+use nesy_reasoner::{KeyframeImages, Views};
 use nesy_sim::api::Embodiment;
 use nesy_sim::demo::{CameraName, Demo};
 use nesy_sim::perception::render::{self, View};
 use nesy_sim::scene::{SceneSpec, parts};
-use nesy_sim::{Sim, observe};
-use nesy_vlm::{Image, KeyframeImages, Views};
+use nesy_sim::{ApiCall, Sim, observe};
+use nesy_vlm::Image;
 
 use crate::PipelineError;
 
@@ -55,6 +56,17 @@ impl DemoInput {
             demo,
             load_time: started.elapsed(),
         })
+    }
+
+    /// The robot call recorded for each transition (keyframe `t` to `t + 1`), `None` where
+    /// the demonstration did not record one (real-world demos record none).
+    pub fn recorded_calls(&self) -> Vec<Option<ApiCall>> {
+        self.demo
+            .keyframes
+            .iter()
+            .skip(1)
+            .map(|k| k.action.as_ref().map(|entry| entry.call.clone()))
+            .collect()
     }
 
     /// A demo already in memory (tests, benchmarks).
@@ -272,12 +284,10 @@ impl TargetInput {
     }
 }
 
-/// The demo's keyframes for the reasoner: marked views (raw where unlabelled) and the
-/// recorded API calls, both decoded once.
+/// The demo's keyframes for the reasoner: marked views (raw where unlabelled), decoded once.
 #[derive(Debug, Clone, Default)]
 pub struct DemoKeyframes {
     views: Vec<Option<Views>>,
-    calls: Vec<Option<serde_json::Value>>,
 }
 
 impl DemoKeyframes {
@@ -298,13 +308,7 @@ impl DemoKeyframes {
                 back: image(CameraName::Back)?,
             }));
         }
-        let calls = demo
-            .keyframes
-            .iter()
-            .skip(1)
-            .map(|k| k.action.as_ref().and_then(|a| serde_json::to_value(a).ok()))
-            .collect();
-        Ok(DemoKeyframes { views, calls })
+        Ok(DemoKeyframes { views })
     }
 
     /// The views of one keyframe.
@@ -316,10 +320,6 @@ impl DemoKeyframes {
 impl KeyframeImages for DemoKeyframes {
     fn views(&self, keyframe: usize) -> Option<Views> {
         self.keyframe_views(keyframe).cloned()
-    }
-
-    fn demo_call(&self, step: usize) -> Option<serde_json::Value> {
-        self.calls.get(step).cloned().flatten()
     }
 }
 

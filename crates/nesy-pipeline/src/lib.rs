@@ -13,7 +13,7 @@
 //! 3. [`states`]: symbolic states, observed (ground truth) or translated by the VLM from the
 //!    marked views.
 //! 4. [`adapt_episode`]: world model and counterfactual adaptation (`nesy_core::adapt::run`
-//!    over the [`nesy_vlm::VlmReasoner`], timed by [`timing::TimedReasoner`]).
+//!    over the [`nesy_reasoner::VlmReasoner`], timed by [`timing::TimedReasoner`]).
 //! 5. [`synth`]: code synthesis, by the VLM's code-generation prompt or by the template
 //!    compiler. An unresolved adaptation is never compiled.
 //! 6. [`execute`]: the policy in the sandbox against the target scene; SR, GC, PD from
@@ -44,7 +44,8 @@ use nesy_core::predicates::Vocabulary;
 use nesy_core::symbol::Symbol;
 use nesy_core::{Operator, State};
 use nesy_policy::{Limits, WorkerCommand};
-use nesy_vlm::{RunUsage, VlmReasoner};
+use nesy_reasoner::VlmReasoner;
+use nesy_vlm::RunUsage;
 use serde::Serialize;
 
 pub use error::PipelineError;
@@ -53,7 +54,7 @@ pub use inputs::{DemoInput, DemoKeyframes, TargetInput};
 pub use progress::{LogProgress, NoProgress, Progress};
 pub use setting::{Setting, derive_setting};
 pub use states::{StateSource, StatesMode, SymbolicStates};
-pub use synth::{CodegenMode, SynthError, SynthesisRequest, SynthesizedPolicy, TemplateCompiler};
+pub use synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest, SynthesizedPolicy};
 pub use timing::TimeBreakdown;
 pub use vlm::{VlmSetup, VlmSource};
 
@@ -310,7 +311,8 @@ pub async fn run(
             message: format!("loading nesy's prompts: {e}"),
         })?
         .with_keyframes(keyframes)
-        .with_embodiments(setting.source_embodiment, setting.target_embodiment);
+        .with_embodiments(setting.source_embodiment, setting.target_embodiment)
+        .with_program_check(Arc::new(SandboxChecks));
 
     progress.stage("symbolic states");
     let vocabulary = Vocabulary::new();

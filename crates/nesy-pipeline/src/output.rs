@@ -237,7 +237,7 @@ fn inductions(adaptation: &Adaptation) -> Vec<serde_json::Value> {
 }
 
 /// The code-generation replies that were re-asked, each with its problem and the reply.
-fn write_rejected_programs(md: &mut String, rejected: &[nesy_vlm::codegen::RejectedProgram]) {
+fn write_rejected_programs(md: &mut String, rejected: &[nesy_reasoner::codegen::RejectedProgram]) {
     for (i, r) in rejected.iter().enumerate() {
         let _ = writeln!(
             md,

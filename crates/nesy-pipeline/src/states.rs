@@ -10,8 +10,9 @@ use std::time::{Duration, Instant};
 
 use nesy_core::predicates::Vocabulary;
 use nesy_core::{Atom, State};
+use nesy_reasoner::VlmReasoner;
+use nesy_reasoner::translate::{StateTranslationRequest, TranslatedState};
 use nesy_sim::api::Embodiment;
-use nesy_vlm::{StateTranslationRequest, VlmReasoner};
 use serde::{Deserialize, Serialize};
 
 use crate::PipelineError;
@@ -196,7 +197,7 @@ pub async fn symbolic_states(
             (i, request, result)
         });
     }
-    let mut results: Vec<Option<(StateTranslationRequest, nesy_vlm::TranslatedState)>> = vec![None; total];
+    let mut results: Vec<Option<(StateTranslationRequest, TranslatedState)>> = vec![None; total];
     let mut done = 0;
     while let Some(joined) = set.join_next().await {
         let (i, request, result) = joined.map_err(|e| PipelineError::States {

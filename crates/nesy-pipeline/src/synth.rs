@@ -8,14 +8,13 @@
 
 use nesy_core::Operator;
 use nesy_core::adapt::ReasonerErrorKind;
-use nesy_sim::api::Embodiment;
-use nesy_sim::codegen::{CodegenError as TemplateError, compile_policy};
-use nesy_sim::scene::SceneSpec;
-use nesy_vlm::codegen::RejectedProgram;
-use nesy_vlm::{
-    CodeGenerationContext, CodeGenerationRequest, CodegenError, PolicyCompileError, PolicyCompiler,
-    VlmReasoner,
+use nesy_reasoner::VlmReasoner;
+use nesy_reasoner::codegen::{
+    CheckUnavailable, CodeGenerationRequest, CodegenError, Finding, ProgramCheck, RejectedProgram,
 };
+use nesy_sim::api::Embodiment;
+use nesy_sim::codegen::compile_policy;
+use nesy_sim::scene::SceneSpec;
 use serde::Serialize;
 
 /// How code is synthesized (`--codegen`).
@@ -164,21 +163,21 @@ fn template(request: &SynthesisRequest<'_>) -> Result<SynthesizedPolicy, SynthEr
     })
 }
 
-/// The template compiler as the oracle's code generator.
+/// The sandbox's static checks (nesy-policy's, in its embedded CPython), which every
+/// generated program passes before code generation accepts it.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct TemplateCompiler;
+pub struct SandboxChecks;
 
-impl PolicyCompiler for TemplateCompiler {
-    fn compile(&self, request: &CodeGenerationContext) -> Result<String, PolicyCompileError> {
-        compile_policy(&request.procedure, &request.objects, request.embodiment)
-            .map(|c| c.code)
-            .map_err(|e| {
-                let detail = e.to_string();
-                match e {
-                    TemplateError::UnknownAction { index, name } => {
-                        PolicyCompileError::UnknownAction { index, name, detail }
-                    }
-                }
+impl ProgramCheck for SandboxChecks {
+    fn check(&self, program: &str) -> Result<Vec<Finding>, CheckUnavailable> {
+        let violations = nesy_policy::check_source(program).map_err(|e| CheckUnavailable(e.to_string()))?;
+        Ok(violations
+            .into_iter()
+            .map(|v| Finding {
+                line: v.line,
+                column: v.column,
+                message: v.message,
             })
+            .collect())
     }
 }

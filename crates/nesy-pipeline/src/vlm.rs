@@ -5,7 +5,7 @@
 //! - `--vlm URL`: a live OpenAI-compatible server at URL (backend `vllm` unless configured);
 //! - `--vlm replay:CASSETTE`: replay only; the backend and model come from the cassette's
 //!   metadata, so the request bodies match the recording; a miss names the request;
-//! - `--vlm oracle`: the offline reference responder (nesy-vlm's oracle transport);
+//! - `--vlm oracle`: the offline reference responder (nesy-oracle's transport);
 //! - in code, any [`Transport`] (tests' scripted responders).
 //!
 //! `--record CASSETTE` wraps whichever live transport in a cassette in `all` mode.
@@ -15,11 +15,14 @@ use std::sync::Arc;
 
 use nesy_vlm::cassette::CassetteFile;
 
-use crate::PipelineError;
+use nesy_oracle::{OracleNoise, OracleTransport};
+use nesy_sim::ApiCall;
 use nesy_vlm::{
-    BackendKind, CassetteMode, CassetteOptions, CassetteTransport, ConfigOverrides, OracleNoise,
-    OracleTransport, ProcessEnv, Transport, VlmClient, VlmConfig,
+    BackendKind, CassetteMode, CassetteOptions, CassetteTransport, ConfigOverrides, ProcessEnv, Transport,
+    VlmClient, VlmConfig,
 };
+
+use crate::{DemoInput, PipelineError};
 
 /// The model name the offline responder's requests carry (recorded in its cassettes).
 pub const ORACLE_MODEL: &str = "nesy-oracle";
@@ -134,8 +137,9 @@ pub fn replay_config(path: &Path, file: &CassetteFile) -> Result<VlmConfig, Pipe
     Ok(VlmConfig::new(backend, model))
 }
 
-/// Builds the client for `setup`.
-pub fn build_client(setup: &VlmSetup) -> Result<VlmClient, PipelineError> {
+/// Builds the client for `setup`. The offline responder is given `demo`'s recorded robot
+/// calls, which its induction answers start from.
+pub fn build_client(setup: &VlmSetup, demo: &DemoInput) -> Result<VlmClient, PipelineError> {
     let (config, live): (VlmConfig, Option<Arc<dyn Transport>>) = match &setup.source {
         VlmSource::Replay(path) => {
             if setup.record.is_some() {
@@ -192,7 +196,7 @@ pub fn build_client(setup: &VlmSetup) -> Result<VlmClient, PipelineError> {
             (config, Some(Arc::new(http)))
         }
         VlmSource::Oracle { noise, seed } => {
-            let transport = oracle_transport(noise, *seed)?;
+            let transport = oracle_transport(noise, *seed, demo.recorded_calls())?;
             (oracle_config(), Some(transport))
         }
         VlmSource::Transport { config, transport } => ((**config).clone(), Some(transport.clone())),
@@ -223,9 +227,14 @@ pub fn build_client(setup: &VlmSetup) -> Result<VlmClient, PipelineError> {
     Ok(VlmClient::with_transport(&config, transport))
 }
 
-/// The offline reference responder: nesy-vlm's oracle over the true domain, with the noise
-/// knobs seeded by `seed`, answering code generation with the template compiler.
-pub fn oracle_transport(noise: &str, seed: u64) -> Result<Arc<dyn Transport>, PipelineError> {
+/// The offline reference responder: nesy-oracle's transport over the true domain, with the
+/// noise knobs seeded by `seed` and the demonstration's recorded robot calls `demo_calls`
+/// (one per transition).
+pub fn oracle_transport(
+    noise: &str,
+    seed: u64,
+    demo_calls: Vec<Option<ApiCall>>,
+) -> Result<Arc<dyn Transport>, PipelineError> {
     let noise: OracleNoise = if noise.trim().is_empty() {
         OracleNoise::NONE
     } else {
@@ -236,7 +245,7 @@ pub fn oracle_transport(noise: &str, seed: u64) -> Result<Arc<dyn Transport>, Pi
     let oracle = OracleTransport::new()
         .map_err(|e| setup_error(format!("loading the oracle's domain: {e}")))?
         .with_noise(noise, seed)
-        .with_compiler(Arc::new(crate::synth::TemplateCompiler));
+        .with_demo_calls(demo_calls);
     Ok(Arc::new(oracle))
 }
 

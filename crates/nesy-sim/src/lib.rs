@@ -13,6 +13,8 @@
 //! - [`perception`]: the symbolic observer and the renderer.
 //! - [`tasks`]: the benchmark's tasks, goal checks, scripted experts and scenarios.
 //! - [`demo`]: recorded demonstrations (MCAP and folders) and the recorder.
+//! - [`domain`]: the world's true domain (`assets/pddl/nesy-world.pddl`) and what each of
+//!   its schemas does on the robot.
 //! - [`codegen`]: the template compiler from symbolic actions to robot-API code.
 //!
 //! ```
@@ -32,6 +34,7 @@
 pub mod api;
 pub mod codegen;
 pub mod demo;
+pub mod domain;
 pub mod perception;
 pub mod robot;
 pub mod scene;

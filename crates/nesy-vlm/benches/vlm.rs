@@ -10,9 +10,6 @@
 //!   to a raw reqwest POST of the same body to the same server, for a text prompt and for
 //!   the rendered two-image prompt. After the Criterion groups an interleaved run prints the
 //!   ratio of medians.
-//! - `prompts/*`: building the NeSyCR requests from nesy-core's requests (template rendering,
-//!   few-shot examples projected onto the tier, task context serialised to JSON, six keyframe
-//!   images attached), and extracting the program from a code-generation reply.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -25,10 +22,6 @@ use nesy_vlm::{
 use serde_json::json;
 use wiremock::matchers::method;
 use wiremock::{Mock, MockServer, ResponseTemplate};
-
-#[path = "../tests/integration/common/mod.rs"]
-#[allow(missing_docs)]
-mod common;
 
 fn runtime() -> tokio::runtime::Runtime {
     tokio::runtime::Builder::new_current_thread()
@@ -46,7 +39,7 @@ fn rendered_views() -> (Vec<u8>, Vec<u8>) {
 
 /// Two synthetic 384×384 images with per-pixel noise (poorly compressible).
 fn noisy_views() -> (Vec<u8>, Vec<u8>) {
-    (common::png(384, 1), common::png(384, 2))
+    (nesy_testkit::png(384, 1), nesy_testkit::png(384, 2))
 }
 
 /// A request with two images, built from the bytes each time (nothing about the images is
@@ -72,7 +65,7 @@ fn text_request() -> ChatRequest {
 }
 
 fn server_config(server: &MockServer) -> VlmConfig {
-    let mut cfg = common::config(BackendKind::OpenAi, "gpt-5", &server.uri());
+    let mut cfg = nesy_testkit::mock_config(BackendKind::OpenAi, "gpt-5", &server.uri());
     cfg.api_key = Some(SecretString::new("sk-bench-not-a-real-key"));
     cfg.retry = RetryPolicy {
         max_attempts: 1,
@@ -241,117 +234,10 @@ fn overhead_ratio() {
     }
 }
 
-/// The prompt layer: the scenario's real requests rendered into chat requests.
-fn prompts(c: &mut Criterion) {
-    use common::scenario;
-    use nesy_core::adapt::{InductionRequest, PatchRequest, Reasoner, ReasonerError};
-
-    #[derive(Default)]
-    struct Recorder {
-        replies: Vec<&'static str>,
-        patches: Vec<&'static str>,
-        induction: Vec<InductionRequest>,
-        patch: Vec<PatchRequest>,
-    }
-    impl Reasoner for Recorder {
-        async fn induce_operator(&mut self, r: &InductionRequest) -> Result<String, ReasonerError> {
-            self.induction.push(r.clone());
-            Ok(self.replies.remove(0).into())
-        }
-        async fn propose_patch(&mut self, r: &PatchRequest) -> Result<String, ReasonerError> {
-            self.patch.push(r.clone());
-            Ok(self.patches.remove(0).into())
-        }
-    }
-    let mut recorder = Recorder {
-        replies: vec![
-            scenario::APPROACH,
-            scenario::GRASP,
-            scenario::CARRY,
-            scenario::DROP,
-        ],
-        patches: vec![scenario::PATCH],
-        ..Recorder::default()
-    };
-    let adaptation = runtime()
-        .block_on(nesy_core::adapt::run(
-            &mut recorder,
-            &scenario::demo(),
-            &scenario::target(),
-            &scenario::config(),
-        ))
-        .expect("scenario adapts");
-    let (top, front) = rendered_views();
-    let views = |_| nesy_vlm::Views {
-        top: Image::png(top.clone()).expect("png"),
-        front: Image::png(front.clone()).expect("png"),
-        back: Image::png(top.clone()).expect("png"),
-    };
-    let keyframes = Arc::new(nesy_vlm::KeyframeList {
-        views: (0..5).map(views).collect(),
-        calls: Vec::new(),
-    });
-    let client = VlmClient::with_transport(
-        &VlmConfig::new(BackendKind::OpenAi, "gpt-5"),
-        Arc::new(common::InFlightCounter::new(Arc::new(NeverSends))),
-    );
-    let reasoner = nesy_vlm::VlmReasoner::new(client)
-        .expect("prompts")
-        .with_keyframes(keyframes);
-    let prompts = nesy_vlm::Prompts::builtin().expect("prompts");
-    let codegen = nesy_vlm::CodeGenerationRequest {
-        instruction: "Put the fruits in the hinge box.".into(),
-        objects: scenario::OBJECTS.iter().map(|o| o.to_string()).collect(),
-        procedure: adaptation.outcome.procedure().to_vec(),
-        plan: Vec::new(),
-        embodiment: nesy_vlm::Embodiment::Vacuum,
-        extended: true,
-    };
-    let mut group = c.benchmark_group("prompts");
-    group.bench_function("induction_request_6_rendered_images", |b| {
-        b.iter(|| {
-            reasoner
-                .induction_request(&recorder.induction[3])
-                .expect("renders")
-        })
-    });
-    group.bench_function("refinement_request", |b| {
-        b.iter(|| reasoner.patch_request(&recorder.patch[0]).expect("renders"))
-    });
-    group.bench_function("code_generation_extended_request", |b| {
-        b.iter(|| nesy_vlm::codegen::build_request(prompts, &codegen, &Default::default()).expect("renders"))
-    });
-    group.bench_function("extract_code", |b| {
-        b.iter(|| nesy_vlm::codegen::extract_code(scenario::CODE).expect("a program"))
-    });
-    group.finish();
-}
-
-/// The prompt benchmarks only build requests.
-#[derive(Debug)]
-struct NeverSends;
-
-impl Transport for NeverSends {
-    fn send<'a>(
-        &'a self,
-        _: &'a nesy_vlm::WireRequest,
-    ) -> nesy_vlm::BoxFuture<'a, Result<nesy_vlm::WireResponse, nesy_vlm::TransportError>> {
-        Box::pin(async {
-            Err(nesy_vlm::TransportError::Failed {
-                message: "benchmarks never send".into(),
-                retryable: false,
-            })
-        })
-    }
-    fn label(&self) -> String {
-        "never".into()
-    }
-}
-
 criterion_group! {
     name = benches;
     config = Criterion::default().measurement_time(Duration::from_secs(3)).warm_up_time(Duration::from_secs(1));
-    targets = replay, overhead, prompts
+    targets = replay, overhead
 }
 
 fn main() {

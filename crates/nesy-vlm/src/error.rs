@@ -113,30 +113,6 @@ impl VlmError {
         }
     }
 
-    /// Which kind of reasoner failure this is, for callers that must branch on it (the
-    /// benchmark harness retries transport failures later and scores the rest).
-    pub fn reasoner_kind(&self) -> nesy_core::adapt::ReasonerErrorKind {
-        use nesy_core::adapt::ReasonerErrorKind as Kind;
-        match self {
-            Self::Config(_) | Self::InvalidRequest(_) => Kind::Request,
-            Self::TooManyImages { .. } => Kind::Refused,
-            Self::Transport {
-                error: TransportError::Declined(_),
-                ..
-            } => Kind::Exhausted,
-            Self::Transport { .. } => Kind::Transport,
-            // Timeouts, rate limits and server errors are the endpoint's state; a quota that
-            // ran out or a key that is refused will not fix itself, but they say nothing
-            // about the method either, so they count as transport failures too.
-            Self::Http { status, .. } if matches!(status, 401 | 403 | 408 | 409 | 429) || *status >= 500 => {
-                Kind::Transport
-            }
-            Self::Http { .. } => Kind::Refused,
-            Self::InvalidResponse { .. } | Self::Truncated { .. } | Self::Refusal { .. } => Kind::Reply,
-            Self::Cassette(_) => Kind::Replay,
-        }
-    }
-
     /// How many attempts the call made before failing, where the client counted them.
     pub fn attempts(&self) -> Option<u32> {
         match self {

@@ -12,28 +12,10 @@
 //!   replays or records around an optional inner transport; an offline responder can be
 //!   added as another implementation without touching the client.
 //!
-//! On top of the client, the NeSyCR prompts (minijinja templates under `prompts/`, see
-//! [`prompts`]):
-//! - [`VlmReasoner`] implements nesy-core's `Reasoner` (operator induction with keyframe
-//!   images from a [`KeyframeImages`] source, refinement proposals) and offers
-//!   [`VlmReasoner::translate_state`] and [`VlmReasoner::generate_code`];
-//! - every request carries a typed [`VlmTask`] context for offline responders.
-//!
-//! ```no_run
-//! # async fn demo() -> Result<(), nesy_vlm::VlmError> {
-//! use nesy_vlm::{ChatRequest, Image, Message, Part, VlmClient, VlmConfig};
-//! let client = VlmClient::from_config(&VlmConfig::from_env()?)?;
-//! let png: Vec<u8> = std::fs::read("keyframe.png").unwrap();
-//! let reply = client
-//!     .chat(ChatRequest::new().purpose("describe").message(Message::user(vec![
-//!         Part::text("What is on the table?"),
-//!         Image::png(png)?.into(),
-//!     ])))
-//!     .await?;
-//! println!("{} ({} attempts)", reply.text, reply.attempts);
-//! client.finish()?;
-//! # Ok(()) }
-//! ```
+//! nesy-vlm knows nothing of NeSyCR: the prompts, the reasoner and the offline responder
+//! are the crates above it (nesy-reasoner, nesy-oracle). A request may carry an opaque
+//! [`TaskContext`] (a kind and JSON data) for transports that answer offline; it is never sent
+//! to a server and never part of a cassette key.
 //!
 //! Settings resolve from flags over the environment over a TOML file over defaults; keys come
 //! from the environment only:
@@ -59,33 +41,12 @@
 //! assert!(config.api_key.is_none()); // a cloud key is never sent to a local server
 //! ```
 //!
-//! The offline reference responder plugs in where HTTP would; a compiler turns verified
-//! procedures into code for its code-generation answers:
-//!
-//! ```
-//! use std::sync::Arc;
-//! use nesy_vlm::{BackendKind, OracleNoise, OracleTransport, VlmClient, VlmConfig};
-//!
-//! let noise: OracleNoise = "op-drop=0.1,bad-patch=0.2".parse().unwrap();
-//! let oracle = Arc::new(OracleTransport::new().unwrap().with_noise(noise, 7));
-//! let config = VlmConfig::new(BackendKind::OpenAi, "oracle");
-//! let client = VlmClient::with_transport(&config, oracle.clone());
-//! assert_eq!(oracle.stats().inductions, 0);
-//! # drop(client);
-//! ```
-
 pub mod accounting;
 pub mod cassette;
 pub mod client;
-pub mod codegen;
 pub mod config;
-pub mod context;
 pub mod error;
-pub mod keyframes;
-pub mod oracle;
 pub mod profile;
-pub mod prompts;
-pub mod reasoner;
 pub mod reply;
 pub mod request;
 pub mod response;
@@ -93,31 +54,20 @@ pub mod retry;
 pub mod secret;
 pub mod settings;
 pub mod timefmt;
-pub mod translate;
 pub mod transport;
 
 pub use accounting::{CallRecord, ModelPrice, PriceTable, RunUsage, UsageTotals};
 pub use cassette::{CassetteError, CassetteMode, CassetteOptions, CassetteTransport};
 pub use client::VlmClient;
-pub use codegen::{CodeGenerationRequest, CodegenError, PolicySource, generate_code};
 pub use config::{
     CassetteSettings, ConfigError, ConfigOverrides, EnvSource, ProcessEnv, Timeouts, VlmConfig,
 };
-pub use context::{
-    CodeGenerationContext, ContextError, Embodiment, InductionContext, PatchContext, StateTranslationContext,
-    VlmTask,
-};
 pub use error::{ProviderError, TimeoutPhase, TransportError, VlmError};
-pub use keyframes::{KeyframeImages, KeyframeList, NoKeyframes, Views};
-pub use oracle::{OracleNoise, OracleTransport, PolicyCompileError, PolicyCompiler};
 pub use profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, TokenCapField};
-pub use prompts::{PromptError, Prompts};
-pub use reasoner::VlmReasoner;
 pub use request::{ChatRequest, Image, ImageDetail, Message, Part, ReasoningEffort, Role, TaskContext};
 pub use response::{ChatResponse, FinishReason, Usage};
 pub use retry::RetryPolicy;
 pub use secret::SecretString;
 pub use settings::{CallSettings, PurposeSettings};
-pub use translate::{StateTranslationRequest, TranslateError, TranslatedState, translate_state};
 pub use transport::http::Auth;
 pub use transport::{BoxFuture, HttpTransport, Origin, Transport, WireRequest, WireResponse};

@@ -13,8 +13,9 @@ use futures::future::BoxFuture;
 use nesy_baselines::{Baseline, BaselineError, BaselineInputs, BaselinePlan, Fidelity, Keyframe, SixViews};
 use nesy_core::predicates::Vocabulary;
 use nesy_pipeline::CodegenMode;
+use nesy_reasoner::Views;
 use nesy_sim::demo::CameraName;
-use nesy_vlm::{Image, Views, VlmClient};
+use nesy_vlm::{Image, VlmClient};
 
 use super::{
     Classes, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified, UnitInputs,

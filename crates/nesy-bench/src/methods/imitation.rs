@@ -9,8 +9,9 @@ use futures::future::BoxFuture;
 use nesy_core::adapt::{AdaptConfig, Trace, construct_world_model, identify};
 use nesy_core::predicates::Vocabulary;
 use nesy_core::verify_procedure;
-use nesy_pipeline::{CodegenMode, NoProgress, StatesMode, adaptation_inputs, states, vlm};
-use nesy_vlm::{VlmClient, VlmReasoner};
+use nesy_pipeline::{CodegenMode, DemoInput, NoProgress, StatesMode, adaptation_inputs, states, vlm};
+use nesy_reasoner::VlmReasoner;
+use nesy_vlm::VlmClient;
 
 use super::{
     Classes, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified, UnitInputs,
@@ -25,9 +26,9 @@ use crate::variant::Variant;
 pub struct Imitation;
 
 /// An offline client over the reference responder without noise: the true domain's
-/// induction, used by the controls.
-pub(crate) fn ground_truth_client() -> Result<VlmClient, MethodFailure> {
-    let transport = vlm::oracle_transport("", 0)
+/// induction from `demo`'s recorded calls, used by the controls.
+pub(crate) fn ground_truth_client(demo: &DemoInput) -> Result<VlmClient, MethodFailure> {
+    let transport = vlm::oracle_transport("", 0, demo.recorded_calls())
         .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?;
     Ok(VlmClient::with_transport(&vlm::oracle_config(), transport))
 }
@@ -61,7 +62,7 @@ impl Method for Imitation {
         _client: &'a VlmClient,
     ) -> BoxFuture<'a, Result<Specified, MethodFailure>> {
         async move {
-            let client = ground_truth_client()?;
+            let client = ground_truth_client(&inputs.demo)?;
             let setting = &inputs.setting;
             let mut reasoner = VlmReasoner::new(client)
                 .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?

@@ -11,7 +11,8 @@ use nesy_core::predicates::Vocabulary;
 use nesy_pipeline::{
     CodegenMode, NoProgress, PipelineError, StatesMode, adapt_episode, adaptation_inputs, states,
 };
-use nesy_vlm::{VlmClient, VlmReasoner};
+use nesy_reasoner::VlmReasoner;
+use nesy_vlm::VlmClient;
 
 use super::{
     Classes, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified, UnitInputs,

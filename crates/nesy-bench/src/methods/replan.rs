@@ -10,8 +10,8 @@ use nesy_core::formula::Formula;
 use nesy_core::planner::{Heuristic, PlannerConfig, Search};
 use nesy_core::symbol::Symbol;
 use nesy_pipeline::CodegenMode;
+use nesy_sim::domain::{WorldDomain, plan_to_goal};
 use nesy_vlm::VlmClient;
-use nesy_vlm::oracle::{WorldDomain, plan_to_goal};
 
 use super::{
     Classes, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified, UnitInputs,

@@ -92,7 +92,7 @@ pub fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     progress.stage("building the target scene");
     let target = TargetInput::load(args.target.as_deref(), &demo)?;
     progress.stage("connecting the VLM");
-    let client = pipeline::vlm::build_client(&setup)?;
+    let client = pipeline::vlm::build_client(&setup, &demo)?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()

@@ -458,7 +458,7 @@ fn pddl_problem(scenario: &Scenario, side: Side) -> anyhow::Result<String> {
     // The domain's schemas are split by end effector on this atom.
     init.insert(nesy_core::Atom::new(scene.embodiment.state_predicate(), &[]));
     let goal = Formula::And(scene.symbolic_goal().into_iter().map(Formula::atom).collect());
-    let world = nesy_vlm::oracle::WorldDomain::builtin()?;
+    let world = nesy_sim::domain::WorldDomain::builtin()?;
     let names = sim.names();
     let name = format!(
         "{}-{}",

@@ -44,7 +44,7 @@ fn record_realstyle_fixture() {
         },
         record: Some(cassette),
     };
-    let client = pipeline::vlm::build_client(&setup).unwrap();
+    let client = pipeline::vlm::build_client(&setup, &demo).unwrap();
     let runtime = tokio::runtime::Runtime::new().unwrap();
     let run = runtime
         .block_on(pipeline::run(

@@ -12,7 +12,7 @@
 use nesy_core::formula::{Effect, Formula};
 use nesy_core::operator::Operator;
 
-use super::{Kind, kind_of};
+use crate::domain::{SchemaKind as Kind, kind_of, schemas};
 use crate::scene::parts;
 
 /// A ground literal: predicate and arguments.
@@ -131,7 +131,7 @@ pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(&'
             None
         };
         if let Some(name) = schema {
-            return super::SCHEMAS
+            return schemas()
                 .iter()
                 .find(|s| s.name == name)
                 .map(|s| (s.name, Vec::new()));

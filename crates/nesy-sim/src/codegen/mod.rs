@@ -23,219 +23,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::api::Embodiment;
 use crate::api::MAX_FINGER_DEPTH;
+use crate::domain::{Motion, Schema, SchemaKind as Kind, kind_of, schema, schemas};
 use crate::scene::{TABLE_TOP, parts};
 use crate::world::FLOOR_AABB;
-
-/// What an action does, independent of the end effector.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Motion {
-    /// `move_gripper_to(item)`: around it (finger) or onto it (vacuum).
-    MoveToObject,
-    /// `close_gripper` / `activate_vacuum`.
-    Take,
-    /// `move_to_position` onto a free spot of a surface (table or board).
-    CarryOnto,
-    /// `move_to_position` into an open-topped box.
-    CarryInto,
-    /// `move_to_position` over the hinge box.
-    CarryOverHinge,
-    /// `move_to_position` over the bottom drawer.
-    CarryOverDrawer,
-    /// `open_gripper` / `deactivate_vacuum`.
-    Release,
-    /// `move_parallel` across the board into a box.
-    Push,
-    /// `move_parallel("up")`.
-    Retreat,
-    /// `move_gripper_to(handle)`.
-    MoveToHandle,
-    /// `grasp_handle` / `attach_vacuum_handle` (moving to the handle first if needed).
-    GraspHandle,
-    /// `move_to_position` swinging the lid open.
-    OpenLid,
-    /// `move_to_position` swinging the lid closed.
-    CloseLid,
-    /// `release_handle` / `detach_vacuum_handle`.
-    ReleaseHandle,
-    /// `move_parallel` pulling a drawer open.
-    OpenDrawer,
-    /// `move_parallel` pushing a drawer closed.
-    CloseDrawer,
-}
-
-/// Argument kinds of a schema (the domain's types).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Kind {
-    Item,
-    Surface,
-    Box,
-}
-
-/// One schema of the true domain: name, what it does, its parameters, and the part it
-/// works on (handles, drawers).
-struct Schema {
-    name: &'static str,
-    motion: Motion,
-    params: &'static [Kind],
-    part: Option<&'static str>,
-}
-
-const fn s(
-    name: &'static str,
-    motion: Motion,
-    params: &'static [Kind],
-    part: Option<&'static str>,
-) -> Schema {
-    Schema {
-        name,
-        motion,
-        params,
-        part,
-    }
-}
-
-use Kind::{Box as B, Item as I, Surface as S};
 use Motion::*;
-
-/// Every schema of `nesy-world.pddl` (finger, then vacuum); `tests/integration/codegen_domain.rs`
-/// checks the table against the file.
-const SCHEMAS: &[Schema] = &[
-    s("move-to-surround", MoveToObject, &[I], None),
-    s("grasp", Take, &[I], None),
-    s("carry-onto", CarryOnto, &[I, S], None),
-    s("carry-into", CarryInto, &[I, B], None),
-    s("carry-over-hinge-body", CarryOverHinge, &[I], None),
-    s("carry-over-bottom-drawer", CarryOverDrawer, &[I], None),
-    s("put-down", Release, &[I, S], None),
-    s("release-into", Release, &[I, B], None),
-    s("drop-into-hinge-body", Release, &[I], None),
-    s("drop-into-bottom-drawer", Release, &[I], None),
-    s("sweep-into", Push, &[I, B], None),
-    s("retreat", Retreat, &[], None),
-    s(
-        "move-to-hinge-handle",
-        MoveToHandle,
-        &[],
-        Some(parts::HINGE_HANDLE),
-    ),
-    s("grasp-hinge-handle", GraspHandle, &[], Some(parts::HINGE_HANDLE)),
-    s("open-hinge-lid", OpenLid, &[], None),
-    s("close-hinge-lid", CloseLid, &[], None),
-    s("release-hinge-handle", ReleaseHandle, &[], None),
-    s(
-        "move-to-bottom-drawer-handle",
-        MoveToHandle,
-        &[],
-        Some(parts::BOTTOM_DRAWER_HANDLE),
-    ),
-    s(
-        "grasp-bottom-drawer-handle",
-        GraspHandle,
-        &[],
-        Some(parts::BOTTOM_DRAWER_HANDLE),
-    ),
-    s("open-bottom-drawer", OpenDrawer, &[], Some(parts::BOTTOM_DRAWER)),
-    s(
-        "close-bottom-drawer",
-        CloseDrawer,
-        &[],
-        Some(parts::BOTTOM_DRAWER),
-    ),
-    s("release-bottom-drawer-handle", ReleaseHandle, &[], None),
-    s(
-        "move-to-top-drawer-handle",
-        MoveToHandle,
-        &[],
-        Some(parts::TOP_DRAWER_HANDLE),
-    ),
-    s(
-        "grasp-top-drawer-handle",
-        GraspHandle,
-        &[],
-        Some(parts::TOP_DRAWER_HANDLE),
-    ),
-    s("open-top-drawer", OpenDrawer, &[], Some(parts::TOP_DRAWER)),
-    s("close-top-drawer", CloseDrawer, &[], Some(parts::TOP_DRAWER)),
-    s("release-top-drawer-handle", ReleaseHandle, &[], None),
-    s("move-to-align", MoveToObject, &[I], None),
-    s("attach", Take, &[I], None),
-    s("suction-carry-onto", CarryOnto, &[I, S], None),
-    s("suction-carry-into", CarryInto, &[I, B], None),
-    s("suction-carry-over-hinge-body", CarryOverHinge, &[I], None),
-    s("suction-carry-over-bottom-drawer", CarryOverDrawer, &[I], None),
-    s("suction-put-down", Release, &[I, S], None),
-    s("suction-release-into", Release, &[I, B], None),
-    s("suction-drop-into-hinge-body", Release, &[I], None),
-    s("suction-drop-into-bottom-drawer", Release, &[I], None),
-    s("slide-into", Push, &[I, B], None),
-    s("suction-retreat", Retreat, &[], None),
-    s(
-        "suction-move-to-hinge-handle",
-        MoveToHandle,
-        &[],
-        Some(parts::HINGE_HANDLE),
-    ),
-    s("attach-hinge-handle", GraspHandle, &[], Some(parts::HINGE_HANDLE)),
-    s("suction-open-hinge-lid", OpenLid, &[], None),
-    s("suction-close-hinge-lid", CloseLid, &[], None),
-    s("detach-hinge-handle", ReleaseHandle, &[], None),
-    s(
-        "suction-move-to-bottom-drawer-handle",
-        MoveToHandle,
-        &[],
-        Some(parts::BOTTOM_DRAWER_HANDLE),
-    ),
-    s(
-        "attach-bottom-drawer-handle",
-        GraspHandle,
-        &[],
-        Some(parts::BOTTOM_DRAWER_HANDLE),
-    ),
-    s(
-        "suction-open-bottom-drawer",
-        OpenDrawer,
-        &[],
-        Some(parts::BOTTOM_DRAWER),
-    ),
-    s(
-        "suction-close-bottom-drawer",
-        CloseDrawer,
-        &[],
-        Some(parts::BOTTOM_DRAWER),
-    ),
-    s("detach-bottom-drawer-handle", ReleaseHandle, &[], None),
-    s(
-        "suction-move-to-top-drawer-handle",
-        MoveToHandle,
-        &[],
-        Some(parts::TOP_DRAWER_HANDLE),
-    ),
-    s(
-        "attach-top-drawer-handle",
-        GraspHandle,
-        &[],
-        Some(parts::TOP_DRAWER_HANDLE),
-    ),
-    s(
-        "suction-open-top-drawer",
-        OpenDrawer,
-        &[],
-        Some(parts::TOP_DRAWER),
-    ),
-    s(
-        "suction-close-top-drawer",
-        CloseDrawer,
-        &[],
-        Some(parts::TOP_DRAWER),
-    ),
-    s("detach-top-drawer-handle", ReleaseHandle, &[], None),
-];
-
-/// The schema names the compiler knows, in the domain file's order.
-pub fn schema_names() -> impl Iterator<Item = &'static str> {
-    SCHEMAS.iter().map(|s| s.name)
-}
 
 // Where objects go and how the lid swings: the scripted experts' constants, shared so the
 // compiled policies place objects exactly where the experts do.
@@ -348,18 +139,6 @@ fn camel(text: &str) -> String {
         .collect()
 }
 
-/// The schema argument kind an object can fill, from its name: the world's fixed names are
-/// surfaces, boxes or parts no schema takes as an argument; every other name is a loose item.
-fn kind_of(object: &str) -> Option<Kind> {
-    match object {
-        parts::FLOOR | parts::BOARD => Some(Kind::Surface),
-        parts::TOY_BOX | parts::LEFT_CHESS_BOX | parts::RIGHT_CHESS_BOX => Some(Kind::Box),
-        parts::GRIPPER | parts::VACUUM_GRIPPER => None,
-        o if parts::HINGE_BOX_PARTS.contains(&o) || parts::DRAWER_CABINET_PARTS.contains(&o) => None,
-        _ => Some(Kind::Item),
-    }
-}
-
 fn match_args(rest: &str, params: &[Kind], objects: &[String]) -> Option<Vec<String>> {
     let Some((first, more)) = params.split_first() else {
         return rest.is_empty().then(Vec::new);
@@ -382,7 +161,7 @@ fn match_args(rest: &str, params: &[Kind], objects: &[String]) -> Option<Vec<Str
 /// arguments among `objects`.
 pub fn resolve_action(name: &str, objects: &[String]) -> Option<ResolvedAction> {
     let key = camel(name);
-    let mut schemas: Vec<&Schema> = SCHEMAS.iter().collect();
+    let mut schemas: Vec<&Schema> = schemas().iter().collect();
     schemas.sort_by_key(|s| std::cmp::Reverse(camel(s.name).len()));
     schemas.into_iter().find_map(|schema| {
         let rest = key.strip_prefix(camel(schema.name).as_str())?;
@@ -407,13 +186,6 @@ pub fn resolve_by_effects(op: &Operator, objects: &[String]) -> Option<ResolvedA
         motion: schema.motion,
         args,
     })
-}
-
-fn schema(name: &str) -> &'static Schema {
-    SCHEMAS
-        .iter()
-        .find(|s| s.name == name)
-        .expect("resolved actions name table schemas")
 }
 
 /// Compiles a verified procedure into a policy program for `embodiment`.

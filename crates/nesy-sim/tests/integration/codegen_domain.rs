@@ -3,7 +3,8 @@
 
 use nesy_core::operator::Operator;
 use nesy_sim::Embodiment;
-use nesy_sim::codegen::{compile_policy, resolve_action, schema_names};
+use nesy_sim::codegen::{compile_policy, resolve_action};
+use nesy_sim::domain::schema_names;
 
 const DOMAIN: &str = include_str!("../../../../assets/pddl/nesy-world.pddl");
 

@@ -2,8 +2,6 @@
 //! helpful misses, blob de-duplication, secret hygiene, resuming, strict mode, and the
 //! inspect/prune/verify tools.
 
-use crate::common;
-
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -16,7 +14,7 @@ use serde_json::json;
 use wiremock::matchers::method;
 use wiremock::{Mock, MockServer, ResponseTemplate};
 
-use common::{completion, config, png};
+use nesy_testkit::{completion, mock_config as config, png};
 
 /// A body whose exact bytes (odd spacing, key order, trailing newline) must survive.
 const ODD_BODY: &str = "{ \"id\":\"c-1\",\"model\":\"gpt-5\",  \"choices\":[{\"message\":{\"content\":\"(On a b)\"},\"finish_reason\":\"stop\"}],\"usage\":{\"prompt_tokens\":900,\"completion_tokens\":40}}\n";

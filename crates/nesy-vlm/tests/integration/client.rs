@@ -2,8 +2,6 @@
 //! shape per backend profile, image encoding, retries, timeouts, bad bodies, truncation,
 //! the concurrency cap and secret hygiene.
 
-use crate::common;
-
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
 use std::time::Duration;
@@ -17,7 +15,7 @@ use serde_json::{Value, json};
 use wiremock::matchers::{header, method, path, query_param};
 use wiremock::{Mock, MockServer, ResponseTemplate};
 
-use common::{InFlightCounter, completion, config, png};
+use nesy_testkit::{InFlightCounter, completion, mock_config as config, png};
 
 fn simple_request() -> ChatRequest {
     ChatRequest::new()

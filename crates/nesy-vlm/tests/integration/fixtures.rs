@@ -1,15 +1,13 @@
 //! Committed fixture cassettes: one replays offline, and no file anywhere under `fixtures/`
 //! contains anything that looks like a credential.
 
-use crate::common;
-
 use std::path::{Path, PathBuf};
 
 use nesy_vlm::cassette::tools;
 use nesy_vlm::{BackendKind, CassetteMode, CassetteSettings, ChatRequest, Image, Message, Part, VlmClient};
 
 fn fixtures_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
+    nesy_testkit::workspace_root().join("fixtures")
 }
 
 fn smoke_cassette() -> PathBuf {
@@ -23,14 +21,14 @@ fn smoke_request() -> ChatRequest {
         ))
         .message(Message::user(vec![
             Part::text("Top view, then front view."),
-            Image::png(common::png(24, 11)).unwrap().into(),
-            Image::png(common::png(24, 12)).unwrap().into(),
+            Image::png(nesy_testkit::png(24, 11)).unwrap().into(),
+            Image::png(nesy_testkit::png(24, 12)).unwrap().into(),
         ]))
         .purpose("smoke")
 }
 
 fn smoke_config(base_url: &str, mode: CassetteMode) -> nesy_vlm::VlmConfig {
-    let mut cfg = common::config(BackendKind::OpenAi, "gpt-5-mini", base_url);
+    let mut cfg = nesy_testkit::mock_config(BackendKind::OpenAi, "gpt-5-mini", base_url);
     cfg.cassette = Some(CassetteSettings {
         path: smoke_cassette(),
         mode,
@@ -56,7 +54,7 @@ async fn the_smoke_fixture_replays_offline() {
 async fn regenerate_smoke_fixture() {
     use wiremock::{Mock, MockServer, ResponseTemplate, matchers::method};
     let server = MockServer::start().await;
-    let mut body = common::completion("(OnTopOf red_block table)\n(Open drawer)");
+    let mut body = nesy_testkit::completion("(OnTopOf red_block table)\n(Open drawer)");
     body["model"] = "gpt-5-mini-2025-08-07".into();
     body["usage"]["completion_tokens_details"]["reasoning_tokens"] = 64.into();
     Mock::given(method("POST"))

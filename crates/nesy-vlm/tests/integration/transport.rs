@@ -2,8 +2,6 @@
 //! responder a later issue adds) plugs in under the client and under a cassette without any
 //! change to either, and receives the task context that never goes on the wire.
 
-use crate::common;
-
 use std::sync::{Arc, Mutex};
 
 use nesy_vlm::{
@@ -26,7 +24,7 @@ impl Transport for AnswerFromTask {
                 retryable: false,
             })?;
             self.seen.lock().unwrap().push(task.kind.clone());
-            let body = common::completion(task.data["answer"].as_str().unwrap_or_default());
+            let body = nesy_testkit::completion(task.data["answer"].as_str().unwrap_or_default());
             Ok(WireResponse::new(
                 200,
                 serde_json::to_vec(&body).unwrap(),
@@ -50,7 +48,7 @@ fn request(answer: &str) -> ChatRequest {
 async fn a_custom_transport_plugs_in_under_the_client_and_a_cassette() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("offline.json");
-    let mut cfg = common::config(BackendKind::OpenAi, "gpt-5", "http://127.0.0.1:9");
+    let mut cfg = nesy_testkit::mock_config(BackendKind::OpenAi, "gpt-5", "http://127.0.0.1:9");
     cfg.cassette = Some(CassetteSettings {
         path: path.clone(),
         mode: CassetteMode::All,

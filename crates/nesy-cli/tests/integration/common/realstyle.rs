@@ -9,7 +9,8 @@
 //! does not match and goes back as feedback), then a correct one; a code block between an
 //! introduction and an explanation.
 
-use nesy_vlm::{BoxFuture, Origin, Transport, TransportError, VlmTask, WireRequest, WireResponse};
+use nesy_reasoner::VlmTask;
+use nesy_vlm::{BoxFuture, Origin, Transport, TransportError, WireRequest, WireResponse};
 use serde_json::json;
 
 /// The model name the cassette records (honest: these are not a model's answers).

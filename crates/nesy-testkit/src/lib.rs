@@ -1,0 +1,133 @@
+//! # nesy-testkit
+//!
+//! What several crates' tests and benchmarks need and would otherwise each copy: the body of
+//! a chat-completion reply, real PNG images, a client configuration pointed at a mock server
+//! with fast retries, a transport wrapper that counts calls in flight, and the workspace
+//! root. It is a dev-dependency only (`publish = false`): no library or binary links it.
+//!
+//! ```
+//! let body = nesy_testkit::completion("(OnTopOf red_cube floor)");
+//! assert_eq!(body["choices"][0]["message"]["content"], "(OnTopOf red_cube floor)");
+//! let image = nesy_testkit::png(16, 1);
+//! assert_eq!(&image[1..4], b"PNG");
+//! assert!(nesy_testkit::workspace_root().join("Cargo.toml").is_file());
+//! ```
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Duration;
+
+use nesy_vlm::{
+    BackendKind, BoxFuture, RetryPolicy, Timeouts, Transport, TransportError, VlmConfig, WireRequest,
+    WireResponse,
+};
+use serde_json::{Value, json};
+
+/// The workspace's root folder (where the top-level `Cargo.toml`, `fixtures/` and `assets/`
+/// are), found from this crate's own manifest so that it holds from any crate's tests.
+pub fn workspace_root() -> PathBuf {
+    let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    here.parent()
+        .and_then(|crates| crates.parent())
+        .map(PathBuf::from)
+        .unwrap_or(here)
+}
+
+/// A chat-completions success body whose one choice says `text` and stopped normally, with
+/// token usage (including reasoning tokens) so that accounting has something to count.
+pub fn completion(text: &str) -> Value {
+    json!({
+        "id": "chatcmpl-test",
+        "object": "chat.completion",
+        "model": "mock-model",
+        "choices": [{"index": 0, "message": {"role": "assistant", "content": text}, "finish_reason": "stop"}],
+        "usage": {"prompt_tokens": 120, "completion_tokens": 30,
+                  "completion_tokens_details": {"reasoning_tokens": 12}}
+    })
+}
+
+/// A configuration for `backend` whose base URL is a mock server, with millisecond retries
+/// and second-scale timeouts, so that tests of failure paths finish quickly.
+pub fn mock_config(backend: BackendKind, model: &str, base_url: &str) -> VlmConfig {
+    let mut config = VlmConfig::new(backend, model);
+    config.base_url = base_url.to_string();
+    config.retry = RetryPolicy {
+        max_attempts: 3,
+        base_delay: Duration::from_millis(5),
+        max_delay: Duration::from_millis(20),
+        max_retry_after: Duration::from_secs(120),
+    };
+    config.timeouts = Timeouts {
+        connect: Some(Duration::from_secs(5)),
+        read: Some(Duration::from_secs(10)),
+        total: Some(Duration::from_secs(10)),
+        pool_idle: Some(Duration::from_secs(60)),
+    };
+    config
+}
+
+/// A real RGB PNG of `size`×`size` pixels: smooth gradients plus deterministic noise, so it
+/// compresses like a rendered keyframe rather than like a flat colour.
+pub fn png(size: u32, seed: u64) -> Vec<u8> {
+    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    let mut data = Vec::with_capacity((size * size * 3) as usize);
+    for y in 0..size {
+        for x in 0..size {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let noise = (state & 0x0F) as u32;
+            data.push(((x * 255 / size) + noise).min(255) as u8);
+            data.push(((y * 255 / size) + noise).min(255) as u8);
+            data.push((((x + y) * 127 / size) + noise).min(255) as u8);
+        }
+    }
+    let mut out = Vec::new();
+    let mut encoder = png::Encoder::new(&mut out, size, size);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().expect("png header");
+    writer.write_image_data(&data).expect("png data");
+    writer.finish().expect("png finish");
+    out
+}
+
+/// Wraps a transport and records the largest number of calls in flight at once, to test the
+/// client's concurrency cap.
+#[derive(Debug)]
+pub struct InFlightCounter {
+    /// The transport that answers.
+    pub inner: Arc<dyn Transport>,
+    /// Calls in flight now.
+    pub now: AtomicUsize,
+    /// The most calls that were in flight at once.
+    pub max: AtomicUsize,
+}
+
+impl InFlightCounter {
+    /// A counter around `inner`, at zero.
+    pub fn new(inner: Arc<dyn Transport>) -> Self {
+        Self {
+            inner,
+            now: AtomicUsize::new(0),
+            max: AtomicUsize::new(0),
+        }
+    }
+}
+
+impl Transport for InFlightCounter {
+    fn send<'a>(&'a self, request: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
+        Box::pin(async move {
+            let now = self.now.fetch_add(1, Ordering::SeqCst) + 1;
+            self.max.fetch_max(now, Ordering::SeqCst);
+            let result = self.inner.send(request).await;
+            self.now.fetch_sub(1, Ordering::SeqCst);
+            result
+        })
+    }
+
+    fn label(&self) -> String {
+        "counter".into()
+    }
+}
