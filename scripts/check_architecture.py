@@ -8,7 +8,9 @@ Each rule is a sentence of ARCHITECTURE.md ("Rules the graph keeps") made checka
 - source rules, read from the crate's `src/` with comments removed (no I/O in nesy-core,
   no runtime built in the libraries);
 - module rules: no two files of the listed crates import each other, directly or in a
-  circle (`scripts/module_cycles.py`).
+  circle (`scripts/module_cycles.py`);
+- API rules: no item of a library crate is public under two paths, its own or another
+  crate's (`scripts/public_paths.py`).
 
 Exit status 1 with one line per broken rule, naming the crate, the rule and what breaks it.
 
@@ -128,9 +130,14 @@ def main():
         if out.returncode != 0:
             for line in out.stdout.splitlines():
                 problems.append(f"{crate}: files import each other in a circle: {line}")
+    for crate in sorted(NESY - {"nesy-cli"}):
+        out = subprocess.run([sys.executable, str(ROOT / "scripts/public_paths.py"), str(ROOT / "crates" / crate)],
+                             capture_output=True, text=True)
+        for line in out.stdout.splitlines():
+            problems.append(f"{crate}: public under two paths: {line}")
     for p in problems:
         print(p)
-    checked = len(DEPENDENCY_RULES) + len(SOURCE_RULES) + len(ACYCLIC) + 2
+    checked = len(DEPENDENCY_RULES) + len(SOURCE_RULES) + len(ACYCLIC) + len(NESY - {"nesy-cli"}) + 2
     print(f"architecture: {checked} rules checked, {len(problems)} broken")
     return 1 if problems else 0
 

@@ -1,7 +1,7 @@
 #![no_main]
 //! The cassette reader never panics.
 use libfuzzer_sys::fuzz_target;
-use nesy_vlm::cassette::CassetteFile;
+use nesy_vlm::CassetteFile;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(text) = std::str::from_utf8(data) {

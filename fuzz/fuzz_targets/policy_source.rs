@@ -2,7 +2,7 @@
 //! Decoding a policy file's bytes never panics; what decodes as UTF-8 without a coding line
 //! comes back unchanged.
 use libfuzzer_sys::fuzz_target;
-use nesy_policy::source::decode_policy_source;
+use nesy_policy::decode_policy_source;
 
 fuzz_target!(|data: &[u8]| {
     let decoded = decode_policy_source(data);

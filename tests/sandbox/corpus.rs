@@ -10,9 +10,9 @@ use std::net::TcpListener;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use nesy_policy::worker::run_policy_without_static_checks;
+use nesy_core::Embodiment;
+use nesy_policy::run_policy_without_static_checks;
 use nesy_policy::{EpisodeSpec, ExecutionResult, Limits, Outcome, TimeLimit, WorkerCommand, run_policy};
-use nesy_sim::api::Embodiment;
 
 fn corpus_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/sandbox")
@@ -261,7 +261,7 @@ fn worker_overhead_figures() {
     nesy_policy::initialize().unwrap();
     let mut local_times = Vec::new();
     for _ in 0..RUNS {
-        let episode = Box::new(nesy_policy::testing::RecordingRobot::new(Embodiment::Finger));
+        let episode = Box::new(nesy_policy::RecordingRobot::new(Embodiment::Finger));
         let result = nesy_policy::run_in_process("pass", episode, &limits, None).unwrap();
         local_times.push(result.wall_time_s);
     }

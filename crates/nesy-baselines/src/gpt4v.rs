@@ -8,8 +8,8 @@
 //! images for a high-complexity demonstration. A client configured with the endpoint's
 //! image limit refuses it before sending ([`nesy_vlm::VlmError::TooManyImages`]).
 
-use nesy_core::predicates::Tier;
-use nesy_core::state::State;
+use nesy_core::State;
+use nesy_core::Tier;
 use nesy_vlm::VlmClient;
 use serde::Serialize;
 

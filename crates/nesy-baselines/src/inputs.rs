@@ -1,7 +1,7 @@
 //! What every baseline sees of one episode.
 
-use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::state::State;
+use nesy_core::State;
+use nesy_core::{Tier, Vocabulary};
 use nesy_reasoner::Views;
 use nesy_vlm::Part;
 use serde::Serialize;

@@ -31,6 +31,15 @@
 //! [`BaselineError::Unreadable`] with the reply kept, which is the authors' behaviour (their
 //! parsers raise and the episode fails); in [`Fidelity::Repaired`] it is re-asked with the
 //! reason first, up to [`REPAIRED_ATTEMPTS`] replies.
+//!
+//! The readers are total: whatever a model writes, they return what they can find.
+//!
+//! ```
+//! use nesy_baselines::parse::ordered_list;
+//!
+//! let reply = "Here is the plan:\n1. Open the bottom drawer.\n2. Put the red cylinder in it.\nDone.";
+//! assert_eq!(ordered_list(reply), ["Open the bottom drawer.", "Put the red cylinder in it."]);
+//! ```
 
 pub mod critic;
 pub mod demo2code;

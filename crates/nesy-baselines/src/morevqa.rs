@@ -14,7 +14,7 @@
 //! resends the same prompt). [`Fidelity::Repaired`] reads the object out of prose or a fence
 //! and shows the reason.
 
-use nesy_core::predicates::Tier;
+use nesy_core::Tier;
 use nesy_vlm::{Part, VlmClient};
 use serde::Serialize;
 

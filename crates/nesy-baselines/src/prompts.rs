@@ -274,6 +274,6 @@ pub(crate) fn numbered<'a, I: IntoIterator<Item = &'a String>>(items: I) -> Stri
 }
 
 /// A state as `- atom` lines, sorted.
-pub(crate) fn state_lines(state: &nesy_core::state::State) -> String {
+pub(crate) fn state_lines(state: &nesy_core::State) -> String {
     bullets(state.sorted_by_text().into_iter().map(|a| a.to_string()))
 }

@@ -88,7 +88,7 @@ impl Stage<'_> {
     /// Sends the stage's request (reasoning effort `low`, as the authors set for every
     /// stage but code generation) and reads the reply with `read`, which says what is
     /// missing when the answer is not there.
-    pub async fn ask<T>(
+    pub(crate) async fn ask<T>(
         self,
         read: impl Fn(&str) -> Result<T, String>,
     ) -> Result<(T, StageRecord), BaselineError> {

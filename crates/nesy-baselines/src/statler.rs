@@ -15,7 +15,7 @@
 
 use std::collections::BTreeSet;
 
-use nesy_core::predicates::Tier;
+use nesy_core::Tier;
 use nesy_vlm::{Part, VlmClient};
 use serde::Serialize;
 

@@ -9,8 +9,8 @@ use nesy_baselines::{
     BaselineError, BaselineInputs, Fidelity, Keyframe, SixViews, critic, demo2code, gpt4v, llmdm, morevqa,
     statler,
 };
-use nesy_core::predicates::Vocabulary;
-use nesy_core::state::State;
+use nesy_core::State;
+use nesy_core::Vocabulary;
 use nesy_reasoner::Views;
 use nesy_vlm::{
     BackendKind, BoxFuture, Image, Origin, Transport, TransportError, VlmClient, VlmConfig, VlmError,

@@ -170,7 +170,7 @@ impl DemoCache {
             keyframes: recording.demo.keyframes.len(),
             sim_seconds: recording.sim_seconds,
             wall_s: started.elapsed().as_secs_f64(),
-            recorded_at: nesy_vlm::timefmt::now_rfc3339(),
+            recorded_at: nesy_vlm::now_rfc3339(),
         };
         // The demo and the target first, the record (which makes them current) last: a
         // reader that finds a stale record records again, and a current record always has

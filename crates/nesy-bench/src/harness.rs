@@ -21,15 +21,16 @@ use std::time::Instant;
 
 use nesy_core::benchmark::Factor;
 use nesy_core::format_procedure;
+use nesy_pipeline::states::StateSource;
+use nesy_pipeline::synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest};
 use nesy_pipeline::{
-    AdaptOptions, CodegenMode, DemoInput, DemoKeyframes, SandboxChecks, StateSource, SynthError,
-    SynthesisRequest, TargetInput, derive_setting, execute, output, synth, vlm,
+    AdaptOptions, DemoInput, DemoKeyframes, TargetInput, derive_setting, execute, output, synth, vlm,
 };
 use nesy_policy::{Limits, WorkerCommand};
 use nesy_reasoner::VlmReasoner;
 use nesy_reasoner::codegen::CodeGenerationRequest;
 use nesy_sim::tasks::scenario::{self, ConfigFile, Scenario, Side};
-use nesy_vlm::cassette::CassetteFile;
+use nesy_vlm::CassetteFile;
 use nesy_vlm::{
     CassetteMode, CassetteOptions, CassetteTransport, ConfigOverrides, ProcessEnv, Transport, VlmClient,
     VlmConfig,
@@ -268,7 +269,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, BenchError> {
     }
     let mut manifest = Manifest {
         schema_version: MANIFEST_VERSION,
-        created_at: nesy_vlm::timefmt::now_rfc3339(),
+        created_at: nesy_vlm::now_rfc3339(),
         provenance,
         suite_hash: suite_hash(&files),
         responder,
@@ -583,7 +584,7 @@ fn base_record(
             .join(unit.key.folder(&unit.variant))
             .to_string_lossy()
             .into_owned(),
-        finished_at: nesy_vlm::timefmt::now_rfc3339(),
+        finished_at: nesy_vlm::now_rfc3339(),
     }
 }
 
@@ -1117,7 +1118,7 @@ pub fn missing_units(manifest: &Manifest, records: &HashMap<String, UnitRecord>)
 
 /// A short id for a run directory from the clock: `YYYYMMDD-HHMMSS`.
 pub fn default_run_id() -> String {
-    nesy_vlm::timefmt::now_rfc3339()
+    nesy_vlm::now_rfc3339()
         .replace(['-', ':'], "")
         .replace('T', "-")
         .trim_end_matches('Z')

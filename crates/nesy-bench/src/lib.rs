@@ -11,7 +11,7 @@
 //!   running it again resumes.
 //! - [`demos`]: each scenario's demonstration recorded once, keyed by the scenario and the
 //!   simulator's fingerprint.
-//! - [`shard`], [`merge`]: job arrays and their merge; [`slurm`] writes the `sbatch` file.
+//! - [`Shard`], [`merge`]: job arrays and their merge; [`slurm`] writes the `sbatch` file.
 //! - [`plan`]: model calls and images per method and cell, before any call.
 //! - [`report`]: `report.md`, `tables/*.csv` and PNG plots.
 //! - [`study`]: the ablation and robustness studies, each a set of variants under one
@@ -19,9 +19,20 @@
 //!
 //! Offline, no number is a method's performance: the reference responder bounds NeSyCR
 //! from above, the controls measure the benchmark, and every report says which it is.
+//!
+//! A method with its settings is a [`Variant`], written as on the command line:
+//!
+//! ```
+//! use nesy_bench::Variant;
+//!
+//! let variants = Variant::parse_list("nesycr,nesycr+verification=off,replan").unwrap();
+//! assert_eq!(variants[1].method, "nesycr");
+//! assert_eq!(variants[1].option("verification"), Some("off"));
+//! assert!(Variant::parse("nesycr+verification").is_err());
+//! ```
 
 pub mod demos;
-pub mod error;
+mod error;
 pub mod harness;
 pub mod manifest;
 pub mod merge;
@@ -29,17 +40,16 @@ pub mod meter;
 pub mod methods;
 pub mod plan;
 pub mod pool;
-pub mod record;
+mod record;
 pub mod report;
-pub mod shard;
+mod shard;
 pub mod slurm;
 pub mod store;
 pub mod study;
-pub mod unit;
-pub mod variant;
+mod unit;
+mod variant;
 
 pub use error::BenchError;
-pub use harness::{BenchProgress, Quiet, ResponderSetup, RunConfig, RunSummary, StopSignal};
 pub use record::{UnitRecord, UnitStatus};
 pub use shard::Shard;
 pub use unit::Selection;

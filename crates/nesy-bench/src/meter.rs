@@ -5,9 +5,9 @@
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
+use nesy_vlm::TransportError;
 use nesy_vlm::VlmError;
-use nesy_vlm::error::TransportError;
-use nesy_vlm::transport::{BoxFuture, Transport, WireRequest, WireResponse};
+use nesy_vlm::{BoxFuture, Transport, WireRequest, WireResponse};
 use tokio::sync::Semaphore;
 
 /// What a unit's calls came to.

@@ -58,8 +58,8 @@ pub fn unit_load(unit: &Unit, keyframes: u64, budget: u64) -> Load {
             };
             let tries = s.adapt.induction_tries as u64;
             let budget = s.budget.map_or(budget, |b| b as u64);
-            let codegen = u64::from(s.codegen == nesy_pipeline::CodegenMode::Vlm);
-            let (t_calls, t_images) = if s.states == nesy_pipeline::StatesMode::Vlm {
+            let codegen = u64::from(s.codegen == nesy_pipeline::synth::CodegenMode::Vlm);
+            let (t_calls, t_images) = if s.states == nesy_pipeline::states::StatesMode::Vlm {
                 (keyframes + 1, (keyframes + 1) * IMAGES_PER_TRANSLATION)
             } else {
                 (0, 0)

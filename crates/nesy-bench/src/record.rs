@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::unit::UnitKey;
 
 /// State translation against ground truth, when the states came from the model.
-pub use nesy_pipeline::states::Agreement;
+pub(crate) use nesy_pipeline::states::Agreement;
 
 /// How a unit ended. Every unit ends in exactly one status; none is dropped from a table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]

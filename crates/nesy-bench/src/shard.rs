@@ -13,7 +13,7 @@ use crate::error::BenchError;
 use crate::unit::Unit;
 
 /// The seed of the assignment permutation (fixed: shards must agree on it).
-pub const SHARD_PERMUTATION_SEED: u64 = 42;
+pub(crate) const SHARD_PERMUTATION_SEED: u64 = 42;
 
 /// One shard of a run, 0-based.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -158,7 +158,7 @@ impl Unit {
 
 /// Every unit of a run: variants × scenarios × repeats, ordered by scenario, then variant,
 /// then repeat (so a worker that takes units in order builds each scenario's scene once).
-pub fn units(variants: &[Variant], scenarios: &[Scenario], repeats: u32, run_seed: u64) -> Vec<Unit> {
+pub(crate) fn units(variants: &[Variant], scenarios: &[Scenario], repeats: u32, run_seed: u64) -> Vec<Unit> {
     let mut out = Vec::new();
     for scenario in scenarios {
         for variant in variants {

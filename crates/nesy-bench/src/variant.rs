@@ -133,7 +133,7 @@ impl fmt::Display for Variant {
 
 /// SHA-256 (hex) of a value's canonical JSON (object keys sorted by serde_json's map, which
 /// is a BTreeMap here): the configuration hash of anything serialisable.
-pub fn config_hash(value: &impl Serialize) -> String {
+pub(crate) fn config_hash(value: &impl Serialize) -> String {
     let canonical = serde_json::to_value(value)
         .map(|v| v.to_string())
         .unwrap_or_default();
@@ -141,7 +141,7 @@ pub fn config_hash(value: &impl Serialize) -> String {
 }
 
 /// Lower-case hex of bytes.
-pub fn hex(bytes: &[u8]) -> String {
+pub(crate) fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 

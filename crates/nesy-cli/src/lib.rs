@@ -27,20 +27,20 @@ macro_rules! out {
     }};
 }
 
-pub mod commands;
+mod commands;
 
 /// Turn a demonstration recorded in one setting into a verified robot program for another.
 #[derive(Debug, Parser)]
 #[command(name = "nesy", version, about, long_about = None)]
-pub struct Cli {
+pub(crate) struct Cli {
     /// What to do.
     #[command(subcommand)]
-    pub command: Command,
+    pub(crate) command: Command,
 }
 
 /// The subcommands. Each lives in its own module under [`commands`].
 #[derive(Debug, Subcommand)]
-pub enum Command {
+pub(crate) enum Command {
     /// Adapt a demonstration to a target scene and synthesize (and run) a verified code policy.
     Adapt(Box<commands::adapt::AdaptArgs>),
     /// Run the benchmark over the 440 scenarios: methods, resumable and sharded runs, reports.
@@ -63,7 +63,7 @@ pub enum Command {
 }
 
 /// Exit code for bad input or usage errors.
-pub const EXIT_BAD_INPUT: u8 = 2;
+pub(crate) const EXIT_BAD_INPUT: u8 = 2;
 
 /// Parses the command line, sets up logging from `RUST_LOG`, and runs the subcommand.
 pub fn main() -> ExitCode {
@@ -78,7 +78,7 @@ pub fn main() -> ExitCode {
 }
 
 /// Runs a parsed command line and maps errors to exit code 2 with their full context.
-pub fn run(cli: Cli) -> ExitCode {
+pub(crate) fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
         Command::Adapt(args) => commands::adapt::run(*args),
         Command::Bench(args) => commands::bench::run(args),
@@ -106,7 +106,7 @@ pub fn run(cli: Cli) -> ExitCode {
 /// before it already ends with (library errors show their source in their own message, so
 /// anyhow's `{:#}` printed it twice: `…: Is a directory (os error 21): Is a directory (os
 /// error 21)`).
-pub fn error_chain(err: &anyhow::Error) -> String {
+pub(crate) fn error_chain(err: &anyhow::Error) -> String {
     let mut text = String::new();
     for cause in err.chain() {
         let part = cause.to_string();
@@ -121,7 +121,7 @@ pub fn error_chain(err: &anyhow::Error) -> String {
 }
 
 /// Exit code when standard output was closed by its reader (128 + SIGPIPE).
-pub const EXIT_BROKEN_PIPE: u8 = 141;
+pub(crate) const EXIT_BROKEN_PIPE: u8 = 141;
 
 /// True if `err` was caused by writing to a closed pipe.
 fn is_broken_pipe(err: &anyhow::Error) -> bool {
@@ -139,7 +139,7 @@ mod tests {
     #[test]
     fn a_cause_already_in_the_message_is_not_repeated() {
         let io = std::io::Error::new(std::io::ErrorKind::IsADirectory, "Is a directory (os error 21)");
-        let scene = nesy_sim::SceneError::Io {
+        let scene = nesy_sim::scene::SceneError::Io {
             path: "x.json".into(),
             source: io,
         };

@@ -3,10 +3,10 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use nesy_core::exec::{CompiledProcedure, implicit_universe, verify_procedure};
-use nesy_core::operator::format_procedure;
+use nesy_core::format_procedure;
 use nesy_core::planner::{PlannerConfig, plan};
 use nesy_core::text::parse_procedure;
+use nesy_core::{CompiledProcedure, implicit_universe, verify_procedure};
 use nesy_core::{Universe, apply_in};
 
 mod workload;

@@ -13,10 +13,10 @@ mod workload;
 use std::hint::black_box;
 use std::time::Instant;
 
-use nesy_core::exec::{CompiledProcedure, implicit_universe};
 use nesy_core::format_procedure;
 use nesy_core::planner::{PlannerConfig, plan};
 use nesy_core::text::parse_procedure;
+use nesy_core::{CompiledProcedure, implicit_universe};
 
 /// Process CPU time in seconds (user + system), with the kernel's tick resolution.
 fn cpu_seconds() -> f64 {

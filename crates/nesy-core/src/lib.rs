@@ -7,36 +7,57 @@
 //!
 //! This crate is pure: no IO, no async runtime, no physics. See `README.md` next to this
 //! crate's `Cargo.toml` for the file formats, the design decisions and measured figures.
+//!
+//! A state in the paper's list format, an operator in its action-block format, and the
+//! executor checking the operator's preconditions before applying its effects:
+//!
+//! ```
+//! use nesy_core::text::{parse_action_block, parse_state_list};
+//!
+//! let state = parse_state_list("- (OnTopOf red_cube floor)\n- (GripperOpen)").unwrap();
+//! let grasp = parse_action_block(
+//!     "GraspRedCube\n- Preconditions:\n\t(GripperOpen)\n- Effects:\n\t(GripperHolding red_cube)\n\t(not (GripperOpen))",
+//! )
+//! .unwrap();
+//! let after = nesy_core::apply(&state, &grasp).unwrap();
+//! assert!(after.to_string().contains("(GripperHolding red_cube)"));
+//! assert!(!after.to_string().contains("(GripperOpen)"));
+//! // Applied again, the precondition no longer holds: the executor says which literal.
+//! assert!(nesy_core::apply(&after, &grasp).is_err());
+//! ```
 
 pub mod adapt;
-pub mod atom;
+mod atom;
 pub mod benchmark;
-pub mod embodiment;
-pub mod exec;
-pub mod formula;
+mod embodiment;
+mod exec;
+mod formula;
 mod indexed;
 pub mod metrics;
-pub mod operator;
-pub mod patch;
+mod operator;
+mod patch;
 pub mod pddl;
 pub mod planner;
-pub mod predicates;
+mod predicates;
 pub mod rng;
-pub mod state;
-pub mod symbol;
+mod state;
+mod symbol;
 pub mod text;
-pub mod types;
+mod types;
 
-pub use atom::Atom;
+pub use atom::{Args, Atom, AtomParseError};
 pub use embodiment::Embodiment;
 pub use exec::{
-    ExecError, Report, UnmetPrecondition, Violation, apply, apply_in, verify_procedure, verify_procedure_in,
+    CompiledProcedure, ExecError, GoalCheck, Report, StepOutcome, StepStatus, UnmetPrecondition, Violation,
+    apply, apply_in, check_goal, format_unmet, implicit_universe, verify_procedure, verify_procedure_in,
 };
-pub use formula::{Effect, Formula, Term, TypedVar};
+pub use formula::{
+    AtomPattern, AtomTruth, Bindings, ConditionalEffect, Effect, Formula, Ground, GroundEffects, GroundError,
+    Term, TypedVar, fmt_typed_vars,
+};
 pub use operator::{CompiledOperator, Operator, format_procedure};
-pub use patch::{Patch, PatchError, apply_patch};
-pub use predicates::{Category, Tier, Vocabulary};
+pub use patch::{ActionKey, AppliedPatch, ClosestCandidate, Patch, PatchError, apply_patch};
+pub use predicates::{Category, PredicateInfo, Tier, Vocabulary, VocabularyError, builtin_predicates};
 pub use state::{State, StateDiff};
 pub use symbol::Symbol;
-pub use text::{ParseError, ParseErrorKind};
-pub use types::{TypeHierarchy, Universe};
+pub use types::{PDDL_ROOT_TYPE, ROOT_TYPE, TypeError, TypeHierarchy, Universe};

@@ -38,10 +38,10 @@ pub struct Operator {
 
 mod typed_vars_serde {
     use super::*;
-    pub fn serialize<S: serde::Serializer>(vars: &[TypedVar], s: S) -> Result<S::Ok, S::Error> {
+    pub(super) fn serialize<S: serde::Serializer>(vars: &[TypedVar], s: S) -> Result<S::Ok, S::Error> {
         s.collect_seq(vars.iter().map(|v| format!("?{} - {}", v.name, v.ty)))
     }
-    pub fn deserialize<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<TypedVar>, D::Error> {
+    pub(super) fn deserialize<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<TypedVar>, D::Error> {
         let items = Vec::<String>::deserialize(d)?;
         items
             .iter()

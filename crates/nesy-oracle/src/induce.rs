@@ -2,19 +2,19 @@
 //! transition selects the true domain's schemas for that call; the binding whose grounded
 //! effects reproduce s_{t+1} (and whose preconditions hold in s_t) is the answer.
 
-use nesy_core::exec::ExecError;
-use nesy_core::formula::{AtomPattern, Effect, Formula};
-use nesy_core::operator::Operator;
-use nesy_core::state::State;
-use nesy_core::symbol::Symbol;
+use nesy_core::ExecError;
+use nesy_core::Operator;
+use nesy_core::State;
+use nesy_core::Symbol;
+use nesy_core::Universe;
 use nesy_core::text::normalize_action_name;
-use nesy_core::types::Universe;
 use nesy_core::{Atom, apply};
+use nesy_core::{AtomPattern, Effect, Formula};
 use serde::{Deserialize, Serialize};
 
 use nesy_core::Embodiment;
 use nesy_reasoner::InductionContext;
-use nesy_sim::ApiCall;
+use nesy_sim::api::ApiCall;
 use nesy_sim::domain::{WorldDomain, semantic};
 
 /// The robot API function a schema of the true domain stands for, on an end effector.
@@ -117,7 +117,7 @@ struct Candidate {
 /// The handle a handle schema works with, from its name (`grasp-hinge-handle` →
 /// `hinge_handle`); the schemas cannot say it in the vocabulary, which has no predicate
 /// for "the tool is at the handle".
-pub fn schema_handle(schema: &str) -> Option<&'static str> {
+pub(crate) fn schema_handle(schema: &str) -> Option<&'static str> {
     ["hinge_handle", "bottom_drawer_handle", "top_drawer_handle"]
         .into_iter()
         .find(|h| schema.contains(&h.replace('_', "-")))
@@ -306,7 +306,7 @@ pub fn induce(
 
 /// The observed changes as effects; an unchanged state is restated by one of its atoms (an
 /// effect list may not be empty, and re-adding a true atom changes nothing).
-pub fn observed_changes(prev: &State, next: &State) -> Vec<Effect> {
+pub(crate) fn observed_changes(prev: &State, next: &State) -> Vec<Effect> {
     let d = prev.diff(next);
     let mut eff: Vec<Effect> = d
         .added
@@ -323,7 +323,7 @@ pub fn observed_changes(prev: &State, next: &State) -> Vec<Effect> {
 }
 
 /// The reply in the Action Prediction format.
-pub fn format_reply(action: &InducedAction, call: Option<&ApiCall>) -> String {
+pub(crate) fn format_reply(action: &InducedAction, call: Option<&ApiCall>) -> String {
     let call_text = call.map_or_else(
         || "no recorded call".to_owned(),
         |c| match call_object(c) {

@@ -17,6 +17,21 @@
 //!   fenced code block.
 //!
 //! [`OracleNoise`] degrades the answers on purpose for the robustness study.
+//!
+//! The responder plugs in where HTTP would, behind nesy-vlm's client; its answers are an
+//! upper bound on a model's, never a model's:
+//!
+//! ```
+//! use std::sync::Arc;
+//! use nesy_oracle::{OracleNoise, OracleTransport};
+//! use nesy_vlm::{BackendKind, VlmClient, VlmConfig};
+//!
+//! let noise: OracleNoise = "op-drop=0.1,bad-patch=0.2".parse().unwrap();
+//! let oracle = Arc::new(OracleTransport::new().unwrap().with_noise(noise, 7));
+//! let client = VlmClient::with_transport(&VlmConfig::new(BackendKind::Vllm, "nesy-oracle"), oracle.clone());
+//! assert_eq!(oracle.stats().inductions, 0);
+//! # drop(client);
+//! ```
 
 mod induce;
 mod noise;
@@ -25,9 +40,9 @@ mod patch;
 use std::fmt;
 use std::sync::Mutex;
 
-use nesy_core::atom::Atom;
+use nesy_core::Atom;
+use nesy_core::Symbol;
 use nesy_core::planner::PlannerConfig;
-use nesy_core::symbol::Symbol;
 use serde::{Deserialize, Serialize};
 
 pub use induce::{InduceError, InducedAction, api_function, induce};
@@ -35,7 +50,7 @@ pub use noise::{NoiseError, NoiseRng, OracleNoise, Relations, StateScope};
 pub use patch::{OraclePatchError, ProposedPatch, Strategy, misplaced, propose, propose_for_guess};
 
 use nesy_reasoner::{CodeGenerationContext, StateTranslationContext, VlmTask};
-use nesy_sim::ApiCall;
+use nesy_sim::api::ApiCall;
 use nesy_sim::codegen::compile_policy;
 use nesy_sim::domain::{DomainError, WorldDomain};
 use nesy_vlm::{BoxFuture, Origin, Transport, TransportError, WireRequest, WireResponse};
@@ -303,8 +318,8 @@ impl Transport for OracleTransport {
 
 #[cfg(test)]
 mod tests {
-    use nesy_core::predicates::Tier;
-    use nesy_core::state::State;
+    use nesy_core::State;
+    use nesy_core::Tier;
 
     use super::*;
 

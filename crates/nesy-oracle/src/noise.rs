@@ -8,11 +8,11 @@
 use std::fmt;
 use std::str::FromStr;
 
-use nesy_core::atom::Atom;
-use nesy_core::formula::{Effect, Formula};
-use nesy_core::operator::Operator;
+use nesy_core::Atom;
+use nesy_core::Operator;
+use nesy_core::Symbol;
 use nesy_core::rng::SplitMix64;
-use nesy_core::symbol::Symbol;
+use nesy_core::{Effect, Formula};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -169,7 +169,7 @@ pub enum NoiseError {
 }
 
 /// Every knob name, as the error message lists them.
-pub const KNOBS: &str = "op-drop, op-flip, state-drop, state-inject, state-corrupt, state-scope=demo|target|both, relations=binary|all, bad-patch, localize-miss";
+pub(crate) const KNOBS: &str = "op-drop, op-flip, state-drop, state-inject, state-corrupt, state-scope=demo|target|both, relations=binary|all, bad-patch, localize-miss";
 
 impl OracleNoise {
     /// No noise.
@@ -351,7 +351,7 @@ impl NoiseRng {
 
 /// Drops and negates literals of an induced operator (`op_drop`, `op_flip`); at least one
 /// effect stays. Returns how many literals were changed.
-pub fn perturb_operator(op: &mut Operator, noise: &OracleNoise, rng: &mut NoiseRng) -> usize {
+pub(crate) fn perturb_operator(op: &mut Operator, noise: &OracleNoise, rng: &mut NoiseRng) -> usize {
     let mut changed = 0;
     let mut pre = Vec::new();
     for f in op.pre.iter().cloned() {
@@ -391,7 +391,7 @@ pub fn perturb_operator(op: &mut Operator, noise: &OracleNoise, rng: &mut NoiseR
 
 /// What [`perturb_state`] did to one scene graph.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct StatePerturbation {
+pub(crate) struct StatePerturbation {
     /// The relation atoms the scene had.
     pub relations: usize,
     /// Relation atoms removed.
@@ -404,7 +404,7 @@ pub struct StatePerturbation {
 
 impl StatePerturbation {
     /// Every change.
-    pub fn changed(&self) -> usize {
+    pub(crate) fn changed(&self) -> usize {
         self.dropped + self.corrupted + self.injected
     }
 }
@@ -417,7 +417,7 @@ const INJECT_TRIES: usize = 32;
 /// would answer, `objects` the scene's objects. Drops first, then corrupts what is left,
 /// then injects, each counted against the relations the true scene had. The scope is the
 /// caller's to check. The result is sorted and free of duplicates.
-pub fn perturb_state(
+pub(crate) fn perturb_state(
     atoms: &[Atom],
     objects: &[Symbol],
     noise: &OracleNoise,
@@ -703,7 +703,7 @@ mod tests {
         let (truth, _) = scene();
         let (out, report) = draw("op-drop=1,op-flip=1,bad-patch=1", 5);
         assert_eq!((out, report.changed()), (truth, 0));
-        let atom = |s: &str| nesy_core::formula::AtomPattern::ground(s.parse().unwrap());
+        let atom = |s: &str| nesy_core::AtomPattern::ground(s.parse().unwrap());
         let mut op = Operator::new(
             "a",
             vec![Formula::Atom(atom("(P x)"))],

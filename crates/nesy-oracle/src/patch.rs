@@ -14,15 +14,15 @@
 //! Goal violations (every step applies, the goal does not hold) get a plan to the unmet
 //! goal literals appended after the last action.
 
+use nesy_core::AppliedPatch;
+use nesy_core::Operator;
+use nesy_core::State;
+use nesy_core::Symbol;
 use nesy_core::adapt::{Problem, ViolationInfo, ViolationKind, resolves};
-use nesy_core::exec::{ExecError, Report, UnmetPrecondition};
-use nesy_core::formula::{AtomPattern, Effect, Formula};
-use nesy_core::operator::Operator;
-use nesy_core::patch::AppliedPatch;
 use nesy_core::planner::PlannerConfig;
-use nesy_core::state::State;
-use nesy_core::symbol::Symbol;
 use nesy_core::{Atom, apply, verify_procedure};
+use nesy_core::{AtomPattern, Effect, Formula};
+use nesy_core::{ExecError, Report, UnmetPrecondition};
 use serde::{Deserialize, Serialize};
 
 use nesy_core::Embodiment;
@@ -93,7 +93,7 @@ fn formula_preds(f: &Formula, out: &mut Vec<Symbol>) {
 }
 
 /// Whether a formula holds in a state (over the state's and the formula's objects).
-pub fn holds(state: &State, f: &Formula) -> bool {
+pub(crate) fn holds(state: &State, f: &Formula) -> bool {
     apply(state, &Operator::new("Check", vec![f.clone()], Vec::new())).is_ok()
 }
 
@@ -468,7 +468,7 @@ fn negated(f: &Formula) -> Formula {
 }
 
 /// The reply in the Refinement Proposal format.
-pub fn format_reply(patch: &ProposedPatch) -> String {
+pub(crate) fn format_reply(patch: &ProposedPatch) -> String {
     let blocks = |ops: &[Operator]| ops.iter().map(|o| o.to_string()).collect::<Vec<_>>().join("\n\n");
     let mut out = String::new();
     out.push_str("* Refinement rationale:\n");
@@ -490,8 +490,8 @@ pub fn format_reply(patch: &ProposedPatch) -> String {
 #[cfg(test)]
 mod tests {
     use nesy_core::adapt::{PatchRequest, TaskContext};
-    use nesy_core::predicates::{Tier, Vocabulary};
     use nesy_core::text::{parse_formula, parse_state_list};
+    use nesy_core::{Tier, Vocabulary};
 
     use super::*;
 

@@ -7,13 +7,15 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use nesy_core::Embodiment;
 use nesy_core::State;
 use nesy_reasoner::{KeyframeImages, Views};
-use nesy_sim::api::Embodiment;
+use nesy_sim::api::ApiCall;
 use nesy_sim::demo::{CameraName, Demo};
+use nesy_sim::perception::observer::observe;
 use nesy_sim::perception::render::{self, View};
 use nesy_sim::scene::{SceneSpec, parts};
-use nesy_sim::{ApiCall, Sim, observe};
+use nesy_sim::world::Sim;
 use nesy_vlm::Image;
 
 use crate::PipelineError;
@@ -86,13 +88,13 @@ impl DemoInput {
 }
 
 /// Latest keyframe time (s) a demo may give: a day, far beyond any demonstration.
-pub const MAX_KEYFRAME_TIME_S: f64 = 86_400.0;
+pub(crate) const MAX_KEYFRAME_TIME_S: f64 = 86_400.0;
 
 /// What the pipeline needs of a demo's contents beyond its format: keyframe times that are
 /// finite, non-negative and in order, and ground-truth states whose atoms use nesy's
 /// predicates at their arity over the demo's objects (the scene's, the floor and the robot's
 /// own parts). Such an atom would otherwise enter the world model as a fact.
-pub fn check_demo(demo: &Demo) -> Result<(), String> {
+pub(crate) fn check_demo(demo: &Demo) -> Result<(), String> {
     let vocabulary = nesy_core::Vocabulary::new();
     let known: std::collections::HashSet<&str> = demo
         .metadata
@@ -147,7 +149,7 @@ pub fn check_demo(demo: &Demo) -> Result<(), String> {
 }
 
 /// Object names without the robot's own.
-pub fn scene_objects(names: &[String]) -> Vec<String> {
+pub(crate) fn scene_objects(names: &[String]) -> Vec<String> {
     names
         .iter()
         .filter(|n| ![parts::GRIPPER, parts::VACUUM_GRIPPER].contains(&n.as_str()))

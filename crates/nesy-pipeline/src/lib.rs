@@ -6,14 +6,15 @@
 //!
 //! The stages, each callable on its own:
 //!
-//! 1. [`inputs`]: the demo (`demo.mcap` or a folder, read by `nesy_sim::demo::read`) and the
+//! 1. [`DemoInput`] and [`TargetInput`]: the demo (`demo.mcap` or a folder, read by `nesy_sim::demo::read`) and the
 //!    target scene, built in nesy-sim, which observes its ground-truth initial state and
 //!    renders its three views.
-//! 2. [`setting::derive_setting`]: embodiments, predicate tier, factor, complexity, budget.
+//! 2. [`derive_setting`]: embodiments, predicate tier, factor, complexity, budget.
 //! 3. [`states`]: symbolic states, observed (ground truth) or translated by the VLM from the
 //!    marked views.
 //! 4. [`adapt_episode`]: world model and counterfactual adaptation (`nesy_core::adapt::run`
-//!    over the [`nesy_reasoner::VlmReasoner`], timed by [`timing::TimedReasoner`]).
+//!    over the [`nesy_reasoner::VlmReasoner`], timed so that model time and symbolic time are
+//!    reported apart).
 //! 5. [`synth`]: code synthesis, by the VLM's code-generation prompt or by the template
 //!    compiler. An unresolved adaptation is never compiled.
 //! 6. [`execute`]: the policy in the sandbox against the target scene; SR, GC, PD from
@@ -23,40 +24,54 @@
 //! [`run`] drives stages 2–6 as one `async` function; the caller owns the runtime. Errors
 //! are typed ([`PipelineError`]): a caller can tell bad input from a transport failure from
 //! an episode's own failure.
+//!
+//! The first two stages on the bundled quick-start demo, whose target scene closes the
+//! drawer the demonstration found open:
+//!
+//! ```
+//! use nesy_pipeline::{AdaptOptions, DemoInput, TargetInput, derive_setting};
+//!
+//! let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/demos/adapt-realstyle");
+//! let demo = DemoInput::load(dir.as_ref()).unwrap();
+//! let target = TargetInput::load(Some(format!("{dir}/target.json").as_ref()), &demo).unwrap();
+//! assert_eq!(demo.demo.keyframes.len(), 9);
+//! let setting = derive_setting(&demo, &target, &AdaptOptions::default());
+//! assert_eq!(setting.source_embodiment, setting.target_embodiment);
+//! ```
 
-pub mod error;
+mod error;
 pub mod execute;
-pub mod inputs;
+mod inputs;
 pub mod output;
-pub mod progress;
-pub mod setting;
+mod progress;
+mod setting;
 pub mod states;
 pub mod synth;
-pub mod timing;
+mod timing;
 pub mod vlm;
 
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use nesy_core::Symbol;
+use nesy_core::Vocabulary;
 use nesy_core::adapt::{self, AdaptConfig, Adaptation, Demonstration, Target, TaskContext};
-use nesy_core::predicates::Vocabulary;
-use nesy_core::symbol::Symbol;
 use nesy_core::{Operator, State};
 use nesy_policy::{Limits, WorkerCommand};
 use nesy_reasoner::VlmReasoner;
 use nesy_vlm::RunUsage;
 use serde::Serialize;
 
+use execute::ExecutionReport;
+use states::{StateSource, StatesMode, SymbolicStates};
+use synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest, SynthesizedPolicy};
+
 pub use error::PipelineError;
-pub use execute::{EpisodeMetrics, ExecutionReport};
 pub use inputs::{DemoInput, DemoKeyframes, TargetInput};
 pub use progress::{LogProgress, NoProgress, Progress};
 pub use setting::{Setting, derive_setting};
-pub use states::{StateSource, StatesMode, SymbolicStates};
-pub use synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest, SynthesizedPolicy};
 pub use timing::TimeBreakdown;
-pub use vlm::{VlmSetup, VlmSource};
 
 /// Everything a run can be asked to do, besides its inputs and the VLM.
 #[derive(Debug, Clone)]

@@ -22,8 +22,10 @@ use serde::Serialize;
 use serde_json::json;
 
 use crate::inputs::TargetInput;
+use crate::states::StateSource;
 use crate::synth::SynthesizedPolicy;
-use crate::{AdaptRun, PipelineError, StateSource};
+use crate::synth::{CodegenMode, SynthError};
+use crate::{AdaptRun, PipelineError};
 
 /// `world_model.json`.
 pub const WORLD_MODEL_FILE: &str = "world_model.json";
@@ -473,8 +475,8 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
     match (&run.policy, &run.codegen_error) {
         (Some(p), _) => {
             let how = match p.mode {
-                crate::CodegenMode::Vlm => "the VLM's code generation",
-                crate::CodegenMode::Template => "the template compiler",
+                CodegenMode::Vlm => "the VLM's code generation",
+                CodegenMode::Template => "the template compiler",
             };
             let _ = writeln!(
                 md,
@@ -485,7 +487,7 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
         }
         (None, Some(e)) => {
             let _ = writeln!(md, "Code synthesis failed: {e}\n");
-            if let crate::SynthError::NoProgram { replies, .. } = e {
+            if let SynthError::NoProgram { replies, .. } = e {
                 write_rejected_programs(&mut md, replies);
             }
         }

@@ -2,9 +2,9 @@
 //! tier the prompts show, whether states carry embodiment atoms, the domain factor and
 //! complexity, and the exploration budget.
 
+use nesy_core::Embodiment;
+use nesy_core::Tier;
 use nesy_core::benchmark::{Complexity, Factor, iteration_budget, parse_scenario_id};
-use nesy_core::predicates::Tier;
-use nesy_sim::api::Embodiment;
 use serde::Serialize;
 
 use crate::AdaptOptions;

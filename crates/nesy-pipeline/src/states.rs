@@ -8,11 +8,11 @@
 
 use std::time::{Duration, Instant};
 
-use nesy_core::predicates::Vocabulary;
+use nesy_core::Embodiment;
+use nesy_core::Vocabulary;
 use nesy_core::{Atom, State};
 use nesy_reasoner::VlmReasoner;
 use nesy_reasoner::translate::{StateTranslationRequest, TranslatedState};
-use nesy_sim::api::Embodiment;
 use serde::{Deserialize, Serialize};
 
 use crate::PipelineError;

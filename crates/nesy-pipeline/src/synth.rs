@@ -6,13 +6,13 @@
 //! - `template`: every verified symbolic action compiled deterministically to API calls by
 //!   nesy-sim's template compiler (beyond the paper).
 
+use nesy_core::Embodiment;
 use nesy_core::Operator;
 use nesy_core::adapt::ReasonerErrorKind;
 use nesy_reasoner::VlmReasoner;
 use nesy_reasoner::codegen::{
     CheckUnavailable, CodeGenerationRequest, CodegenError, Finding, ProgramCheck, RejectedProgram,
 };
-use nesy_sim::api::Embodiment;
 use nesy_sim::codegen::compile_policy;
 use nesy_sim::scene::SceneSpec;
 use serde::Serialize;

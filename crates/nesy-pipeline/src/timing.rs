@@ -43,7 +43,7 @@ pub struct TimeBreakdown {
 
 /// A [`Reasoner`] that measures the time spent inside the wrapped reasoner and reports
 /// each call as progress.
-pub struct TimedReasoner<R> {
+pub(crate) struct TimedReasoner<R> {
     inner: R,
     vlm: Duration,
     reporting: Duration,
@@ -56,7 +56,7 @@ pub struct TimedReasoner<R> {
 
 /// When the first patch was requested, and the time spent outside symbolic work before it.
 #[derive(Debug, Clone, Copy)]
-pub struct FirstPatch {
+pub(crate) struct FirstPatch {
     /// When the request arrived.
     pub at: Instant,
     /// Model time before it.
@@ -67,7 +67,7 @@ pub struct FirstPatch {
 
 impl<R: Reasoner> TimedReasoner<R> {
     /// Wraps `inner`; `transitions` and `budget` only shape the progress messages.
-    pub fn new(inner: R, progress: Arc<dyn Progress>, transitions: usize, budget: usize) -> Self {
+    pub(crate) fn new(inner: R, progress: Arc<dyn Progress>, transitions: usize, budget: usize) -> Self {
         TimedReasoner {
             inner,
             vlm: Duration::ZERO,
@@ -81,28 +81,28 @@ impl<R: Reasoner> TimedReasoner<R> {
     }
 
     /// Time spent inside the wrapped reasoner so far.
-    pub fn vlm_time(&self) -> Duration {
+    pub(crate) fn vlm_time(&self) -> Duration {
         self.vlm
     }
 
     /// Time spent reporting progress (formatting and emitting the messages) so far.
-    pub fn reporting_time(&self) -> Duration {
+    pub(crate) fn reporting_time(&self) -> Duration {
         self.reporting
     }
 
     /// When the first patch was requested (the end of world-model construction and the
     /// first identification), if any was requested.
-    pub fn first_patch(&self) -> Option<FirstPatch> {
+    pub(crate) fn first_patch(&self) -> Option<FirstPatch> {
         self.first_patch
     }
 
     /// Calls made so far.
-    pub fn calls(&self) -> usize {
+    pub(crate) fn calls(&self) -> usize {
         self.calls
     }
 
     /// The wrapped reasoner.
-    pub fn into_inner(self) -> R {
+    pub(crate) fn into_inner(self) -> R {
         self.inner
     }
 }

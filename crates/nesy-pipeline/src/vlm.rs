@@ -13,10 +13,10 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use nesy_vlm::cassette::CassetteFile;
+use nesy_vlm::CassetteFile;
 
 use nesy_oracle::{OracleNoise, OracleTransport};
-use nesy_sim::ApiCall;
+use nesy_sim::api::ApiCall;
 use nesy_vlm::{
     BackendKind, CassetteMode, CassetteOptions, CassetteTransport, ConfigOverrides, ProcessEnv, Transport,
     VlmClient, VlmConfig,
@@ -157,7 +157,7 @@ pub fn build_client(setup: &VlmSetup, demo: &DemoInput) -> Result<VlmClient, Pip
                 .map_err(|e| setup_error(format!("reading the cassette {}: {e}", path.display())))?;
             let config = replay_config(path, &file)?;
             let options = CassetteOptions {
-                usage_report: std::env::var_os(nesy_vlm::config::CASSETTE_USAGE_ENV).map(PathBuf::from),
+                usage_report: std::env::var_os(nesy_vlm::CASSETTE_USAGE_ENV).map(PathBuf::from),
                 ..CassetteOptions::default()
             };
             let transport = CassetteTransport::open(path, CassetteMode::None, None, options)

@@ -6,9 +6,9 @@
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use nesy_policy::testing::RecordingRobot;
+use nesy_core::Embodiment;
+use nesy_policy::RecordingRobot;
 use nesy_policy::{Limits, run_in_process};
-use nesy_sim::api::Embodiment;
 
 const CALLS: usize = 20_000;
 

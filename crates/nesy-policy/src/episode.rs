@@ -3,8 +3,9 @@
 
 use std::path::PathBuf;
 
+use nesy_core::Embodiment;
 use nesy_core::State;
-use nesy_sim::api::{Embodiment, RobotApi};
+use nesy_sim::api::RobotApi;
 use serde::{Deserialize, Serialize};
 
 use crate::result::SubtaskReport;
@@ -39,7 +40,7 @@ pub enum EpisodeSpec {
         /// Render every N simulation steps (0 = never).
         render_every: u32,
     },
-    /// The recording test double of [`crate::testing`]: records calls, moves nothing.
+    /// The recording test double of [`RecordingRobot`](crate::RecordingRobot): records calls, moves nothing.
     /// For sandbox tests, which exercise the interpreter and the worker, not the robot.
     RecordingDouble {
         /// The double's embodiment.

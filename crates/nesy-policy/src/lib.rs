@@ -9,7 +9,7 @@
 //! 3. a deny-by-default audit hook installed before the interpreter starts;
 //! 4. a trace-event budget, a watchdog raising `TimeoutError`, and API-call budgets;
 //! 5. a worker process with rlimits, no-new-privs, a seccomp filter and a parent-enforced
-//!    wall-clock kill ([`worker`]).
+//!    wall-clock kill ([`run_policy`]).
 //!
 //! The entry point for pipelines is [`worker::run_policy`]: source + [`EpisodeSpec`] +
 //! [`Limits`] in, [`ExecutionResult`] out. It runs the policy in a worker process, the
@@ -32,9 +32,9 @@
 //! the recording double, whose trace shows what the policy called.
 //!
 //! ```
-//! use nesy_policy::testing::RecordingRobot;
+//! use nesy_policy::RecordingRobot;
 //! use nesy_policy::{Limits, run_in_process};
-//! use nesy_sim::Embodiment;
+//! use nesy_core::Embodiment;
 //!
 //! let robot = Box::new(RecordingRobot::new(Embodiment::Finger));
 //! let source = "move_gripper_to('red_cube')\nclose_gripper()\n";
@@ -49,15 +49,15 @@
 //! assert!(!result.is_ok());
 //! ```
 
-pub mod episode;
-pub mod limits;
-pub mod python;
-pub mod result;
-pub mod runner;
-pub mod sim_episode;
-pub mod source;
-pub mod testing;
-pub mod worker;
+mod episode;
+mod limits;
+mod python;
+mod result;
+mod runner;
+mod sim_episode;
+mod source;
+mod testing;
+mod worker;
 
 pub use episode::{Episode, EpisodeBuildError, EpisodeEnd, EpisodeFactory, EpisodeSpec};
 pub use limits::Limits;
@@ -66,6 +66,14 @@ pub use result::{
     CapturedText, ExecutionResult, Outcome, PythonError, StaticViolation, SubtaskReport, TimeLimit,
     TracebackFrame, WorkerReport,
 };
-pub use runner::{POLICY_FILE, api_function_names, api_signatures, check_source, run_in_process};
+pub use runner::{
+    POLICY_FILE, api_function_names, api_signatures, check_source, run_in_process,
+    run_in_process_without_static_checks,
+};
 pub use sim_episode::SimEpisodes;
-pub use worker::{RunError, WorkerCommand, run_policy};
+pub use source::{SourceError, decode_policy_source};
+pub use testing::RecordingRobot;
+pub use worker::{
+    RunError, WORKER_SUBCOMMAND, WorkerCommand, install_seccomp_filter, run_policy,
+    run_policy_without_static_checks, worker_main,
+};

@@ -26,7 +26,7 @@ pub struct ExecutionResult {
     /// The observed symbolic state after the settle steps (`None` for robots without a
     /// world, such as the test double, and for episodes that were killed or rejected).
     pub final_state: Option<State>,
-    /// Details of the worker process, for runs through [`crate::worker`].
+    /// Details of the worker process, for runs through [`run_policy`](crate::run_policy).
     pub worker: Option<WorkerReport>,
 }
 

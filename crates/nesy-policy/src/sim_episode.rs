@@ -2,8 +2,9 @@
 //! it settles for the post-run steps of `docs/benchmark.md` §7 and reports the goal checks' subtask results
 //! (for scenes with goals) and the observed symbolic state.
 
+use nesy_sim::perception::observer::observe;
 use nesy_sim::tasks::goal::{GoalMonitor, POST_RUN_SETTLE_STEPS, SubtaskOutcome};
-use nesy_sim::{Sim, observe};
+use nesy_sim::world::Sim;
 
 use crate::episode::{Episode, EpisodeBuildError, EpisodeEnd, EpisodeFactory, EpisodeSpec};
 use crate::result::SubtaskReport;
@@ -61,7 +62,8 @@ impl EpisodeFactory for SimEpisodes {
                         feature: "rendering during a policy run (--render-every)".to_owned(),
                     });
                 }
-                let mut scene = nesy_sim::SceneSpec::from_file(path).map_err(|e| scene_error(path, e))?;
+                let mut scene =
+                    nesy_sim::scene::SceneSpec::from_file(path).map_err(|e| scene_error(path, e))?;
                 if let Some(embodiment) = embodiment {
                     scene.embodiment = *embodiment;
                 }
@@ -79,7 +81,7 @@ impl EpisodeFactory for SimEpisodes {
     }
 }
 
-fn scene_error(path: &std::path::Path, error: nesy_sim::SceneError) -> EpisodeBuildError {
+fn scene_error(path: &std::path::Path, error: nesy_sim::scene::SceneError) -> EpisodeBuildError {
     EpisodeBuildError::Scene {
         path: path.to_owned(),
         message: error.to_string(),

@@ -8,7 +8,7 @@
 //! where the first bad byte is, as line, column and byte offset.
 //!
 //! ```
-//! use nesy_policy::source::{SourceError, decode_policy_source};
+//! use nesy_policy::{SourceError, decode_policy_source};
 //!
 //! let latin = b"# -*- coding: latin-1 -*-\nprint('caf\xe9')\n";
 //! assert_eq!(decode_policy_source(latin).unwrap(), "# -*- coding: latin-1 -*-\nprint('café')\n");

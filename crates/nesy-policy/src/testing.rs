@@ -6,7 +6,8 @@
 //! argument conversion, error mapping and the sandbox; it is not a simulator. Nothing it
 //! returns describes a real scene.
 
-use nesy_sim::api::{ApiCall, ApiError, ApiValue, Direction, Embodiment, RobotApi, TraceEntry};
+use nesy_core::Embodiment;
+use nesy_sim::api::{ApiCall, ApiError, ApiValue, Direction, RobotApi, TraceEntry};
 
 use crate::episode::{Episode, EpisodeEnd};
 

@@ -10,15 +10,15 @@
 //! that needs the demonstration's recorded robot calls is given them when it is built.
 //! [`Embodiment`] is nesy-core's, shared with the simulator.
 
+use nesy_core::Operator;
+use nesy_core::State;
+use nesy_core::Tier;
 use nesy_core::adapt::{InductionRequest, PatchRequest};
-use nesy_core::operator::Operator;
-use nesy_core::predicates::Tier;
-use nesy_core::state::State;
 use serde::{Deserialize, Serialize};
 
 use nesy_vlm::TaskContext;
 
-pub use nesy_core::Embodiment;
+pub(crate) use nesy_core::Embodiment;
 
 /// Operator induction for one demonstrated transition.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]

@@ -4,12 +4,12 @@
 //! something the task does not have is re-asked with the nearest names), is added to the
 //! known atoms.
 
+use nesy_core::Atom;
+use nesy_core::State;
 use nesy_core::Symbol;
 use nesy_core::adapt::{UnknownSymbol, known_objects, unknown_atom_symbols};
-use nesy_core::atom::Atom;
-use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::state::State;
 use nesy_core::text::{ParseError, normalize_reply, parse_state_list};
+use nesy_core::{Tier, Vocabulary};
 use serde::{Deserialize, Serialize};
 
 use crate::context::{StateTranslationContext, VlmTask};

@@ -5,8 +5,11 @@ use std::hint::black_box;
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use nesy_sim::api::{Direction, RobotApi};
+use nesy_sim::perception::observer::observe;
 use nesy_sim::perception::render::{VIEW_SIZE, render_views};
-use nesy_sim::{Direction, RobotApi, SceneSpec, Sim, observe};
+use nesy_sim::scene::SceneSpec;
+use nesy_sim::world::Sim;
 
 fn scene(name: &str) -> SceneSpec {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -14,11 +14,13 @@
 //! the loose objects that moved more than 2 cm during it are listed, so an object knocked by
 //! the arm shows at the call that knocked it.
 
+use nesy_core::Embodiment;
+use nesy_sim::api::TraceEntry;
 use nesy_sim::scene::SubtaskKind;
 use nesy_sim::tasks::TaskConfig;
 use nesy_sim::tasks::goal::GoalMonitor;
+use nesy_sim::world::Sim;
 use nesy_sim::world::SimHook;
-use nesy_sim::{Embodiment, Sim, TraceEntry};
 
 /// Prints every action call with its result and the articulations' joint positions after it.
 struct PrintActions {
@@ -102,7 +104,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let scene = if args.first().map(String::as_str) == Some("--scene") {
         let path = args.get(1).ok_or(USAGE)?;
-        nesy_sim::SceneSpec::from_file(std::path::Path::new(path))?
+        nesy_sim::scene::SceneSpec::from_file(std::path::Path::new(path))?
     } else if args.first().map(String::as_str) == Some("--scenario") {
         // The scene exactly as the sweep builds it (a scene written as JSON and read back can
         // differ in the last bits of a coordinate, and some episodes are sensitive to that).
@@ -123,7 +125,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 }
 
 /// The scene of the first two forms (written to SCENE_OUT.json when given).
-fn generated_scene(args: &[String]) -> Result<nesy_sim::SceneSpec, Box<dyn std::error::Error>> {
+fn generated_scene(args: &[String]) -> Result<nesy_sim::scene::SceneSpec, Box<dyn std::error::Error>> {
     let (config, scene_out) = if args.first().map(String::as_str) == Some("--task") {
         let path = args.get(1).ok_or(USAGE)?;
         let text = std::fs::read_to_string(path)?;
@@ -139,7 +141,7 @@ fn generated_scene(args: &[String]) -> Result<nesy_sim::SceneSpec, Box<dyn std::
     Ok(task.scene)
 }
 
-fn trace(scene: &nesy_sim::SceneSpec) -> Result<(), Box<dyn std::error::Error>> {
+fn trace(scene: &nesy_sim::scene::SceneSpec) -> Result<(), Box<dyn std::error::Error>> {
     let mut sim = Sim::new(scene)?;
     let monitor = GoalMonitor::attach(&mut sim)?;
     let tracked = scene
@@ -153,7 +155,7 @@ fn trace(scene: &nesy_sim::SceneSpec) -> Result<(), Box<dyn std::error::Error>> 
         tracked,
     }));
     let result = nesy_sim::tasks::experts::run(&mut sim, scene);
-    println!("\n{}", nesy_sim::observe(&sim));
+    println!("\n{}", nesy_sim::perception::observer::observe(&sim));
     let outcome = monitor.finish(&mut sim);
     // After the final settle, as the goal checks saw them: the displaced list is decided here.
     let containers = [

@@ -13,7 +13,8 @@
 
 use std::sync::{Arc, Mutex};
 
-use nesy_sim::{ApiCall, ApiValue, RobotApi, Sim, SimHook, TraceEntry};
+use nesy_sim::api::{ApiCall, ApiValue, RobotApi, TraceEntry};
+use nesy_sim::world::{Sim, SimHook};
 
 /// Watches objects every few control steps and prints each step at which one moved.
 struct Watch {
@@ -60,8 +61,8 @@ impl SimHook for Watch {
 }
 
 /// Replays one call; returns what the simulation answered.
-fn replay(sim: &mut Sim, call: &ApiCall) -> Result<ApiValue, nesy_sim::ApiError> {
-    let none = |r: Result<(), nesy_sim::ApiError>| r.map(|()| ApiValue::None);
+fn replay(sim: &mut Sim, call: &ApiCall) -> Result<ApiValue, nesy_sim::api::ApiError> {
+    let none = |r: Result<(), nesy_sim::api::ApiError>| r.map(|()| ApiValue::None);
     match call {
         ApiCall::IsObjVisible { obj_name } => Ok(ApiValue::Bool(sim.is_obj_visible(obj_name))),
         ApiCall::GetObjNames => Ok(ApiValue::Names(sim.get_obj_names())),
@@ -103,7 +104,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if args.len() < 3 {
         return Err("usage: replay_trace SCENE.json EXECUTION.json OBJECT...".into());
     }
-    let scene = nesy_sim::SceneSpec::from_file(std::path::Path::new(&args[0]))?;
+    let scene = nesy_sim::scene::SceneSpec::from_file(std::path::Path::new(&args[0]))?;
     let text = std::fs::read_to_string(&args[1])?;
     let json: serde_json::Value = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", args[1]))?;
     let trace = json

@@ -5,8 +5,11 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use nesy_sim::api::{Direction, RobotApi};
+use nesy_sim::perception::observer::observe;
 use nesy_sim::perception::render::{VIEW_SIZE, render_views};
-use nesy_sim::{Direction, RobotApi, SceneSpec, Sim, observe};
+use nesy_sim::scene::SceneSpec;
+use nesy_sim::world::Sim;
 
 fn cpu_seconds() -> f64 {
     let mut ts = libc::timespec {

@@ -8,7 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
-pub use nesy_core::Embodiment;
+pub(crate) use nesy_core::Embodiment;
 
 /// Largest distance (m) between the tool and a handle's centre at which `grasp_handle`
 /// (or `attach_vacuum_handle`) takes it, and beyond which a grasped handle slips out

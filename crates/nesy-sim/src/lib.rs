@@ -6,9 +6,9 @@
 //!
 //! The modules are layers, lowest first:
 //!
-//! - [`api`]: the robot API contract ([`RobotApi`]) that policies and experts call.
+//! - [`api`]: the robot API contract ([`api::RobotApi`]) that policies and experts call.
 //! - [`scene`]: the `scene.json` format, part names and joints, subtask goals.
-//! - [`world`]: the Rapier world ([`Sim`]) built from a scene; it implements the API.
+//! - [`world`]: the Rapier world ([`world::Sim`]) built from a scene; it implements the API.
 //! - [`robot`]: the Panda models, kinematics, motion generation and the planner.
 //! - [`perception`]: the symbolic observer and the renderer.
 //! - [`tasks`]: the benchmark's tasks, goal checks, scripted experts and scenarios.
@@ -18,9 +18,12 @@
 //! - [`codegen`]: the template compiler from symbolic actions to robot-API code.
 //!
 //! ```
+//! use nesy_core::Embodiment;
+//! use nesy_sim::api::RobotApi;
+//! use nesy_sim::perception::observer::observe;
 //! use nesy_sim::scene::SubtaskKind;
 //! use nesy_sim::tasks::TaskConfig;
-//! use nesy_sim::{Embodiment, RobotApi, Sim, observe};
+//! use nesy_sim::world::Sim;
 //!
 //! let task = TaskConfig::single(SubtaskKind::PickPlace, 3, 0, 0, Embodiment::Finger)
 //!     .generate()
@@ -44,8 +47,3 @@ pub mod world;
 /// The simulator's fingerprint: its version and a hash of its sources and robot models.
 /// Anything recorded with the simulator (demonstrations) is keyed by it.
 pub const FINGERPRINT: &str = env!("NESY_SIM_FINGERPRINT");
-
-pub use api::{ApiCall, ApiError, ApiValue, Direction, Embodiment, RobotApi, TraceEntry};
-pub use perception::observe;
-pub use scene::{SceneError, SceneSpec};
-pub use world::{Sim, SimConfig, SimHook};

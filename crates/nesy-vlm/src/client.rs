@@ -15,7 +15,7 @@ use crate::request::ChatRequest;
 use crate::response::{ChatResponse, parse_completion};
 use crate::retry::{RetryPolicy, status_is_retryable};
 use crate::secret::SecretString;
-use crate::transport::http::Auth;
+use crate::transport::Auth;
 use crate::transport::{HttpTransport, Origin, Transport, WireRequest, WireResponse};
 
 /// An OpenAI-compatible chat client. Cheap to clone; clones share the transport, the

@@ -156,7 +156,7 @@ pub struct ProviderError {
 impl ProviderError {
     /// Reads an error body. Never fails: a body that is not JSON becomes the message.
     /// Anything in it that looks like a credential is redacted
-    /// ([`crate::secret::redact_credentials`]): providers echo a rejected key in their 401s.
+    /// (credential-looking tokens are redacted): providers echo a rejected key in their 401s.
     pub fn from_body(body: &[u8]) -> Self {
         let mut error = Self::parse_body(body);
         error.message = crate::secret::redact_credentials(&error.message);

@@ -41,26 +41,32 @@
 //! assert!(config.api_key.is_none()); // a cloud key is never sent to a local server
 //! ```
 //!
-pub mod accounting;
-pub mod cassette;
-pub mod client;
-pub mod config;
-pub mod error;
-pub mod profile;
+mod accounting;
+mod cassette;
+mod client;
+mod config;
+mod error;
+mod profile;
 pub mod reply;
-pub mod request;
-pub mod response;
-pub mod retry;
-pub mod secret;
-pub mod settings;
-pub mod timefmt;
-pub mod transport;
+mod request;
+mod response;
+mod retry;
+mod secret;
+mod settings;
+mod timefmt;
+mod transport;
 
 pub use accounting::{CallRecord, ModelPrice, PriceTable, RunUsage, UsageTotals};
-pub use cassette::{CassetteError, CassetteMode, CassetteOptions, CassetteTransport};
+pub use cassette::tools as cassette_tools;
+pub use cassette::{
+    CassetteError, CassetteFile, CassetteMeta, CassetteMiss, CassetteMode, CassetteOptions,
+    CassetteTransport, Interaction, InteractionRef, JsonDiff, MissReason, NearMatch,
+    SCHEMA_VERSION as CASSETTE_SCHEMA_VERSION, StoredRequest, StoredResponse, UsageReport, blobs_dir,
+};
 pub use client::VlmClient;
 pub use config::{
-    CassetteSettings, ConfigError, ConfigOverrides, EnvSource, ProcessEnv, Timeouts, VlmConfig,
+    CASSETTE_USAGE_ENV, CassetteSettings, ConfigError, ConfigOverrides, DEFAULT_AZURE_API_VERSION, EnvSource,
+    ProcessEnv, Timeouts, VlmConfig,
 };
 pub use error::{ProviderError, TimeoutPhase, TransportError, VlmError};
 pub use profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, TokenCapField};
@@ -69,5 +75,5 @@ pub use response::{ChatResponse, FinishReason, Usage};
 pub use retry::RetryPolicy;
 pub use secret::SecretString;
 pub use settings::{CallSettings, PurposeSettings};
-pub use transport::http::Auth;
-pub use transport::{BoxFuture, HttpTransport, Origin, Transport, WireRequest, WireResponse};
+pub use timefmt::{now_rfc3339, rfc3339};
+pub use transport::{Auth, BoxFuture, HttpTransport, Origin, Transport, WireRequest, WireResponse};

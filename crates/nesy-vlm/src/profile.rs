@@ -176,7 +176,7 @@ pub struct Profile {
 }
 
 /// Whether a model name looks like an OpenAI reasoning model.
-pub fn looks_like_reasoning_model(model: &str) -> bool {
+pub(crate) fn looks_like_reasoning_model(model: &str) -> bool {
     let name = model.rsplit('/').next().unwrap_or(model).to_ascii_lowercase();
     let o_series = ["o1", "o3", "o4"].iter().any(|prefix| {
         name == *prefix

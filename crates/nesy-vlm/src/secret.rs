@@ -26,14 +26,14 @@ impl SecretString {
 
 /// Shortest secret that is replaced by its exact text: a shorter one would blank out common
 /// words.
-pub const MIN_REDACTED_LEN: usize = 8;
+pub(crate) const MIN_REDACTED_LEN: usize = 8;
 
 /// What a redacted credential is replaced with.
-pub const REDACTED: &str = "[REDACTED]";
+pub(crate) const REDACTED: &str = "[REDACTED]";
 
 impl SecretString {
-    /// `text` with every occurrence of this secret replaced by [`REDACTED`] (secrets shorter
-    /// than [`MIN_REDACTED_LEN`] are left, see there).
+    /// `text` with every occurrence of this secret replaced by `[REDACTED]` (secrets shorter
+    /// than eight characters are left: too short to redact without mangling the text).
     pub fn redact_in(&self, text: &str) -> String {
         if self.0.len() >= MIN_REDACTED_LEN && text.contains(&*self.0) {
             text.replace(&*self.0, REDACTED)
@@ -49,14 +49,7 @@ impl SecretString {
 /// assignment (`api_key = "…"`, as a TOML parser quotes the offending line). Used on every
 /// text that comes from a server or a configuration file before it can reach an error
 /// message or a log, whether or not the configured key is known there.
-///
-/// ```
-/// use nesy_vlm::secret::redact_credentials;
-/// let shown = redact_credentials("Incorrect API key provided: sk-proj-abc123def456.");
-/// assert_eq!(shown, "Incorrect API key provided: [REDACTED].");
-/// assert_eq!(redact_credentials("api_key = \"hunter2-xyz\""), "api_key = [REDACTED]");
-/// ```
-pub fn redact_credentials(text: &str) -> String {
+pub(crate) fn redact_credentials(text: &str) -> String {
     let is_token_char = |c: char| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '*' | '.');
     let mut out = String::with_capacity(text.len());
     let mut rest = text;

@@ -4,7 +4,7 @@
 
 use futures::FutureExt as _;
 use futures::future::BoxFuture;
-use nesy_pipeline::CodegenMode;
+use nesy_pipeline::synth::CodegenMode;
 use nesy_vlm::VlmClient;
 
 use super::{

@@ -6,10 +6,12 @@
 
 use futures::FutureExt as _;
 use futures::future::BoxFuture;
+use nesy_core::Vocabulary;
 use nesy_core::adapt::{AdaptConfig, Trace, construct_world_model, identify};
-use nesy_core::predicates::Vocabulary;
 use nesy_core::verify_procedure;
-use nesy_pipeline::{CodegenMode, DemoInput, NoProgress, StatesMode, adaptation_inputs, states, vlm};
+use nesy_pipeline::states::StatesMode;
+use nesy_pipeline::synth::CodegenMode;
+use nesy_pipeline::{DemoInput, NoProgress, adaptation_inputs, states, vlm};
 use nesy_reasoner::VlmReasoner;
 use nesy_vlm::VlmClient;
 

@@ -18,7 +18,9 @@ use std::sync::Arc;
 use futures::future::BoxFuture;
 use nesy_core::Operator;
 use nesy_core::adapt::Adaptation;
-use nesy_pipeline::{CodegenMode, DemoInput, DemoKeyframes, Setting, StateSource, TargetInput};
+use nesy_pipeline::states::StateSource;
+use nesy_pipeline::synth::CodegenMode;
+use nesy_pipeline::{DemoInput, DemoKeyframes, Setting, TargetInput};
 use nesy_vlm::VlmClient;
 use serde::Serialize;
 

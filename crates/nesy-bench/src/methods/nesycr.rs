@@ -6,11 +6,11 @@ use std::sync::Arc;
 
 use futures::FutureExt as _;
 use futures::future::BoxFuture;
+use nesy_core::Vocabulary;
 use nesy_core::adapt::{Ablation, AdaptConfig, Outcome, TransitionCheck};
-use nesy_core::predicates::Vocabulary;
-use nesy_pipeline::{
-    CodegenMode, NoProgress, PipelineError, StatesMode, adapt_episode, adaptation_inputs, states,
-};
+use nesy_pipeline::states::StatesMode;
+use nesy_pipeline::synth::CodegenMode;
+use nesy_pipeline::{NoProgress, PipelineError, adapt_episode, adaptation_inputs, states};
 use nesy_reasoner::VlmReasoner;
 use nesy_vlm::VlmClient;
 
@@ -24,7 +24,7 @@ use crate::variant::Variant;
 
 /// What an unresolved adaptation turns into.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum OnUnresolved {
+pub(crate) enum OnUnresolved {
     /// No specification: the unit ends `unresolved` (the project's NeSyCR never compiles an
     /// unverified plan).
     Fail,

@@ -6,10 +6,10 @@
 
 use futures::FutureExt as _;
 use futures::future::BoxFuture;
-use nesy_core::formula::Formula;
+use nesy_core::Formula;
+use nesy_core::Symbol;
 use nesy_core::planner::{Heuristic, PlannerConfig, Search};
-use nesy_core::symbol::Symbol;
-use nesy_pipeline::CodegenMode;
+use nesy_pipeline::synth::CodegenMode;
 use nesy_sim::domain::{WorldDomain, plan_to_goal};
 use nesy_vlm::VlmClient;
 
@@ -27,7 +27,7 @@ pub struct Replan;
 
 /// The planner's settings for the control: greedy best-first search on h_FF with a 10 s
 /// wall limit (the authors give Fast Downward 10 s).
-pub fn planner_config() -> PlannerConfig {
+pub(super) fn planner_config() -> PlannerConfig {
     PlannerConfig {
         search: Search::Gbfs,
         heuristic: Heuristic::HFf,
@@ -38,7 +38,7 @@ pub fn planner_config() -> PlannerConfig {
 
 /// The target's goal as the planner takes it: every scene goal's atoms, and the end effector
 /// open with nothing held ([`nesy_sim::scene::SceneSpec::symbolic_goal`]).
-pub fn target_goal(inputs: &UnitInputs) -> Formula {
+pub(super) fn target_goal(inputs: &UnitInputs) -> Formula {
     Formula::And(
         inputs
             .target

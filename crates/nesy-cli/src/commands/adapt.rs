@@ -11,16 +11,18 @@ use std::time::Duration;
 use anyhow::Context as _;
 use nesy_core::adapt::AdaptConfig;
 use nesy_pipeline::output::{induction_counts, proposals, violations};
+use nesy_pipeline::states::{StateSource, StatesMode};
+use nesy_pipeline::synth::CodegenMode;
+use nesy_pipeline::vlm::{VlmSetup, VlmSource};
 use nesy_pipeline::{
-    self as pipeline, AdaptOptions, AdaptRun, CodegenMode, DemoInput, LogProgress, NoProgress, Progress,
-    StateSource, StatesMode, TargetInput, VlmSetup, VlmSource,
+    self as pipeline, AdaptOptions, AdaptRun, DemoInput, LogProgress, NoProgress, Progress, TargetInput,
 };
 use nesy_policy::Limits;
 use nesy_vlm::ConfigOverrides;
 
 /// Arguments of `nesy adapt`.
 #[derive(Debug, clap::Args)]
-pub struct AdaptArgs {
+pub(crate) struct AdaptArgs {
     /// The demonstration: `demo.mcap`, a folder holding it, or a folder with `manifest.json`.
     #[arg(long, value_name = "DIR")]
     pub demo: PathBuf,
@@ -74,7 +76,7 @@ pub struct AdaptArgs {
 /// Runs `nesy adapt`: exit 0 when the procedure was adapted, compiled and (with `--execute`)
 /// succeeded; 1 when the adaptation is unresolved, code generation failed or the policy
 /// failed; 2 on bad input.
-pub fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
+pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     let options = options(&args)?;
     let setup = VlmSetup {
         source: match &args.vlm {
@@ -120,7 +122,7 @@ pub fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     } else {
         out!("{}", summary(&run))?;
     }
-    if let Some(error @ pipeline::SynthError::Call { .. }) = &run.codegen_error {
+    if let Some(error @ pipeline::synth::SynthError::Call { .. }) = &run.codegen_error {
         eprintln!("error: {error} (outputs written to {})", run.out_dir.display());
     }
     Ok(ExitCode::from(run.exit_code()))
@@ -210,7 +212,7 @@ impl Progress for Spinner {
 }
 
 /// The terminal summary.
-pub fn summary(run: &AdaptRun) -> String {
+pub(crate) fn summary(run: &AdaptRun) -> String {
     use std::fmt::Write as _;
     let mut out = String::new();
     let s = &run.setting;

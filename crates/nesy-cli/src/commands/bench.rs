@@ -11,18 +11,17 @@ use std::time::Instant;
 use anyhow::Context as _;
 use nesy_bench::demos::DemoCache;
 use nesy_bench::harness::{self, Prepared};
+use nesy_bench::harness::{BenchProgress, ResponderSetup, RunConfig, StopSignal};
 use nesy_bench::manifest::{Manifest, RunSettings};
 use nesy_bench::methods::{self, OfflineMeaning, Role};
 use nesy_bench::study::Study;
-use nesy_bench::{
-    BenchProgress, ResponderSetup, RunConfig, Selection, Shard, StopSignal, UnitRecord, UnitStatus, Variant,
-};
+use nesy_bench::{Selection, Shard, UnitRecord, UnitStatus, Variant};
 use nesy_policy::WorkerCommand;
 use nesy_vlm::ConfigOverrides;
 
 /// Arguments of `nesy bench`.
 #[derive(Debug, clap::Args)]
-pub struct BenchArgs {
+pub(crate) struct BenchArgs {
     /// What to do.
     #[command(subcommand)]
     pub action: BenchAction,
@@ -30,7 +29,7 @@ pub struct BenchArgs {
 
 /// The `nesy bench` subcommands.
 #[derive(Debug, clap::Subcommand)]
-pub enum BenchAction {
+pub(crate) enum BenchAction {
     /// Run (or resume) a benchmark: every pending unit of a shard, one JSON line each; with
     /// every unit done, the report.
     Run(Box<RunArgs>),
@@ -76,7 +75,7 @@ pub enum BenchAction {
 
 /// Arguments of `nesy bench run` and `nesy bench plan`.
 #[derive(Debug, clap::Args)]
-pub struct RunArgs {
+pub(crate) struct RunArgs {
     /// The run directory (default `runs/bench/<date-time>`); running the same command on it
     /// again resumes.
     pub run: Option<PathBuf>,
@@ -168,7 +167,7 @@ pub struct RunArgs {
 
 /// Arguments of `nesy bench demos`.
 #[derive(Debug, clap::Args)]
-pub struct DemosArgs {
+pub(crate) struct DemosArgs {
     /// Scenarios: `all`, or ids and id prefixes, comma-separated.
     #[arg(long, value_name = "LIST", default_value = "all")]
     pub scenarios: String,
@@ -185,7 +184,7 @@ pub struct DemosArgs {
 
 /// Arguments of `nesy bench slurm`.
 #[derive(Debug, clap::Args)]
-pub struct SlurmArgs {
+pub(crate) struct SlurmArgs {
     /// The run directory (on a file system every node sees).
     pub run: PathBuf,
     /// Array tasks (shards).
@@ -212,7 +211,7 @@ pub struct SlurmArgs {
 }
 
 /// Runs `nesy bench`.
-pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
+pub(crate) fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
     match args.action {
         BenchAction::Run(a) => run_bench(*a),
         BenchAction::Demos(a) => demos(a),

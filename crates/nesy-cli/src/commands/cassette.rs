@@ -10,11 +10,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use nesy_vlm::cassette::tools;
+use nesy_vlm::cassette_tools as tools;
 
 /// Arguments of `nesy cassette`.
 #[derive(Debug, clap::Args)]
-pub struct CassetteArgs {
+pub(crate) struct CassetteArgs {
     /// What to do with the cassette.
     #[command(subcommand)]
     pub action: CassetteAction,
@@ -22,7 +22,7 @@ pub struct CassetteArgs {
 
 /// The `nesy cassette` actions.
 #[derive(Debug, clap::Subcommand)]
-pub enum CassetteAction {
+pub(crate) enum CassetteAction {
     /// List the recorded calls with their purpose, model, images, status, tokens and latency.
     Inspect {
         /// The cassette file.
@@ -60,7 +60,7 @@ pub enum CassetteAction {
 }
 
 /// Runs `nesy cassette`.
-pub fn run(args: CassetteArgs) -> anyhow::Result<ExitCode> {
+pub(crate) fn run(args: CassetteArgs) -> anyhow::Result<ExitCode> {
     match args.action {
         CassetteAction::Inspect { cassette, json } => inspect(&cassette, json),
         CassetteAction::Prune {

@@ -1,14 +1,14 @@
 //! One module per subcommand: its clap arguments and its `run` function.
 
-pub mod adapt;
-pub mod bench;
-pub mod cassette;
-pub mod record;
-pub mod render;
-pub mod run;
-pub mod scenarios;
-pub mod verify;
-pub mod worker;
+pub(crate) mod adapt;
+pub(crate) mod bench;
+pub(crate) mod cassette;
+pub(crate) mod record;
+pub(crate) mod render;
+pub(crate) mod run;
+pub(crate) mod scenarios;
+pub(crate) mod verify;
+pub(crate) mod worker;
 
 /// A `--flag SECONDS` value as whole milliseconds: finite and positive, or an error naming
 /// the flag.

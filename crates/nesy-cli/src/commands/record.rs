@@ -14,7 +14,7 @@ use super::scenarios::{SideArg, load_suite};
 
 /// Arguments of `nesy record`.
 #[derive(Debug, clap::Args)]
-pub struct RecordArgs {
+pub(crate) struct RecordArgs {
     /// Scenario id, e.g. `obst_low_00_s0` (`nesy scenarios list --ids` lists them).
     #[arg(long)]
     pub scenario: String,
@@ -38,7 +38,7 @@ pub struct RecordArgs {
 /// Runs `nesy record`. Exit 1 when the expert does not reach `full_success`, or knocks a
 /// placed object out of place again so the final state lacks the goal (the demo is still
 /// written).
-pub fn run(args: RecordArgs) -> anyhow::Result<ExitCode> {
+pub(crate) fn run(args: RecordArgs) -> anyhow::Result<ExitCode> {
     if !(16..=4096).contains(&args.size) {
         anyhow::bail!("--size must be between 16 and 4096 pixels, got {}", args.size);
     }

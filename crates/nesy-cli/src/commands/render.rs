@@ -8,11 +8,11 @@ use anyhow::Context;
 use nesy_sim::perception::render::{
     MAX_RENDER_THREADS, VIEW_SIZE, default_threads, render_views, write_views,
 };
-use nesy_sim::{Sim, SimConfig};
+use nesy_sim::world::{Sim, SimConfig};
 
 /// Arguments of `nesy render`.
 #[derive(Debug, clap::Args)]
-pub struct RenderArgs {
+pub(crate) struct RenderArgs {
     /// Scene file (`scene.json`).
     #[arg(long)]
     pub scene: PathBuf,
@@ -32,14 +32,14 @@ pub struct RenderArgs {
 }
 
 /// Most settle steps `nesy render` takes: 1000 s simulated, far past any scene at rest.
-pub const MAX_SETTLE_STEPS: u32 = 100_000;
+pub(crate) const MAX_SETTLE_STEPS: u32 = 100_000;
 
 /// Runs `nesy render`.
-pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
+pub(crate) fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     if !(16..=4096).contains(&args.size) {
         anyhow::bail!("--size must be between 16 and 4096 pixels, got {}", args.size);
     }
-    let spec = nesy_sim::SceneSpec::from_file(&args.scene)?;
+    let spec = nesy_sim::scene::SceneSpec::from_file(&args.scene)?;
     let config = SimConfig {
         settle_steps: args.settle_steps,
         ..SimConfig::default()

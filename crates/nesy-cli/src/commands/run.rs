@@ -4,12 +4,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
+use nesy_core::Embodiment;
 use nesy_policy::{EpisodeSpec, ExecutionResult, Limits, Outcome, WorkerCommand, run_policy};
-use nesy_sim::api::Embodiment;
 
 /// Arguments of `nesy run`.
 #[derive(Debug, clap::Args)]
-pub struct RunArgs {
+pub(crate) struct RunArgs {
     /// The policy's Python source.
     #[arg(long)]
     pub policy: PathBuf,
@@ -46,10 +46,10 @@ fn parse_embodiment(text: &str) -> Result<Embodiment, String> {
 
 /// Runs `nesy run`: exit 0 if the policy ran to its end, 1 if it failed while running, 2 on
 /// bad input, a policy the static checks reject included (it never ran).
-pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
+pub(crate) fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     let bytes = nesy_input::read_bytes(&args.policy, nesy_input::MAX_POLICY_BYTES)
         .with_context(|| format!("reading the policy {}", args.policy.display()))?;
-    let source = nesy_policy::source::decode_policy_source(&bytes)
+    let source = nesy_policy::decode_policy_source(&bytes)
         .with_context(|| format!("reading the policy {}", args.policy.display()))?;
     let limits = Limits {
         wall_time_ms: super::seconds_to_ms("--timeout", args.timeout)?,

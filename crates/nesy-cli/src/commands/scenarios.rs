@@ -10,7 +10,7 @@ use nesy_sim::tasks::scenario::{self, ConfigFile, CountTable, Scenario, Side};
 
 /// Arguments of `nesy scenarios`.
 #[derive(Debug, clap::Args)]
-pub struct ScenariosArgs {
+pub(crate) struct ScenariosArgs {
     /// What to do.
     #[command(subcommand)]
     pub action: ScenariosAction,
@@ -18,7 +18,7 @@ pub struct ScenariosArgs {
 
 /// The `nesy scenarios` subcommands.
 #[derive(Debug, clap::Subcommand)]
-pub enum ScenariosAction {
+pub(crate) enum ScenariosAction {
     /// Write the 15 configuration files (`<factor>_<complexity>.json`), or with `--gap` the
     /// four files of the auxiliary complexity-gap suite (`gap_obst_plus<k>.json`).
     Generate {
@@ -113,7 +113,7 @@ impl From<SideArg> for Side {
 }
 
 /// The configurations: from `suite` if given, else generated.
-pub fn load_suite(suite: Option<&std::path::Path>) -> anyhow::Result<Vec<ConfigFile>> {
+pub(crate) fn load_suite(suite: Option<&std::path::Path>) -> anyhow::Result<Vec<ConfigFile>> {
     match suite {
         Some(dir) => Ok(scenario::read_suite(dir)?),
         None => Ok(scenario::generate_suite()),
@@ -121,7 +121,7 @@ pub fn load_suite(suite: Option<&std::path::Path>) -> anyhow::Result<Vec<ConfigF
 }
 
 /// Runs `nesy scenarios`.
-pub fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
+pub(crate) fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
     match args.action {
         ScenariosAction::Generate { out, gap } => {
             let started = Instant::now();
@@ -450,10 +450,11 @@ fn run_one(s: &Scenario, side: Side) -> SceneResult {
 /// One side of a scenario as a PDDL problem: the scene built and observed, its objects typed
 /// for the true domain, its goal with the end effector released.
 fn pddl_problem(scenario: &Scenario, side: Side) -> anyhow::Result<String> {
-    use nesy_core::formula::Formula;
+    use nesy_core::Formula;
     let generated = scenario.generate(side)?;
     let scene = generated.scene;
-    let sim = nesy_sim::Sim::new(&scene).with_context(|| format!("building {} ({side:?})", scenario.id))?;
+    let sim =
+        nesy_sim::world::Sim::new(&scene).with_context(|| format!("building {} ({side:?})", scenario.id))?;
     let mut init = nesy_sim::perception::observer::observe(&sim);
     // The domain's schemas are split by end effector on this atom.
     init.insert(nesy_core::Atom::new(scene.embodiment.state_predicate(), &[]));

@@ -8,14 +8,15 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, anyhow};
-use nesy_core::exec::{StepStatus, verify_procedure_in};
 use nesy_core::pddl::{ground_plan, parse_domain, parse_plan, parse_problem};
-use nesy_core::{ParseError, Report, UnmetPrecondition};
+use nesy_core::text::ParseError;
+use nesy_core::{Report, UnmetPrecondition};
+use nesy_core::{StepStatus, verify_procedure_in};
 use serde::Serialize;
 
 /// Arguments of `nesy verify`.
 #[derive(Debug, clap::Args)]
-pub struct VerifyArgs {
+pub(crate) struct VerifyArgs {
     /// PDDL domain file.
     #[arg(long)]
     pub domain: PathBuf,
@@ -82,7 +83,7 @@ fn explain(u: &UnmetPrecondition) -> String {
 }
 
 /// Runs `nesy verify`.
-pub fn run(args: VerifyArgs) -> anyhow::Result<ExitCode> {
+pub(crate) fn run(args: VerifyArgs) -> anyhow::Result<ExitCode> {
     let domain_text = read(&args.domain)?;
     let problem_text = read(&args.problem)?;
     let plan_text = read(&args.plan)?;

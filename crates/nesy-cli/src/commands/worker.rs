@@ -5,9 +5,9 @@ use std::process::ExitCode;
 
 /// Arguments of the hidden worker subcommand (none: the request comes on stdin).
 #[derive(Debug, clap::Args)]
-pub struct WorkerArgs {}
+pub(crate) struct WorkerArgs {}
 
 /// Runs one policy episode in this process under the worker's limits.
-pub fn run(_args: WorkerArgs) -> anyhow::Result<ExitCode> {
-    Ok(nesy_policy::worker::worker_main(&nesy_policy::SimEpisodes))
+pub(crate) fn run(_args: WorkerArgs) -> anyhow::Result<ExitCode> {
+    Ok(nesy_policy::worker_main(&nesy_policy::SimEpisodes))
 }

@@ -10,9 +10,8 @@ use crate::common;
 
 use std::sync::Arc;
 
-use nesy_pipeline::{
-    self as pipeline, AdaptOptions, DemoInput, NoProgress, TargetInput, VlmSetup, VlmSource,
-};
+use nesy_pipeline::vlm::{VlmSetup, VlmSource};
+use nesy_pipeline::{self as pipeline, AdaptOptions, DemoInput, NoProgress, TargetInput};
 use nesy_policy::WorkerCommand;
 use nesy_vlm::{BackendKind, VlmConfig};
 use serde_json::Value;

@@ -11,17 +11,17 @@ use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use nesy_core::State;
+use nesy_core::Symbol;
 use nesy_core::adapt::{
     AdaptConfig, Demonstration, InductionRequest, PatchRequest, Reasoner, ReasonerError, Target, TaskContext,
 };
-use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::state::State;
-use nesy_core::symbol::Symbol;
+use nesy_core::{Tier, Vocabulary};
 use serde::Deserialize;
 
 /// One recorded run, as stored in the corpus.
 #[derive(Debug, Clone, Deserialize)]
-pub struct RecordedRun {
+pub(super) struct RecordedRun {
     /// The scenario id (`comb_high_00_s0`).
     pub scenario: String,
     instruction: String,
@@ -41,7 +41,7 @@ pub struct RecordedRun {
 
 /// The recorded run's outcome.
 #[derive(Debug, Clone, Deserialize)]
-pub struct Expected {
+pub(super) struct Expected {
     /// `adapted` or `unresolved`.
     pub outcome: String,
     /// Proposals made.
@@ -51,7 +51,7 @@ pub struct Expected {
 }
 
 /// The inputs of `adapt::run` for one recorded run.
-pub struct Inputs {
+pub(super) struct Inputs {
     pub demo: Demonstration,
     pub target: Target,
     pub config: AdaptConfig,
@@ -59,7 +59,7 @@ pub struct Inputs {
 
 impl RecordedRun {
     /// The demonstration, target and configuration the pipeline passed to `adapt::run`.
-    pub fn inputs(&self) -> Inputs {
+    pub(super) fn inputs(&self) -> Inputs {
         let task = |objects: &[String]| TaskContext {
             instruction: self.instruction.clone(),
             objects: objects.iter().map(|o| Symbol::new(o)).collect(),
@@ -85,7 +85,7 @@ impl RecordedRun {
     }
 
     /// A reasoner that answers with this run's replies, in order.
-    pub fn reasoner(&self) -> ScriptedReasoner {
+    pub(super) fn reasoner(&self) -> ScriptedReasoner {
         ScriptedReasoner {
             inductions: self.induction_replies.iter().cloned().collect(),
             patches: self.patch_replies.iter().cloned().collect(),
@@ -95,7 +95,7 @@ impl RecordedRun {
 }
 
 /// Returns recorded replies in call order; running out is a reasoner error.
-pub struct ScriptedReasoner {
+pub(super) struct ScriptedReasoner {
     inductions: VecDeque<String>,
     patches: VecDeque<String>,
     /// When the first patch was requested: the CLI's split between world-model
@@ -126,7 +126,7 @@ impl Reasoner for ScriptedReasoner {
 
 /// The corpus directory: `NESY_ADAPT_CORPUS` if set (to time other recorded runs, e.g. a
 /// fresh `scripts/make_adapt_corpus.py --out DIR`), else `tests/adapt_corpus`.
-pub fn corpus_dir() -> PathBuf {
+pub(super) fn corpus_dir() -> PathBuf {
     match std::env::var_os("NESY_ADAPT_CORPUS") {
         Some(dir) => PathBuf::from(dir),
         None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/adapt_corpus"),
@@ -134,7 +134,7 @@ pub fn corpus_dir() -> PathBuf {
 }
 
 /// Every recorded run, sorted by scenario id.
-pub fn load_all() -> Vec<RecordedRun> {
+pub(super) fn load_all() -> Vec<RecordedRun> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(corpus_dir())
         .unwrap_or_else(|e| panic!("{}: {e}", corpus_dir().display()))
         .map(|e| e.expect("readable directory entry").path())

@@ -8,7 +8,7 @@ use nesy_core::text::parse_action_block;
 use nesy_core::{Atom, Formula, Operator, State};
 
 /// A 200-atom state over 60 objects.
-pub fn state_200() -> State {
+pub(crate) fn state_200() -> State {
     let mut atoms = vec![Atom::new("GripperOpen", &[])];
     for i in 0..60 {
         let o = format!("obj{i}");
@@ -27,7 +27,7 @@ pub fn state_200() -> State {
 
 /// An operator of 20 literals: 10 preconditions (7 positive, 3 negative) and 10 effects
 /// (5 adds, 5 deletes), all applicable in [`state_200`].
-pub fn operator_20() -> Operator {
+pub(crate) fn operator_20() -> Operator {
     let mut text = String::from("TwentyLiteralAction\n- Preconditions:\n");
     for i in 0..7 {
         text.push_str(&format!("\t(Near obj{} obj{})\n", i * 5, i * 5 + 1));
@@ -47,7 +47,7 @@ pub fn operator_20() -> Operator {
 
 /// A 116-step procedure (58 grasp/place pairs) valid from [`state_200`], in the style of
 /// induced operators: quantified preconditions over every object and negative literals.
-pub fn procedure_116() -> Vec<Operator> {
+pub(crate) fn procedure_116() -> Vec<Operator> {
     let mut ops = Vec::new();
     for k in 0..58 {
         let grasp = format!(
@@ -63,7 +63,7 @@ pub fn procedure_116() -> Vec<Operator> {
 }
 
 /// The goal of the procedure: every object in the box.
-pub fn goal_116() -> Formula {
+pub(crate) fn goal_116() -> Formula {
     Formula::And(
         (0..58)
             .map(|k| Formula::atom(Atom::new("InsideOf", &[&format!("obj{k}"), "box"])))
@@ -71,10 +71,10 @@ pub fn goal_116() -> Formula {
     )
 }
 
-pub const BLOCKSWORLD: &str = include_str!("../../../../fixtures/pddl/blocksworld/domain.pddl");
+pub(crate) const BLOCKSWORLD: &str = include_str!("../../../../fixtures/pddl/blocksworld/domain.pddl");
 
 /// A 10-block instance: two towers of five, to be rebuilt as one tower in another order.
-pub fn blocksworld_10() -> (Domain, Problem) {
+pub(crate) fn blocksworld_10() -> (Domain, Problem) {
     let domain = parse_domain(BLOCKSWORLD).expect("domain parses");
     let problem = parse_problem(
         "(define (problem bw10) (:domain blocksworld)

@@ -65,7 +65,7 @@ impl std::fmt::Display for UnknownSymbol {
 ///
 /// ```
 /// use nesy_core::adapt::unknown_symbols;
-/// use nesy_core::predicates::Vocabulary;
+/// use nesy_core::Vocabulary;
 /// use nesy_core::text::parse_induction_reply;
 /// use nesy_core::Symbol;
 ///
@@ -105,7 +105,7 @@ pub fn unknown_symbols(
 ///
 /// ```
 /// use nesy_core::adapt::unknown_atom_symbols;
-/// use nesy_core::predicates::Vocabulary;
+/// use nesy_core::Vocabulary;
 /// use nesy_core::text::parse_state_list;
 /// use nesy_core::Symbol;
 ///

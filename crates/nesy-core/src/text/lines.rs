@@ -9,22 +9,22 @@ pub(crate) struct Line<'a> {
 }
 
 impl<'a> Line<'a> {
-    pub fn end(&self) -> usize {
+    pub(crate) fn end(&self) -> usize {
         self.start + self.text.len()
     }
 
-    pub fn is_blank(&self) -> bool {
+    pub(crate) fn is_blank(&self) -> bool {
         self.text.trim().is_empty()
     }
 
     /// A markdown code fence (```` ``` ```` or `~~~`, with or without a language).
-    pub fn is_fence(&self) -> bool {
+    pub(crate) fn is_fence(&self) -> bool {
         let t = self.text.trim_start();
         t.starts_with("```") || t.starts_with("~~~")
     }
 
     /// Offset of the first non-whitespace character.
-    pub fn content_start(&self) -> usize {
+    pub(crate) fn content_start(&self) -> usize {
         self.start + (self.text.len() - self.text.trim_start().len())
     }
 }
@@ -249,7 +249,7 @@ mod tests {
         use winnow::prelude::*;
         use winnow::token::{one_of, take_while};
 
-        pub fn split_lines(doc: &str) -> Vec<(usize, &str)> {
+        pub(super) fn split_lines(doc: &str) -> Vec<(usize, &str)> {
             let mut out = Vec::new();
             let mut start = 0;
             for piece in doc.split('\n') {
@@ -269,7 +269,7 @@ mod tests {
             Ok(())
         }
 
-        pub fn strip_decoration(text: &str) -> (&str, usize) {
+        pub(super) fn strip_decoration(text: &str) -> (&str, usize) {
             let mut rest = text;
             loop {
                 let before = rest.len();
@@ -285,7 +285,7 @@ mod tests {
             (rest, text.len() - rest.len())
         }
 
-        pub fn strip_bullet(text: &str) -> &str {
+        pub(super) fn strip_bullet(text: &str) -> &str {
             let t = text.trim_start();
             let mut input = t;
             if marker(&mut input, &['-', '*', '•', '+']).is_ok() {
@@ -295,7 +295,7 @@ mod tests {
             }
         }
 
-        pub fn label_matches(raw: &str, label: &str) -> bool {
+        pub(super) fn label_matches(raw: &str, label: &str) -> bool {
             let mut cleaned = raw
                 .chars()
                 .filter(|c| !matches!(c, '*' | '_' | '`' | '#' | '-'))

@@ -31,14 +31,14 @@ pub(crate) enum SKind<'a> {
 }
 
 impl<'a> SExpr<'a> {
-    pub fn token(&self) -> Option<&'a str> {
+    pub(crate) fn token(&self) -> Option<&'a str> {
         match self.kind {
             SKind::Token(t) => Some(t),
             SKind::List(_) => None,
         }
     }
 
-    pub fn list(&self) -> Option<&[SExpr<'a>]> {
+    pub(crate) fn list(&self) -> Option<&[SExpr<'a>]> {
         match &self.kind {
             SKind::List(items) => Some(items),
             SKind::Token(_) => None,

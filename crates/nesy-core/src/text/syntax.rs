@@ -23,7 +23,7 @@ fn is_name(t: &str) -> bool {
 }
 
 impl<'d> Converter<'d> {
-    pub fn new(doc: &'d str, lowercase: bool) -> Self {
+    pub(crate) fn new(doc: &'d str, lowercase: bool) -> Self {
         Converter {
             doc,
             lowercase,
@@ -32,16 +32,16 @@ impl<'d> Converter<'d> {
     }
 
     /// Checks every atom against declared predicates (PDDL's `:predicates`).
-    pub fn with_predicates(mut self, predicates: Vec<(Symbol, usize)>) -> Self {
+    pub(crate) fn with_predicates(mut self, predicates: Vec<(Symbol, usize)>) -> Self {
         self.predicates = Some(predicates);
         self
     }
 
-    pub fn err(&self, at: usize, kind: ParseErrorKind, expected: impl Into<String>) -> ParseError {
+    pub(crate) fn err(&self, at: usize, kind: ParseErrorKind, expected: impl Into<String>) -> ParseError {
         ParseError::at(self.doc, at, kind, expected)
     }
 
-    pub fn name(&self, t: &str) -> Symbol {
+    pub(crate) fn name(&self, t: &str) -> Symbol {
         if self.lowercase {
             Symbol::new(&t.to_lowercase())
         } else {
@@ -50,7 +50,7 @@ impl<'d> Converter<'d> {
     }
 
     /// A name token (not a variable, not a list).
-    pub fn expect_name(&self, e: &SExpr<'_>, what: &str) -> Result<Symbol, ParseError> {
+    pub(crate) fn expect_name(&self, e: &SExpr<'_>, what: &str) -> Result<Symbol, ParseError> {
         match e.kind {
             SKind::Token(t) if is_name(t) => Ok(self.name(t)),
             _ => Err(self.err(e.span.start, ParseErrorKind::Syntax, what.to_string())),
@@ -126,7 +126,7 @@ impl<'d> Converter<'d> {
     }
 
     /// Parses `?a ?b - type ?c` (untyped variables are `thing`).
-    pub fn typed_list(
+    pub(crate) fn typed_list(
         &self,
         items: &[SExpr<'_>],
         variables: bool,
@@ -215,7 +215,7 @@ impl<'d> Converter<'d> {
     }
 
     /// A formula; `scope` holds the variables bound around it.
-    pub fn formula(&self, e: &SExpr<'_>, scope: &mut Vec<Symbol>) -> Result<Formula, ParseError> {
+    pub(crate) fn formula(&self, e: &SExpr<'_>, scope: &mut Vec<Symbol>) -> Result<Formula, ParseError> {
         let Some(items) = e.list() else {
             return Err(self.err(e.span.start, ParseErrorKind::Syntax, "a formula in parentheses"));
         };
@@ -280,7 +280,7 @@ impl<'d> Converter<'d> {
     }
 
     /// An effect expression, flattened: `(and e1 e2)` gives two effects.
-    pub fn effects(&self, e: &SExpr<'_>, scope: &mut Vec<Symbol>) -> Result<Vec<Effect>, ParseError> {
+    pub(crate) fn effects(&self, e: &SExpr<'_>, scope: &mut Vec<Symbol>) -> Result<Vec<Effect>, ParseError> {
         let Some(items) = e.list() else {
             return Err(self.err(e.span.start, ParseErrorKind::Syntax, "an effect in parentheses"));
         };

@@ -3,9 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use nesy_core::patch::{PatchError, apply_patch};
+use nesy_core::text::{ParseError, ParseErrorKind};
 use nesy_core::text::{parse_induction_reply, parse_procedure, parse_refinement_reply, parse_state_list};
-use nesy_core::{ParseError, ParseErrorKind};
+use nesy_core::{PatchError, apply_patch};
 use serde_json::Value;
 
 fn dir() -> PathBuf {

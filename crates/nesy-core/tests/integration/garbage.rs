@@ -2,12 +2,13 @@
 //! random strings over the characters that matter to the grammars, give `Ok` or a typed
 //! error with a position inside the input.
 
+use nesy_core::Atom;
 use nesy_core::pddl::{parse_domain, parse_plan, parse_problem};
+use nesy_core::text::ParseError;
 use nesy_core::text::{
     parse_action_block, parse_effects, parse_formula, parse_induction_reply, parse_procedure,
     parse_refinement_reply, parse_state_list,
 };
-use nesy_core::{Atom, ParseError};
 use proptest::prelude::*;
 
 fn fixture(path: &str) -> String {

@@ -1,8 +1,8 @@
 //! The paper's appendix examples parse and verify as the paper describes.
 
-use nesy_core::exec::{StepStatus, verify_procedure};
 use nesy_core::text::{parse_action_block, parse_procedure, parse_state_list};
 use nesy_core::{Atom, ExecError, State, apply};
+use nesy_core::{StepStatus, verify_procedure};
 
 fn atom(s: &str) -> Atom {
     s.parse().unwrap()

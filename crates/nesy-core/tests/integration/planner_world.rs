@@ -7,9 +7,9 @@
 
 use std::path::{Path, PathBuf};
 
-use nesy_core::exec::verify_procedure_in;
 use nesy_core::pddl::{parse_domain, parse_problem};
 use nesy_core::planner::{PlannerConfig, plan};
+use nesy_core::verify_procedure_in;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")

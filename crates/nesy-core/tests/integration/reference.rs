@@ -8,9 +8,9 @@ use crate::common;
 use std::collections::{BTreeMap, BTreeSet};
 
 use common::*;
-use nesy_core::exec::{StepStatus, apply_in, verify_procedure_in};
-use nesy_core::formula::{AtomPattern, Effect, Formula, Term};
+use nesy_core::{AtomPattern, Effect, Formula, Term};
 use nesy_core::{ExecError, Operator, State, Symbol, Universe};
+use nesy_core::{StepStatus, apply_in, verify_procedure_in};
 use proptest::prelude::*;
 
 type Env = BTreeMap<String, String>;

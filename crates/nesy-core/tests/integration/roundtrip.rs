@@ -4,13 +4,13 @@
 use crate::common;
 
 use common::*;
-use nesy_core::formula::{Formula, TypedVar};
-use nesy_core::operator::format_procedure;
-use nesy_core::patch::Patch;
+use nesy_core::Patch;
+use nesy_core::format_procedure;
 use nesy_core::pddl::{
     Domain, PlanStep, PredicateDecl, Problem, format_plan, parse_domain, parse_plan, parse_problem,
 };
 use nesy_core::text::{parse_formula, parse_procedure, parse_refinement_reply, parse_state_list};
+use nesy_core::{Formula, TypedVar};
 use nesy_core::{Operator, State, Symbol};
 use proptest::prelude::*;
 
@@ -185,12 +185,8 @@ fn random_pddl(rng: &mut SeedRng) -> (Domain, Problem, Vec<PlanStep>) {
     (domain, problem, plan)
 }
 
-fn pddl_atom(
-    rng: &mut SeedRng,
-    scope: &[Symbol],
-    objects: &[&'static str],
-) -> nesy_core::formula::AtomPattern {
-    use nesy_core::formula::{AtomPattern, Term};
+fn pddl_atom(rng: &mut SeedRng, scope: &[Symbol], objects: &[&'static str]) -> nesy_core::AtomPattern {
+    use nesy_core::{AtomPattern, Term};
     let term = |rng: &mut SeedRng| {
         if !scope.is_empty() && rng.chance(60) {
             Term::Var(*rng.pick(scope))
@@ -240,7 +236,7 @@ fn pddl_formula(rng: &mut SeedRng, scope: &[Symbol], objects: &[&'static str], d
             Formula::Exists(vec![v], Box::new(pddl_formula(rng, &inner, objects, depth - 1)))
         }
         _ => {
-            use nesy_core::formula::Term;
+            use nesy_core::Term;
             let t = |rng: &mut SeedRng| {
                 if !scope.is_empty() && rng.chance(50) {
                     Term::Var(*rng.pick(scope))

@@ -6,20 +6,22 @@
 
 use std::sync::Arc;
 
+use nesy_core::Embodiment;
+use nesy_core::Symbol;
 use nesy_core::adapt::{AdaptConfig, Demonstration, Outcome, Target, TaskContext, run};
 use nesy_core::metrics::SubtaskResult;
-use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::symbol::Symbol;
+use nesy_core::{Tier, Vocabulary};
 use nesy_oracle::{OracleNoise, OracleStats, OracleTransport};
-use nesy_pipeline::SandboxChecks;
+use nesy_pipeline::synth::SandboxChecks;
 use nesy_policy::{Limits, run_in_process};
 use nesy_reasoner::codegen::CodeGenerationRequest;
 use nesy_reasoner::{KeyframeList, VlmReasoner};
+use nesy_sim::perception::observer::observe;
 use nesy_sim::scene::SceneSpec;
 use nesy_sim::scene::SubtaskKind;
 use nesy_sim::tasks::TaskConfig;
 use nesy_sim::tasks::goal::GoalMonitor;
-use nesy_sim::{Embodiment, Sim, observe};
+use nesy_sim::world::Sim;
 use nesy_vlm::{BackendKind, VlmClient, VlmConfig};
 
 use crate::common::Keyframes;

@@ -4,19 +4,21 @@
 //! every subtask must end in full success. The light cases run by default; every subtask
 //! on both end effectors runs with `--ignored`.
 
+use nesy_core::Embodiment;
+use nesy_core::Operator;
+use nesy_core::Symbol;
 use nesy_core::adapt::{InductionRequest, TaskContext};
 use nesy_core::metrics::SubtaskResult;
-use nesy_core::operator::Operator;
-use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::symbol::Symbol;
+use nesy_core::{Tier, Vocabulary};
 use nesy_oracle::induce;
 use nesy_policy::{Limits, run_in_process};
 use nesy_reasoner::InductionContext;
 use nesy_sim::domain::WorldDomain;
+use nesy_sim::perception::observer::observe;
 use nesy_sim::scene::SubtaskKind;
 use nesy_sim::tasks::TaskConfig;
 use nesy_sim::tasks::goal::GoalMonitor;
-use nesy_sim::{Embodiment, Sim, observe};
+use nesy_sim::world::Sim;
 
 use crate::common::Keyframes;
 

@@ -5,17 +5,19 @@
 //! transitions the grounded schema reproduces by itself is counted and printed; the rest
 //! are the observer effects the README documents.
 
+use nesy_core::Embodiment;
+use nesy_core::State;
+use nesy_core::Symbol;
 use nesy_core::adapt::{InductionRequest, TaskContext, TransitionCheck, check_transition};
-use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::state::State;
-use nesy_core::symbol::Symbol;
+use nesy_core::{Tier, Vocabulary};
 use nesy_oracle::induce;
 use nesy_reasoner::InductionContext;
-use nesy_sim::ApiCall;
+use nesy_sim::api::ApiCall;
 use nesy_sim::domain::WorldDomain;
+use nesy_sim::perception::observer::observe;
 use nesy_sim::scene::SubtaskKind;
 use nesy_sim::tasks::{SubtaskConfig, TaskConfig};
-use nesy_sim::{Embodiment, Sim, observe};
+use nesy_sim::world::Sim;
 
 use crate::common::Keyframes;
 

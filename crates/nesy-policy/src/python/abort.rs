@@ -12,7 +12,7 @@ use crate::result::TimeLimit;
 /// Why an episode was stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
-pub enum AbortReason {
+pub(crate) enum AbortReason {
     /// The wall-clock deadline passed.
     WallClock = 1,
     /// The trace-event budget ran out.
@@ -41,7 +41,7 @@ impl AbortReason {
     }
 
     /// The time limit this reason corresponds to, if it is one.
-    pub fn time_limit(self) -> Option<TimeLimit> {
+    pub(crate) fn time_limit(self) -> Option<TimeLimit> {
         match self {
             AbortReason::WallClock => Some(TimeLimit::WallClock),
             AbortReason::Instructions => Some(TimeLimit::Instructions),
@@ -53,7 +53,7 @@ impl AbortReason {
     }
 
     /// Message of the exception raised into the policy.
-    pub fn message(self) -> &'static str {
+    pub(crate) fn message(self) -> &'static str {
         match self {
             AbortReason::WallClock => "policy exceeded its wall-clock budget",
             AbortReason::Instructions => "policy exceeded its instruction budget",
@@ -68,16 +68,16 @@ impl AbortReason {
 static REASON: AtomicU8 = AtomicU8::new(0);
 
 /// Records `reason` unless an earlier one is already set (the first reason wins).
-pub fn request(reason: AbortReason) {
+pub(crate) fn request(reason: AbortReason) {
     let _ = REASON.compare_exchange(0, reason as u8, Ordering::AcqRel, Ordering::Acquire);
 }
 
 /// The reason the current episode must stop, if any.
-pub fn current() -> Option<AbortReason> {
+pub(crate) fn current() -> Option<AbortReason> {
     AbortReason::from_u8(REASON.load(Ordering::Acquire))
 }
 
 /// Clears the reason at the start of an episode.
-pub fn reset() {
+pub(crate) fn reset() {
     REASON.store(0, Ordering::Release);
 }

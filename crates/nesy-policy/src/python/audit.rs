@@ -29,7 +29,7 @@ static FIRST_VIOLATION: Mutex<Option<Violation>> = Mutex::new(None);
 
 /// A refused audit event.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Violation {
+pub(crate) struct Violation {
     /// Event name, e.g. `open`.
     pub event: String,
     /// The event's first argument if it is a `str`.
@@ -45,11 +45,6 @@ pub(crate) fn install() {
     unsafe {
         PySys_AddAuditHook(Some(hook), std::ptr::null_mut());
     }
-}
-
-/// True once the hook is installed.
-pub fn is_installed() -> bool {
-    INSTALLED.load(Ordering::Acquire)
 }
 
 /// Starts refusing events (just before the policy's code runs).

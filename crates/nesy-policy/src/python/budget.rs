@@ -20,7 +20,7 @@ use pyo3::prelude::*;
 use super::abort::{self, AbortReason};
 
 /// How often the watchdog re-raises once the episode must stop.
-pub const WATCHDOG_PERIOD: Duration = Duration::from_millis(20);
+pub(crate) const WATCHDOG_PERIOD: Duration = Duration::from_millis(20);
 
 static REMAINING: AtomicU64 = AtomicU64::new(u64::MAX);
 /// When the policy last made progress (its start or a robot API call), in milliseconds since

@@ -10,7 +10,7 @@ use pyo3::types::PyDict;
 /// frames, files, the import system or arbitrary attributes is left out (`open`, `exec`,
 /// `eval`, `compile`, `getattr`, `setattr`, `delattr`, `globals`, `locals`, `vars`, `dir`,
 /// `type`, `id`, `input`, `breakpoint`, `memoryview`, `__import__`, ...).
-pub const ALLOWED_BUILTINS: &[&str] = &[
+pub(crate) const ALLOWED_BUILTINS: &[&str] = &[
     "abs",
     "all",
     "any",
@@ -85,7 +85,7 @@ pub const ALLOWED_BUILTINS: &[&str] = &[
 ];
 
 /// Modules a policy may import, by the name it imports them under.
-pub const ALLOWED_MODULES: &[&str] = &["math", "numpy", "robot"];
+pub(crate) const ALLOWED_MODULES: &[&str] = &["math", "numpy", "robot"];
 
 /// `__import__` for policies: returns the pre-imported module for an allowlisted name and
 /// refuses everything else (relative imports included).

@@ -13,11 +13,11 @@ use pyo3::types::{PyBool, PyByteArray, PyBytes, PyDict, PyFloat, PyInt, PyString
 /// Height of the table surface in the world frame (`docs/benchmark.md` §1: `Z_OFFSET = 0.5`),
 /// the scene format's one definition. A two-element position `(x, y)` means a point on the
 /// table surface, `(x, y, TABLE_TOP_Z)`.
-pub const TABLE_TOP_Z: f64 = nesy_sim::scene::TABLE_TOP;
+pub(crate) const TABLE_TOP_Z: f64 = nesy_sim::scene::TABLE_TOP;
 
 /// A robot API function's name and parameters, in order.
 #[derive(Debug)]
-pub struct Signature {
+pub(crate) struct Signature {
     /// Function name.
     pub name: &'static str,
     /// Parameter names with their defaults rendered as Python source (`None` = required).
@@ -26,7 +26,7 @@ pub struct Signature {
 
 impl Signature {
     /// The signature as Python would print it, e.g. `move_gripper_to(obj_name, pointing_to='down', depth=0.01)`.
-    pub fn render(&self) -> String {
+    pub(crate) fn render(&self) -> String {
         let params: Vec<String> = self
             .params
             .iter()
@@ -44,7 +44,7 @@ impl Signature {
 
     /// Binds positional and keyword arguments to the parameters. `None` in the result means
     /// "use the default".
-    pub fn bind<'py, const N: usize>(
+    pub(crate) fn bind<'py, const N: usize>(
         &self,
         args: &Bound<'py, PyTuple>,
         kwargs: Option<&Bound<'py, PyDict>>,
@@ -89,7 +89,7 @@ impl Signature {
     }
 
     /// Converts parameter `index` to a `str`.
-    pub fn string(&self, index: usize, value: &Bound<'_, PyAny>) -> PyResult<String> {
+    pub(crate) fn string(&self, index: usize, value: &Bound<'_, PyAny>) -> PyResult<String> {
         match value.cast::<PyString>() {
             Ok(s) => Ok(s.to_str()?.to_owned()),
             Err(_) => Err(self.type_error(format!(
@@ -102,7 +102,7 @@ impl Signature {
     }
 
     /// Converts parameter `index` to a finite float (Python `int` or `float`, not `bool`).
-    pub fn number(&self, index: usize, value: &Bound<'_, PyAny>) -> PyResult<f64> {
+    pub(crate) fn number(&self, index: usize, value: &Bound<'_, PyAny>) -> PyResult<f64> {
         let what = format!("{}() argument '{}'", self.name, self.params[index].0);
         self.number_named(&what, value)
     }
@@ -129,7 +129,7 @@ impl Signature {
 
     /// Converts parameter `index` to a direction name (`left`, `right`, `front`, `back`,
     /// `up`, `down`). Whether the direction suits the call is the simulator's decision.
-    pub fn direction(&self, index: usize, value: &Bound<'_, PyAny>) -> PyResult<Direction> {
+    pub(crate) fn direction(&self, index: usize, value: &Bound<'_, PyAny>) -> PyResult<Direction> {
         let name = self.string(index, value)?;
         Direction::from_name(&name).ok_or_else(|| {
             let known: Vec<&str> = Direction::ALL.iter().map(|d| d.as_str()).collect();
@@ -146,7 +146,7 @@ impl Signature {
     /// Converts parameter `index` to a position: a list, tuple or other sequence (such as
     /// the `np` arrays the API returns) of 2 or 3 numbers. `(x, y)` means the point on the
     /// table surface, `(x, y, TABLE_TOP_Z)`.
-    pub fn position(&self, index: usize, value: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
+    pub(crate) fn position(&self, index: usize, value: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
         let param = self.params[index].0;
         let not_a_position = || {
             self.type_error(format!(

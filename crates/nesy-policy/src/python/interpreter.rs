@@ -83,11 +83,6 @@ pub fn initialize() -> Result<StartupTimes, InitError> {
         .clone()
 }
 
-/// True if the binary carries its own standard library.
-pub fn has_embedded_stdlib() -> bool {
-    EMBEDDED_STDLIB.is_some()
-}
-
 fn wide(s: &str) -> Vec<libc::wchar_t> {
     s.chars()
         .map(|c| c as libc::wchar_t)

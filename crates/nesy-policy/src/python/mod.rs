@@ -1,11 +1,11 @@
 //! The embedded interpreter and the sandbox layers that live inside it.
 
-pub mod abort;
-pub mod audit;
-pub mod budget;
-pub mod builtins;
-pub mod convert;
-pub mod interpreter;
+pub(crate) mod abort;
+pub(crate) mod audit;
+pub(crate) mod budget;
+pub(crate) mod builtins;
+pub(crate) mod convert;
+pub(crate) mod interpreter;
 pub(crate) mod output;
-pub mod robot_module;
-pub mod session;
+pub(crate) mod robot_module;
+pub(crate) mod session;

@@ -164,7 +164,7 @@ mod sigs {
 }
 
 /// Every function of the module with its signature, in the order of the paper's tables.
-pub const SIGNATURES: [&Signature; 19] = [
+pub(crate) const SIGNATURES: [&Signature; 19] = [
     &sigs::is_obj_visible,
     &sigs::get_obj_names,
     &sigs::get_obj_pos,
@@ -378,7 +378,7 @@ act_bare!(
 
 /// The `robot` module, registered with `append_to_inittab!` before the interpreter starts.
 #[pymodule]
-pub fn robot(m: &Bound<'_, PyModule>) -> PyResult<()> {
+pub(crate) fn robot(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(is_obj_visible, m)?)?;
     m.add_function(wrap_pyfunction!(get_obj_names, m)?)?;
     m.add_function(wrap_pyfunction!(get_obj_pos, m)?)?;

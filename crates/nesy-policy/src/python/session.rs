@@ -15,7 +15,7 @@ use super::abort::{self, AbortReason};
 
 /// Receives every new trace entry as soon as the call returns (the worker streams them to
 /// its parent, so a killed episode still reports the calls it made).
-pub type TraceSink = Box<dyn FnMut(&TraceEntry) + Send>;
+pub(crate) type TraceSink = Box<dyn FnMut(&TraceEntry) + Send>;
 
 /// The robot and budgets of the running episode.
 pub(crate) struct ActiveEpisode {

@@ -27,7 +27,7 @@ impl Channel {
     }
 }
 
-/// Entry point of the hidden worker subcommand. Reads a [`WorkerRequest`] from stdin,
+/// Entry point of the hidden worker subcommand. Reads a worker request from stdin,
 /// builds the episode with `factory`, runs it and reports on fd 3. Never returns normally
 /// after the episode: it exits without finalising the interpreter.
 pub fn worker_main(factory: &dyn EpisodeFactory) -> ExitCode {

@@ -16,8 +16,8 @@
 mod child;
 mod limits;
 mod parent;
-pub mod protocol;
-pub mod seccomp;
+pub(crate) mod protocol;
+pub(crate) mod seccomp;
 
 pub use child::worker_main;
 pub use parent::{RunError, WORKER_SUBCOMMAND, WorkerCommand, run_policy, run_policy_without_static_checks};

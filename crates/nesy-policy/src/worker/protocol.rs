@@ -8,14 +8,14 @@ use crate::limits::Limits;
 use crate::result::ExecutionResult;
 
 /// File descriptor on which the worker writes its messages.
-pub const RESULT_FD: i32 = 3;
+pub(crate) const RESULT_FD: i32 = 3;
 
 /// Largest request the worker accepts on stdin.
-pub const MAX_REQUEST_BYTES: u64 = 16 << 20;
+pub(crate) const MAX_REQUEST_BYTES: u64 = 16 << 20;
 
 /// What the parent asks the worker to run (JSON on the worker's stdin).
 #[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct WorkerRequest {
+pub(crate) struct WorkerRequest {
     /// Random per-episode token; every message back must carry it.
     pub nonce: String,
     /// The policy's Python source.
@@ -36,7 +36,7 @@ fn yes() -> bool {
 /// One JSON line from the worker on [`RESULT_FD`].
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
-pub enum WorkerMessage {
+pub(crate) enum WorkerMessage {
     /// The interpreter is up and the limits are in place; the policy starts now.
     Ready {
         /// The request's nonce.
@@ -69,7 +69,7 @@ pub enum WorkerMessage {
 
 impl WorkerMessage {
     /// The nonce the message carries.
-    pub fn nonce(&self) -> &str {
+    pub(crate) fn nonce(&self) -> &str {
         match self {
             WorkerMessage::Ready { nonce, .. }
             | WorkerMessage::Trace { nonce, .. }

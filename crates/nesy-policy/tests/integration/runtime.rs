@@ -1,10 +1,11 @@
 //! The embedded runtime against the recording test double: argument conversion, error
 //! mapping, tracebacks, output capture and each in-interpreter sandbox layer.
 
-use nesy_policy::runner::run_in_process_without_static_checks;
-use nesy_policy::testing::RecordingRobot;
+use nesy_core::Embodiment;
+use nesy_policy::RecordingRobot;
+use nesy_policy::run_in_process_without_static_checks;
 use nesy_policy::{ExecutionResult, Limits, Outcome, TimeLimit, check_source, run_in_process};
-use nesy_sim::api::{ApiCall, Direction, Embodiment};
+use nesy_sim::api::{ApiCall, Direction};
 
 fn run_with(source: &str, embodiment: Embodiment, limits: &Limits) -> ExecutionResult {
     run_in_process(source, Box::new(RecordingRobot::new(embodiment)), limits, None)

@@ -19,7 +19,7 @@ fn filter_refuses_exec_fork_sockets_and_writes() {
         let mut failures = 0u8;
         // SAFETY: raw system calls in the forked child.
         unsafe {
-            if nesy_policy::worker::install_seccomp_filter().is_err() {
+            if nesy_policy::install_seccomp_filter().is_err() {
                 libc::_exit(100);
             }
             if libc::socket(libc::AF_INET, libc::SOCK_STREAM, 0) >= 0 || errno() != libc::EPERM {

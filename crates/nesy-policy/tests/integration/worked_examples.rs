@@ -4,8 +4,8 @@
 
 use std::path::PathBuf;
 
+use nesy_core::Embodiment;
 use nesy_policy::{EpisodeFactory, EpisodeSpec, Limits, Outcome, SimEpisodes, run_in_process};
-use nesy_sim::api::Embodiment;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")

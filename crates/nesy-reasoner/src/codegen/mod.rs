@@ -5,7 +5,7 @@
 mod check;
 mod extract;
 
-use nesy_core::operator::Operator;
+use nesy_core::Operator;
 use serde::{Deserialize, Serialize};
 
 pub use check::{CheckUnavailable, Finding, ProgramCheck};

@@ -5,12 +5,12 @@
 //! and the code examples are programs that `tests/integration/examples.rs` runs against
 //! those scenes.
 
-use nesy_core::formula::{Effect, Formula};
-use nesy_core::operator::Operator;
-use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::state::State;
-use nesy_core::symbol::Symbol;
+use nesy_core::Operator;
+use nesy_core::State;
+use nesy_core::Symbol;
 use nesy_core::text::{parse_effects, parse_formula, parse_state_list};
+use nesy_core::{Effect, Formula};
+use nesy_core::{Tier, Vocabulary};
 use serde::Deserialize;
 
 use super::PromptError;

@@ -18,14 +18,14 @@ pub mod examples;
 use std::sync::OnceLock;
 
 use minijinja::{AutoEscape, Environment, UndefinedBehavior};
+use nesy_core::State;
 use nesy_core::adapt::{Feedback, InductionRequest, PatchRequest, ViolationKind};
-use nesy_core::operator::{Operator, format_procedure};
-use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::state::State;
+use nesy_core::{Operator, format_procedure};
+use nesy_core::{Tier, Vocabulary};
 use serde::Serialize;
 
 use crate::context::Embodiment;
-pub use examples::{CodeExample, InductionExample, StateExample};
+use examples::{CodeExample, InductionExample, StateExample};
 
 /// A template file: its name (as templates refer to each other) and its text.
 /// The physical constraints every planning prompt states (one `- ` line each), shared by

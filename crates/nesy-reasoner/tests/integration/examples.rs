@@ -7,14 +7,17 @@
 use std::path::PathBuf;
 
 use nesy_core::Embodiment;
+use nesy_core::State;
+use nesy_core::Symbol;
 use nesy_core::adapt::{TransitionCheck, check_transition};
-use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::state::State;
-use nesy_core::symbol::Symbol;
+use nesy_core::{Tier, Vocabulary};
 use nesy_policy::{EpisodeFactory, EpisodeSpec, Limits, Outcome, SimEpisodes, run_in_process};
 use nesy_reasoner::prompts::examples::{project_operator, project_state};
 use nesy_reasoner::prompts::{Prompts, api_docs};
-use nesy_sim::{ApiCall, ApiError, RobotApi, SceneSpec, Sim, observe};
+use nesy_sim::api::{ApiCall, ApiError, RobotApi};
+use nesy_sim::perception::observer::observe;
+use nesy_sim::scene::SceneSpec;
+use nesy_sim::world::Sim;
 
 fn prompts_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("prompts")

@@ -13,8 +13,8 @@ use nesy_core::adapt::{
     Ablation, AdaptConfig, InductionRequest, PatchRequest, Reasoner, ReasonerError, ViolationKind,
     derive_goal, identify, run,
 };
-use nesy_core::exec::verify_procedure;
-use nesy_core::predicates::{Tier, Vocabulary};
+use nesy_core::verify_procedure;
+use nesy_core::{Tier, Vocabulary};
 use nesy_reasoner::codegen::CodeGenerationRequest;
 use nesy_reasoner::prompts::{Prompts, api_docs};
 use nesy_reasoner::translate::StateTranslationRequest;

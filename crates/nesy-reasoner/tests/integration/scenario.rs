@@ -4,21 +4,21 @@
 
 use std::sync::Arc;
 
+use nesy_core::Atom;
+use nesy_core::State;
+use nesy_core::Symbol;
 use nesy_core::adapt::{AdaptConfig, Demonstration, Target, TaskContext};
-use nesy_core::atom::Atom;
-use nesy_core::predicates::{Tier, Vocabulary};
-use nesy_core::state::State;
-use nesy_core::symbol::Symbol;
+use nesy_core::{Tier, Vocabulary};
 use nesy_reasoner::{KeyframeList, Views};
 use nesy_vlm::Image;
 
-pub const OBJECTS: [&str; 5] = ["floor", "hinge_body", "hinge_lid", "hinge_handle", "apple"];
+pub(crate) const OBJECTS: [&str; 5] = ["floor", "hinge_body", "hinge_lid", "hinge_handle", "apple"];
 
-pub fn state(atoms: &[&str]) -> State {
+pub(crate) fn state(atoms: &[&str]) -> State {
     State::from_atoms(atoms.iter().map(|a| a.parse::<Atom>().unwrap()))
 }
 
-pub fn task(tier: Tier) -> TaskContext {
+pub(crate) fn task(tier: Tier) -> TaskContext {
     TaskContext {
         instruction: "Put the fruits in the hinge box.".into(),
         objects: OBJECTS.iter().map(|o| Symbol::new(o)).collect(),
@@ -27,7 +27,7 @@ pub fn task(tier: Tier) -> TaskContext {
     }
 }
 
-pub fn demo_states() -> Vec<State> {
+pub(crate) fn demo_states() -> Vec<State> {
     let context = ["(OnTopOf hinge_body floor)", "(Open hinge_lid)"];
     let with = |atoms: &[&str]| {
         let mut all: Vec<&str> = atoms.to_vec();
@@ -55,14 +55,14 @@ pub fn demo_states() -> Vec<State> {
     ]
 }
 
-pub fn demo() -> Demonstration {
+pub(crate) fn demo() -> Demonstration {
     Demonstration {
         states: demo_states(),
         task: task(Tier::Full),
     }
 }
 
-pub fn target() -> Target {
+pub(crate) fn target() -> Target {
     Target {
         init: state(&[
             "(Closed hinge_lid)",
@@ -76,7 +76,7 @@ pub fn target() -> Target {
     }
 }
 
-pub fn config() -> AdaptConfig {
+pub(crate) fn config() -> AdaptConfig {
     AdaptConfig {
         budget: 5,
         ..AdaptConfig::default()
@@ -84,7 +84,7 @@ pub fn config() -> AdaptConfig {
 }
 
 /// Five keyframes of three views each (distinct real PNGs).
-pub fn keyframes() -> Arc<KeyframeList> {
+pub(crate) fn keyframes() -> Arc<KeyframeList> {
     let views = (0..5u64)
         .map(|k| Views {
             top: Image::png(nesy_testkit::png(24, 10 * k + 1)).unwrap(),
@@ -97,7 +97,7 @@ pub fn keyframes() -> Arc<KeyframeList> {
 
 // Replies written the way real models answer: prose, markdown, odd bullets.
 
-pub const APPROACH: &str = "**Prediction Rationale:**
+pub(crate) const APPROACH: &str = "**Prediction Rationale:**
 * Between the two states only (GripperSurrounding apple) appeared, so the open gripper was lowered around the apple. It must be open and empty for that.
 
 **Predicted Action:**
@@ -111,7 +111,7 @@ Effect:
 ";
 
 /// Forgets that the apple is no longer merely surrounded: the verifier rejects it.
-pub const GRASP_WRONG: &str = "Looking at the images, the fingers have closed on the apple.
+pub(crate) const GRASP_WRONG: &str = "Looking at the images, the fingers have closed on the apple.
 
 * Prediction Rationale:
 - The gripper closed and now holds the apple.
@@ -127,7 +127,7 @@ Effect:
 - (not (GripperOpen))
 ";
 
-pub const GRASP: &str = "You are right, the apple is held now, not just surrounded.
+pub(crate) const GRASP: &str = "You are right, the apple is held now, not just surrounded.
 
 * Prediction Rationale:
 - The gripper closed on the apple it surrounded; afterwards it holds the apple and no longer just surrounds it.
@@ -144,7 +144,7 @@ Effect:
 - (not (GripperSurrounding apple))
 ";
 
-pub const CARRY: &str = "### Prediction Rationale
+pub(crate) const CARRY: &str = "### Prediction Rationale
 - The held apple left the floor and is now above the hinge box.
 
 ### Predicted Action
@@ -157,7 +157,7 @@ Effect:
 2. (not (OnTopOf apple floor))
 ";
 
-pub const DROP: &str = "* Prediction Rationale:
+pub(crate) const DROP: &str = "* Prediction Rationale:
 - The gripper opened over the box and the apple fell in; this needs the lid open.
 
 * Predicted Action:
@@ -178,7 +178,7 @@ This is the only action consistent with the state difference.
 ";
 
 /// The SEARCH block misremembers a precondition, so it matches nothing.
-pub const PATCH_NO_MATCH: &str = "* Refinement rationale:
+pub(crate) const PATCH_NO_MATCH: &str = "* Refinement rationale:
 - The lid is closed, so the apple cannot be dropped in. Open the lid before picking up the apple.
 
 * Refinement patch:
@@ -205,7 +205,7 @@ MoveGripperToSurroundApple
 ```
 ";
 
-pub const PATCH: &str = "* Refinement rationale:
+pub(crate) const PATCH: &str = "* Refinement rationale:
 - Case 1, missing actions: the lid of the hinge box is closed in this scene, so (Open hinge_lid) fails when the apple is dropped. The gripper is free only before the apple is picked up, so the lid is opened by its handle first and the plan continues as before.
 
 * Refinement patch:
@@ -251,7 +251,7 @@ MoveGripperToSurroundApple
 >>>>>>> REPLACE
 ";
 
-pub const CODE: &str =
+pub(crate) const CODE: &str =
     "Here is a program that follows the summary. It opens the lid first, since the lid starts closed.
 
 ```python
@@ -276,7 +276,7 @@ open_gripper()
 The lid is swung open with `lift_clearance=0.0` so the handle is not pulled out of the grasp.
 ";
 
-pub const TRANSLATION: &str = "From the three views I can see the following:
+pub(crate) const TRANSLATION: &str = "From the three views I can see the following:
 
 - (OnTopOf apple floor)
 - (Closed hinge_lid)

@@ -9,8 +9,8 @@
 //! effects say nothing about which schema it is). The finger schema is returned; the
 //! compiler turns it into the target end effector's calls either way.
 
-use nesy_core::formula::{Effect, Formula};
-use nesy_core::operator::Operator;
+use nesy_core::Operator;
+use nesy_core::{Effect, Formula};
 
 use crate::domain::{SchemaKind as Kind, kind_of, schemas};
 use crate::scene::parts;

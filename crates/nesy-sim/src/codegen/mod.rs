@@ -18,7 +18,7 @@ mod effects;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use nesy_core::operator::Operator;
+use nesy_core::Operator;
 use serde::{Deserialize, Serialize};
 
 use crate::api::Embodiment;
@@ -755,7 +755,7 @@ mod tests {
     #[test]
     fn freely_named_operators_are_recognised_by_their_effects() {
         use nesy_core::Atom;
-        use nesy_core::formula::{AtomPattern, Effect, Formula};
+        use nesy_core::{AtomPattern, Effect, Formula};
         let lit = |p: &str, args: &[&str]| AtomPattern::ground(Atom::new(p, args));
         let holds = |p: &str, args: &[&str]| Formula::Atom(lit(p, args));
         let mut o = objects();

@@ -39,11 +39,11 @@ use crate::api::{Embodiment, TraceEntry};
 use crate::scene::SceneSpec;
 
 /// File name of the manifest.
-pub const MANIFEST_FILE: &str = "manifest.json";
+pub(super) const MANIFEST_FILE: &str = "manifest.json";
 /// Folder of the frames.
-pub const FRAMES_DIR: &str = "frames";
+pub(super) const FRAMES_DIR: &str = "frames";
 /// The manifest format version this build reads and writes.
-pub const MANIFEST_VERSION: u32 = 1;
+pub(super) const MANIFEST_VERSION: u32 = 1;
 
 /// `manifest.json` of a demo folder.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]

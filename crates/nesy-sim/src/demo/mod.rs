@@ -9,10 +9,10 @@
 //! Two storage layouts are read by [`read`]:
 //! - `demo.mcap` (written by [`write_mcap`] / `nesy record`): the topics are listed in
 //!   [`mcap_format`] and in the crate README;
-//! - a folder with `manifest.json` and `frames/NNNN_{top,front,back}.png` ([`folder`]), the
+//! - a folder with `manifest.json` and `frames/NNNN_{top,front,back}.png` ([`read_folder`], [`write_folder`]), the
 //!   path for real-world demos, which have images but no ground-truth states.
 
-pub mod folder;
+mod folder;
 pub mod mcap_format;
 mod record;
 
@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 use crate::api::{Embodiment, TraceEntry};
 use crate::scene::SceneSpec;
 
-pub use folder::{Manifest, ManifestKeyframe, read_folder, write_folder};
+pub use folder::{Manifest, ManifestKeyframe, frame_file_name, manifest_schema, read_folder, write_folder};
 pub use mcap_format::{read_mcap, read_mcap_bytes, write_mcap, write_mcap_file};
 pub use record::{ExpertRun, RecordError, RecordOptions, Recording, record_scene, run_expert};
 

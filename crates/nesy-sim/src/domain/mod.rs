@@ -11,14 +11,14 @@ mod schemas;
 
 use std::sync::OnceLock;
 
-use nesy_core::ParseError;
-use nesy_core::formula::{AtomPattern, Effect, Formula};
-use nesy_core::operator::Operator;
+use nesy_core::Operator;
+use nesy_core::State;
+use nesy_core::Symbol;
+use nesy_core::builtin_predicates;
 use nesy_core::pddl::{Domain, Problem, parse_domain};
-use nesy_core::predicates::builtin_predicates;
-use nesy_core::state::State;
-use nesy_core::symbol::Symbol;
-use nesy_core::types::{TypeError, Universe};
+use nesy_core::text::ParseError;
+use nesy_core::{AtomPattern, Effect, Formula};
+use nesy_core::{TypeError, Universe};
 
 use crate::api::Embodiment;
 

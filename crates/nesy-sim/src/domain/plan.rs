@@ -2,13 +2,13 @@
 //! its actions named the way the offline responder writes them. The offline responder's
 //! patches and the model-free `replan` control plan here.
 
-use nesy_core::formula::Formula;
-use nesy_core::operator::Operator;
+use nesy_core::Formula;
+use nesy_core::Operator;
+use nesy_core::State;
+use nesy_core::Symbol;
+use nesy_core::Universe;
 use nesy_core::planner::{self, PlannerConfig};
-use nesy_core::state::State;
-use nesy_core::symbol::Symbol;
 use nesy_core::text::normalize_action_name;
-use nesy_core::types::Universe;
 use nesy_core::{Atom, apply};
 
 use super::{WorldDomain, semantic};

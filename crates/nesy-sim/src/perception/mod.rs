@@ -4,5 +4,3 @@
 
 pub mod observer;
 pub mod render;
-
-pub use observer::observe;

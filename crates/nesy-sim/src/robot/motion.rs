@@ -15,7 +15,7 @@ use crate::world::rng::Stream;
 use crate::world::{CONTROL_DT, Sim};
 
 /// The quadratic ease-in/out profile of `docs/benchmark.md` §4: `2t²` below ½, `1 − 2(1 − t)²` above.
-pub fn ease(t: f64) -> f64 {
+pub(crate) fn ease(t: f64) -> f64 {
     let t = t.clamp(0.0, 1.0);
     if t < 0.5 {
         2.0 * t * t
@@ -32,7 +32,7 @@ const JOINT_SPEED: f64 = 0.8;
 const MIN_SEGMENT: f64 = 0.25;
 /// Shortest duration of a `move_parallel` (s): the authors' 80 interpolation steps. Pushes
 /// (sweeping) then accelerate gently enough that tall pieces slide instead of tipping.
-pub const PARALLEL_MIN_DURATION: f64 = 0.8;
+pub(crate) const PARALLEL_MIN_DURATION: f64 = 0.8;
 /// Spacing of IK samples along a straight segment (m).
 const SAMPLE_SPACING: f64 = 0.015;
 /// Largest joint change (rad) between consecutive samples of a followed line.
@@ -40,7 +40,7 @@ const MAX_SAMPLE_JUMP: f64 = 0.3;
 /// How many times finer a jumping sample step is tried before the line is given up.
 const MAX_SUBDIVISION: usize = 8;
 /// Control steps the world runs after a motion so objects come to rest.
-pub const MOTION_SETTLE_STEPS: u32 = 20;
+pub(crate) const MOTION_SETTLE_STEPS: u32 = 20;
 /// Gap (m) a transit keeps between the arm (and what it carries) and every loose object.
 const TRANSIT_GAP: f32 = 0.01;
 /// Largest joint step (rad) between two configurations checked along a transit.
@@ -66,7 +66,7 @@ struct Obstacle<'a> {
 
 /// A tool pose to reach: position and orientation goal.
 #[derive(Clone, Copy, Debug)]
-pub struct ToolGoal {
+pub(crate) struct ToolGoal {
     /// Tool point position (world).
     pub position: Vector3<f64>,
     /// Tool orientation (world); for the vacuum only its z axis is enforced.

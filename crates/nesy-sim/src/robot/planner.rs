@@ -17,7 +17,7 @@ use crate::world::rng::Stream;
 
 /// Tuning of [`plan`].
 #[derive(Clone, Copy, Debug)]
-pub struct PlannerOptions {
+pub(crate) struct PlannerOptions {
     /// Longest joint-space step (Euclidean norm, rad) a tree grows by in one extension.
     pub step: f64,
     /// Largest joint change (max norm, rad) between two checked configurations on an edge.
@@ -109,7 +109,12 @@ fn max_delta(a: &[f64], b: &[f64]) -> f64 {
 
 /// Whether every configuration on the straight joint edge `a → b` is valid, checked every
 /// `spacing` rad (max norm) and at `b`; `a` is assumed valid.
-pub fn edge_is_valid(a: &[f64], b: &[f64], spacing: f64, is_valid: &mut impl FnMut(&[f64]) -> bool) -> bool {
+pub(crate) fn edge_is_valid(
+    a: &[f64],
+    b: &[f64],
+    spacing: f64,
+    is_valid: &mut impl FnMut(&[f64]) -> bool,
+) -> bool {
     let steps = (max_delta(a, b) / spacing).ceil().max(1.0) as usize;
     let mut q = vec![0.0; a.len()];
     (1..=steps).all(|k| {
@@ -126,7 +131,7 @@ pub fn edge_is_valid(a: &[f64], b: &[f64], spacing: f64, is_valid: &mut impl FnM
 /// configuration is acceptable (collision-free). `start` and the goals must be valid
 /// themselves; invalid goals are dropped. The path starts at `start`, ends at a goal, and
 /// has been shortcut so it carries no needless detours.
-pub fn plan(
+pub(crate) fn plan(
     start: &[f64],
     goals: &[Vec<f64>],
     limits: &[(f64, f64)],

@@ -9,7 +9,6 @@ mod goals;
 pub mod parts;
 
 pub use goals::{Placement, SubtaskGoal, SubtaskKind};
-pub use parts::Joint;
 
 use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
@@ -441,7 +440,7 @@ impl SceneSpec {
         }
         for (part, q) in &self.articulations {
             let at = format!("articulations.{part}");
-            let Some((lo, hi)) = Joint::from_name(part).map(Joint::limits) else {
+            let Some((lo, hi)) = parts::Joint::from_name(part).map(parts::Joint::limits) else {
                 return Err(SceneError::invalid(
                     at,
                     "one of hinge_lid, top_drawer, bottom_drawer",

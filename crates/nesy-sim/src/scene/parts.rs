@@ -7,7 +7,7 @@
 //! compiler all name them through these constants.
 //!
 //! ```
-//! use nesy_sim::scene::{Joint, parts};
+//! use nesy_sim::scene::parts::{self, Joint};
 //!
 //! assert_eq!(Joint::from_name(parts::HINGE_LID), Some(Joint::HingeLid));
 //! assert_eq!(Joint::HingeLid.limits(), (-0.785, 0.8));

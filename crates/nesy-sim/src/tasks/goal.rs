@@ -21,7 +21,7 @@
 
 use std::sync::{Arc, Mutex, MutexGuard};
 
-pub use nesy_core::metrics::SubtaskResult;
+pub(crate) use nesy_core::metrics::SubtaskResult;
 use nesy_core::metrics::{EpisodeResult, Scoring, achieved_in_time_order};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};

@@ -29,7 +29,7 @@ use std::path::Path;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-pub use nesy_core::benchmark::{Complexity, Factor};
+pub(crate) use nesy_core::benchmark::{Complexity, Factor};
 
 use crate::api::Embodiment;
 use crate::tasks::{GeneratedTask, SubtaskConfig, SubtaskKind, TaskConfig, TaskError};

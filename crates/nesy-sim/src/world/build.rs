@@ -14,7 +14,8 @@ use super::objects::{self, JointBuild, PartBuild, PartMotion, PartRole, Pattern}
 use super::{Articulation, CONTROL_DT, Look, Part, RobotBodies, SUBSTEPS, Sim, SimConfig};
 use crate::robot::kinematics::{Iso, JointKind, Primitive, RobotModel};
 use crate::robot::model;
-use crate::scene::{Joint, ObjectSpec, SceneError, SceneSpec, TABLE_TOP};
+use crate::scene::parts::Joint;
+use crate::scene::{ObjectSpec, SceneError, SceneSpec, TABLE_TOP};
 
 /// Continuous collision detection on every dynamic object: a cube dropped into a box or a
 /// piece pushed at the end of a fast segment must not tunnel through a 3–4 mm wall.

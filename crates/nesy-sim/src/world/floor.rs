@@ -17,7 +17,7 @@ const REGION_Y: (f64, f64) = (-0.15, 0.16);
 /// 0.16 − hy]; free means its padded footprint meets no other object's padded footprint.
 /// The current spot wins if it is free; otherwise the candidate nearest the object's
 /// current position.
-pub fn empty_floor_xy(sim: &Sim, part: usize) -> Option<[f64; 2]> {
+pub(crate) fn empty_floor_xy(sim: &Sim, part: usize) -> Option<[f64; 2]> {
     let me = sim.part_aabb(part);
     let size = me.size();
     let (hx, hy) = (size[0] / 2.0, size[1] / 2.0);

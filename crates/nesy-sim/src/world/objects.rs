@@ -573,8 +573,8 @@ pub fn joint_motion(joint: JointBuild, q: f64) -> Pose {
 
 #[cfg(test)]
 mod tests {
-    use crate::Sim;
     use crate::scene::SceneSpec;
+    use crate::world::Sim;
     use rapier3d::prelude::{Rotation, Vector};
 
     /// A fruit knocked onto its side, rolling slowly as the arm left it: Rapier's implicit

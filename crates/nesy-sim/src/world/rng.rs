@@ -11,7 +11,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
 
 /// A deterministic random stream.
-pub struct Stream {
+pub(crate) struct Stream {
     rng: ChaCha8Rng,
 }
 
@@ -24,7 +24,7 @@ fn tag_hash(tag: &str) -> u64 {
 
 impl Stream {
     /// The stream for `tag` (e.g. `"pick_place/layout"`) and `number` (e.g. a variant).
-    pub fn new(tag: &str, number: u64) -> Stream {
+    pub(crate) fn new(tag: &str, number: u64) -> Stream {
         let mut mixer = SplitMix64::new(tag_hash(tag) ^ number.rotate_left(17) ^ number);
         let mut seed = [0u8; 32];
         for chunk in seed.chunks_exact_mut(8) {
@@ -36,18 +36,18 @@ impl Stream {
     }
 
     /// The next raw 64 bits.
-    pub fn next_u64(&mut self) -> u64 {
+    pub(crate) fn next_u64(&mut self) -> u64 {
         self.rng.next_u64()
     }
 
     /// A float uniformly in `[lo, hi)` (53 random bits).
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+    pub(crate) fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
         let unit = (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         lo + (hi - lo) * unit
     }
 
     /// An index uniformly in `0..n` (`n > 0`), unbiased by rejection.
-    pub fn index(&mut self, n: usize) -> usize {
+    pub(crate) fn index(&mut self, n: usize) -> usize {
         assert!(n > 0, "index() needs a non-empty range");
         let n = n as u64;
         // Largest multiple of n that fits; values at or above it are redrawn.
@@ -61,7 +61,7 @@ impl Stream {
     }
 
     /// Shuffles in place (Fisher–Yates from the back).
-    pub fn shuffle<T>(&mut self, items: &mut [T]) {
+    pub(crate) fn shuffle<T>(&mut self, items: &mut [T]) {
         for i in (1..items.len()).rev() {
             let j = self.index(i + 1);
             items.swap(i, j);
@@ -69,7 +69,7 @@ impl Stream {
     }
 
     /// One element chosen uniformly (`None` for an empty slice).
-    pub fn choose<'a, T>(&mut self, items: &'a [T]) -> Option<&'a T> {
+    pub(crate) fn choose<'a, T>(&mut self, items: &'a [T]) -> Option<&'a T> {
         if items.is_empty() {
             None
         } else {
@@ -78,7 +78,7 @@ impl Stream {
     }
 
     /// `k` distinct indices of `0..n` in the order drawn (`k` is capped at `n`).
-    pub fn sample_indices(&mut self, n: usize, k: usize) -> Vec<usize> {
+    pub(crate) fn sample_indices(&mut self, n: usize, k: usize) -> Vec<usize> {
         let mut pool: Vec<usize> = (0..n).collect();
         let k = k.min(n);
         for i in 0..k {

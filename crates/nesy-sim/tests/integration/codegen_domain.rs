@@ -1,8 +1,8 @@
 //! The template compiler's schema table against `assets/pddl/nesy-world.pddl`, and every
 //! schema compiled on both end effectors.
 
-use nesy_core::operator::Operator;
-use nesy_sim::Embodiment;
+use nesy_core::Embodiment;
+use nesy_core::Operator;
 use nesy_sim::codegen::{compile_policy, resolve_action};
 use nesy_sim::domain::schema_names;
 

@@ -5,8 +5,9 @@ use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::Path;
 
+use nesy_core::Embodiment;
 use nesy_core::State;
-use nesy_sim::api::{ApiCall, ApiValue, Direction, Embodiment, TraceEntry};
+use nesy_sim::api::{ApiCall, ApiValue, Direction, TraceEntry};
 use nesy_sim::demo::mcap_format::{self, ACTION_TOPIC, STATE_TOPIC, image_topic, topics};
 use nesy_sim::demo::{
     CameraImages, CameraName, Demo, DemoError, DemoMetadata, Keyframe, KeyframeViews, RecordOptions,
@@ -139,7 +140,7 @@ fn minimal_real_world_folder_reads_without_ground_truth() {
     .unwrap();
     for k in 0..2 {
         for camera in CameraName::ALL {
-            let name = nesy_sim::demo::folder::frame_file_name(k, camera, false);
+            let name = nesy_sim::demo::frame_file_name(k, camera, false);
             std::fs::write(dir.path().join("frames").join(name), png(k as u8)).unwrap();
         }
     }
@@ -491,7 +492,7 @@ fn fixture_demos_read_and_match_their_tasks() {
         let dir = root.join(name);
         let demo = nesy_sim::demo::read(&dir).unwrap_or_else(|e| panic!("{name}: {e}"));
         let target_scene = target.generate().unwrap().scene;
-        let on_disk = nesy_sim::SceneSpec::from_file(&dir.join("target.json")).unwrap();
+        let on_disk = nesy_sim::scene::SceneSpec::from_file(&dir.join("target.json")).unwrap();
         assert_eq!(on_disk, target_scene, "{name}: target.json is current");
         assert_eq!(demo.metadata.target_scene.as_ref(), Some(&target_scene), "{name}");
         assert_eq!(demo.metadata.instruction, source.instruction());

@@ -9,10 +9,11 @@
 //! such objects.
 
 use nesy_core::Atom;
+use nesy_sim::perception::observer::observe;
 use nesy_sim::scene::SubtaskGoal;
 use nesy_sim::tasks::goal::{EpisodeOutcome, GoalMonitor};
 use nesy_sim::tasks::scenario::{self, Side};
-use nesy_sim::{Sim, observe};
+use nesy_sim::world::Sim;
 
 /// Runs the expert on the source scene of `id`; returns the outcome and the final state.
 fn demonstrate(id: &str) -> (Vec<SubtaskGoal>, EpisodeOutcome, nesy_core::State) {

@@ -5,12 +5,13 @@ use crate::common;
 use std::sync::{Arc, Mutex};
 
 use common::load;
-use nesy_sim::{Direction, RobotApi, Sim, SimHook, TraceEntry};
+use nesy_sim::api::{Direction, RobotApi, TraceEntry};
+use nesy_sim::world::{Sim, SimHook};
 
 fn run(scene: &str) -> (String, Vec<u32>) {
     let mut sim = load(scene);
     sim.move_gripper_to("red_cube", Direction::Down, 0.015).unwrap();
-    let vacuum = sim.embodiment() == nesy_sim::Embodiment::Vacuum;
+    let vacuum = sim.embodiment() == nesy_core::Embodiment::Vacuum;
     if vacuum {
         sim.activate_vacuum().unwrap()
     } else {

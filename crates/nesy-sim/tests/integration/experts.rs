@@ -4,7 +4,7 @@
 //! `expert_sweep` example). The benchmark's target scenes are covered by one scenario per
 //! factor × complexity (episode 00, seed 0); `nesy scenarios sweep` runs all 880 scenes.
 
-use nesy_sim::Embodiment;
+use nesy_core::Embodiment;
 use nesy_sim::scene::SubtaskKind;
 use nesy_sim::tasks::experts::run_scene;
 use nesy_sim::tasks::scenario::{self, Side};

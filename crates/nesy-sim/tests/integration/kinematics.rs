@@ -2,7 +2,7 @@
 //! inverse kinematics accuracy and joint limits over the workspace.
 
 use nalgebra::{Matrix3, Vector3};
-use nesy_sim::Embodiment;
+use nesy_core::Embodiment;
 use nesy_sim::robot::kinematics::{IkOptions, OrientationGoal, pointing_rotation};
 use nesy_sim::robot::model::{HOME_ARM, base_pose, load_model};
 

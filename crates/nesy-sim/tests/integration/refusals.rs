@@ -4,7 +4,10 @@
 use crate::common;
 
 use common::{expect, load, scene_path};
-use nesy_sim::{ApiError, Direction, Embodiment, RobotApi, SceneError, SceneSpec, Sim, SimConfig};
+use nesy_core::Embodiment;
+use nesy_sim::api::{ApiError, Direction, RobotApi};
+use nesy_sim::scene::{SceneError, SceneSpec};
+use nesy_sim::world::{Sim, SimConfig};
 
 fn wrong_embodiment(result: Result<(), ApiError>, call: &str, use_instead: &str, embodiment: Embodiment) {
     match result {

@@ -6,7 +6,8 @@
 
 use std::path::{Path, PathBuf};
 
-use nesy_sim::tasks::scenario::{self, Complexity, CountTable, Factor, Side};
+use nesy_core::benchmark::{Complexity, Factor};
+use nesy_sim::tasks::scenario::{self, CountTable, Side};
 
 fn repo(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(path)
@@ -74,7 +75,7 @@ fn committed_suite_and_schemas_are_current() {
         &repo("assets/schema/scenario.schema.json"),
         &scenario::config_schema(),
     );
-    use nesy_sim::demo::{folder, mcap_format};
+    use nesy_sim::demo::{manifest_schema, mcap_format};
     check_committed(
         &repo("assets/schema/demo-state.schema.json"),
         &mcap_format::state_schema(),
@@ -89,7 +90,7 @@ fn committed_suite_and_schemas_are_current() {
     );
     check_committed(
         &repo("assets/schema/demo-manifest.schema.json"),
-        &folder::manifest_schema(),
+        &manifest_schema(),
     );
 }
 

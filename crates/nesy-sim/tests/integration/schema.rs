@@ -22,8 +22,8 @@ fn fixture_scenes_round_trip_through_the_types() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenes");
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
-        let spec = nesy_sim::SceneSpec::from_file(&path).unwrap();
-        let again = nesy_sim::SceneSpec::from_json_str(&spec.to_json_pretty(), "round trip").unwrap();
+        let spec = nesy_sim::scene::SceneSpec::from_file(&path).unwrap();
+        let again = nesy_sim::scene::SceneSpec::from_json_str(&spec.to_json_pretty(), "round trip").unwrap();
         assert_eq!(spec, again, "{}", path.display());
     }
 }

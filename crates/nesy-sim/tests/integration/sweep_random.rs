@@ -1,9 +1,11 @@
 //! Many small pick-and-place episodes with varied cube poses across the table, on both
 //! robots: every cube must end inside the toy box.
 
+use nesy_core::Embodiment;
 use nesy_core::rng::SplitMix64;
+use nesy_sim::api::{Direction, RobotApi};
 use nesy_sim::scene::{ObjectKind, ObjectSpec, PoseSpec, SceneSpec};
-use nesy_sim::{Direction, Embodiment, RobotApi, Sim};
+use nesy_sim::world::Sim;
 
 /// Test layouts draw from nesy-core's SplitMix64.
 struct Rng(SplitMix64);
@@ -79,7 +81,7 @@ fn episode(embodiment: Embodiment, seed: u64) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     }
     sim.step_idle(50);
-    let state = nesy_sim::observe(&sim).to_string();
+    let state = nesy_sim::perception::observer::observe(&sim).to_string();
     for obj in ["red_cube", "blue_cylinder"] {
         if !state.contains(&format!("(InsideOf {obj} toy_box)")) {
             return Err(format!("{obj} not in the box:\n{state}"));

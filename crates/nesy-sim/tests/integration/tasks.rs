@@ -6,48 +6,49 @@
 use crate::common;
 
 use common::{expect, load};
+use nesy_sim::api::{Direction, RobotApi};
 use nesy_sim::tasks::layout::PUSH_DEPTH_DIVISOR;
-use nesy_sim::{Direction, RobotApi, Sim};
+use nesy_sim::world::Sim;
 
 fn grasp(sim: &mut Sim) {
     match sim.embodiment() {
-        nesy_sim::Embodiment::Finger => sim.close_gripper().unwrap(),
-        nesy_sim::Embodiment::Vacuum => sim.activate_vacuum().unwrap(),
+        nesy_core::Embodiment::Finger => sim.close_gripper().unwrap(),
+        nesy_core::Embodiment::Vacuum => sim.activate_vacuum().unwrap(),
     }
 }
 
 fn release(sim: &mut Sim) {
     match sim.embodiment() {
-        nesy_sim::Embodiment::Finger => sim.open_gripper().unwrap(),
-        nesy_sim::Embodiment::Vacuum => sim.deactivate_vacuum().unwrap(),
+        nesy_core::Embodiment::Finger => sim.open_gripper().unwrap(),
+        nesy_core::Embodiment::Vacuum => sim.deactivate_vacuum().unwrap(),
     }
 }
 
 fn grab_handle(sim: &mut Sim, handle: &str) {
     sim.move_gripper_to(handle, Direction::Down, 0.0).unwrap();
     match sim.embodiment() {
-        nesy_sim::Embodiment::Finger => sim.grasp_handle(handle).unwrap(),
-        nesy_sim::Embodiment::Vacuum => sim.attach_vacuum_handle(handle).unwrap(),
+        nesy_core::Embodiment::Finger => sim.grasp_handle(handle).unwrap(),
+        nesy_core::Embodiment::Vacuum => sim.attach_vacuum_handle(handle).unwrap(),
     }
 }
 
 fn let_go_handle(sim: &mut Sim) {
     match sim.embodiment() {
-        nesy_sim::Embodiment::Finger => sim.release_handle().unwrap(),
-        nesy_sim::Embodiment::Vacuum => sim.detach_vacuum_handle().unwrap(),
+        nesy_core::Embodiment::Finger => sim.release_handle().unwrap(),
+        nesy_core::Embodiment::Vacuum => sim.detach_vacuum_handle().unwrap(),
     }
 }
 
 /// Predicate names for the embodiment: (open, closed, holding, surrounding).
 fn names(sim: &Sim) -> (&'static str, &'static str, &'static str, &'static str) {
     match sim.embodiment() {
-        nesy_sim::Embodiment::Finger => (
+        nesy_core::Embodiment::Finger => (
             "GripperOpen",
             "GripperClosed",
             "GripperHolding",
             "GripperSurrounding",
         ),
-        nesy_sim::Embodiment::Vacuum => (
+        nesy_core::Embodiment::Vacuum => (
             "VacuumInactive",
             "VacuumActive",
             "VacuumAttached",
@@ -251,7 +252,7 @@ fn hinge(scene: &str) {
     let body = sim.get_obj_pos("hinge_body").unwrap();
     let top = sim.get_obj_bbox("hinge_body").unwrap()[1][2];
     // Suction holds the fruit by its top, the fingers by its middle.
-    let hang = if sim.embodiment() == nesy_sim::Embodiment::Vacuum {
+    let hang = if sim.embodiment() == nesy_core::Embodiment::Vacuum {
         h
     } else {
         h / 2.0
@@ -296,7 +297,7 @@ fn open_the_hinge_lid_drop_a_fruit_close_it_vacuum() {
 
 fn sweep(scene: &str) {
     let mut sim = load(scene);
-    let vacuum = sim.embodiment() == nesy_sim::Embodiment::Vacuum;
+    let vacuum = sim.embodiment() == nesy_core::Embodiment::Vacuum;
     expect(
         &sim,
         "reset",
@@ -373,7 +374,7 @@ fn unstack(scene: &str) {
         (0.11..=0.53).contains(&x) && (-0.15..=0.16).contains(&y),
         "{x} {y}"
     );
-    let hang = if sim.embodiment() == nesy_sim::Embodiment::Vacuum {
+    let hang = if sim.embodiment() == nesy_core::Embodiment::Vacuum {
         h
     } else {
         h / 2.0
@@ -410,12 +411,12 @@ fn unstack_onto_an_empty_floor_spot_vacuum() {
 
 /// All four subtasks at the benchmark's composite offsets (pick_place at (0.35, 0.2), sweep at
 /// (0.35, −0.2), hinge at (0.65, 0.2), a reflected drawer cabinet at (0.65, −0.2)).
-fn composite(embodiment: nesy_sim::Embodiment) {
+fn composite(embodiment: nesy_core::Embodiment) {
     let text = std::fs::read_to_string(common::scene_path("composite_all_finger")).unwrap();
-    let mut spec = nesy_sim::SceneSpec::from_json_str(&text, "composite").unwrap();
+    let mut spec = nesy_sim::scene::SceneSpec::from_json_str(&text, "composite").unwrap();
     spec.embodiment = embodiment;
     let mut sim = Sim::new(&spec).unwrap();
-    let vacuum = embodiment == nesy_sim::Embodiment::Vacuum;
+    let vacuum = embodiment == nesy_core::Embodiment::Vacuum;
     let hang = |sim: &mut Sim, obj: &str| {
         let h = sim.get_obj_size(obj).unwrap()[2];
         if vacuum { h } else { h / 2.0 }
@@ -574,25 +575,25 @@ fn composite(embodiment: nesy_sim::Embodiment) {
 
 #[test]
 fn all_four_subtasks_at_composite_offsets_finger() {
-    composite(nesy_sim::Embodiment::Finger);
+    composite(nesy_core::Embodiment::Finger);
 }
 
 #[test]
 fn all_four_subtasks_at_composite_offsets_vacuum() {
-    composite(nesy_sim::Embodiment::Vacuum);
+    composite(nesy_core::Embodiment::Vacuum);
 }
 
 /// Obstruction level 1 of the sweep: a piece in the wrong box is lifted back onto the board,
 /// then swept into the right one.
-fn wrong_box_piece(embodiment: nesy_sim::Embodiment) {
+fn wrong_box_piece(embodiment: nesy_core::Embodiment) {
     let text = std::fs::read_to_string(common::scene_path("sweep_finger")).unwrap();
-    let mut spec = nesy_sim::SceneSpec::from_json_str(&text, "sweep").unwrap();
+    let mut spec = nesy_sim::scene::SceneSpec::from_json_str(&text, "sweep").unwrap();
     spec.embodiment = embodiment;
     // The white rook starts in the right (black) box.
     spec.objects[3].pose.position = [0.46, 0.087, 0.503];
     let mut sim = Sim::new(&spec).unwrap();
     expect(&sim, "reset", &["(InsideOf white_rook right_chess_box)"], &[]);
-    let vacuum = embodiment == nesy_sim::Embodiment::Vacuum;
+    let vacuum = embodiment == nesy_core::Embodiment::Vacuum;
     let h = sim.get_obj_size("white_rook").unwrap()[2];
     sim.move_gripper_to("white_rook", Direction::Down, h / 2.0)
         .unwrap();
@@ -627,18 +628,18 @@ fn wrong_box_piece(embodiment: nesy_sim::Embodiment) {
 
 #[test]
 fn a_piece_in_the_wrong_box_is_moved_back_and_swept_finger() {
-    wrong_box_piece(nesy_sim::Embodiment::Finger);
+    wrong_box_piece(nesy_core::Embodiment::Finger);
 }
 
 #[test]
 fn a_piece_in_the_wrong_box_is_moved_back_and_swept_vacuum() {
-    wrong_box_piece(nesy_sim::Embodiment::Vacuum);
+    wrong_box_piece(nesy_core::Embodiment::Vacuum);
 }
 
 /// Obstruction level 2 of the hinge: a fruit on the closed lid is moved to the floor first.
-fn fruit_on_lid(embodiment: nesy_sim::Embodiment) {
+fn fruit_on_lid(embodiment: nesy_core::Embodiment) {
     let text = std::fs::read_to_string(common::scene_path("hinge_finger")).unwrap();
-    let mut spec = nesy_sim::SceneSpec::from_json_str(&text, "hinge").unwrap();
+    let mut spec = nesy_sim::scene::SceneSpec::from_json_str(&text, "hinge").unwrap();
     spec.embodiment = embodiment;
     spec.objects[1].pose.position = [0.525, 0.02, 0.627];
     let mut sim = Sim::new(&spec).unwrap();
@@ -648,7 +649,7 @@ fn fruit_on_lid(embodiment: nesy_sim::Embodiment) {
         &["(OnTopOf apple hinge_lid)", "(Closed hinge_lid)"],
         &[],
     );
-    let vacuum = embodiment == nesy_sim::Embodiment::Vacuum;
+    let vacuum = embodiment == nesy_core::Embodiment::Vacuum;
     let h = sim.get_obj_size("apple").unwrap()[2];
     sim.move_gripper_to("apple", Direction::Down, h / 2.0).unwrap();
     grasp(&mut sim);
@@ -674,12 +675,12 @@ fn fruit_on_lid(embodiment: nesy_sim::Embodiment) {
 
 #[test]
 fn a_fruit_on_the_lid_is_moved_away_before_opening_finger() {
-    fruit_on_lid(nesy_sim::Embodiment::Finger);
+    fruit_on_lid(nesy_core::Embodiment::Finger);
 }
 
 #[test]
 fn a_fruit_on_the_lid_is_moved_away_before_opening_vacuum() {
-    fruit_on_lid(nesy_sim::Embodiment::Vacuum);
+    fruit_on_lid(nesy_core::Embodiment::Vacuum);
 }
 
 #[test]

@@ -5,11 +5,12 @@
 //! pre-shaped grasp. (The earlier regression scenes are held to the same check where they
 //! live: `grip_high_00_s0` in `demo_goal.rs`, the benchmark scenes in `experts.rs`.)
 
+use nesy_core::Embodiment;
 use nesy_sim::api::RobotApi;
 use nesy_sim::scene::SceneSpec;
 use nesy_sim::tasks::experts::run_scene;
 use nesy_sim::tasks::scenario::{self, Side};
-use nesy_sim::{Embodiment, Sim};
+use nesy_sim::world::Sim;
 
 /// The expert on one side of a benchmark scenario: full success, nothing displaced.
 #[track_caller]

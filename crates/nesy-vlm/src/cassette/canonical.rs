@@ -21,12 +21,12 @@ pub(crate) struct FoundImage {
 
 impl FoundImage {
     /// The string that replaces the data URL in a stored body.
-    pub fn reference(&self) -> String {
+    pub(crate) fn reference(&self) -> String {
         format!("{BLOB_SCHEME}{}.{}", self.sha256, self.ext)
     }
 
     /// The blob's file name under `blobs/`.
-    pub fn file_name(&self) -> String {
+    pub(crate) fn file_name(&self) -> String {
         format!("{}.{}", self.sha256, self.ext)
     }
 }

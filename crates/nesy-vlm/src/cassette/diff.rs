@@ -21,7 +21,7 @@ pub struct JsonDiff {
 }
 
 /// Every leaf-level difference between two JSON values.
-pub fn json_diff(recorded: &Value, requested: &Value) -> Vec<JsonDiff> {
+pub(crate) fn json_diff(recorded: &Value, requested: &Value) -> Vec<JsonDiff> {
     let mut out = Vec::new();
     walk(Some(recorded), Some(requested), &mut String::new(), &mut out);
     out

@@ -24,12 +24,13 @@ use crate::error::{TransportError, VlmError};
 use crate::secret::SecretString;
 use crate::transport::{BoxFuture, Origin, Transport, WireRequest, WireResponse};
 
-pub mod canonical;
-pub mod diff;
-pub mod format;
+mod canonical;
+mod diff;
+mod format;
 pub mod tools;
 
-pub use diff::{CassetteMiss, JsonDiff, MissReason, NearMatch, json_diff};
+pub(crate) use diff::json_diff;
+pub use diff::{CassetteMiss, JsonDiff, MissReason, NearMatch};
 pub use format::{
     CassetteFile, CassetteMeta, Interaction, SCHEMA_VERSION, StoredRequest, StoredResponse, blobs_dir,
 };

@@ -13,9 +13,9 @@ use bytes::Bytes;
 use crate::error::{TransportError, VlmError};
 use crate::request::TaskContext;
 
-pub mod http;
+mod http;
 
-pub use http::HttpTransport;
+pub use http::{Auth, HttpTransport};
 
 /// A boxed, sendable future, so [`Transport`] stays object-safe (`Arc<dyn Transport>`).
 pub type BoxFuture<'a, T> = Pin<Box<dyn Future<Output = T> + Send + 'a>>;
@@ -52,7 +52,7 @@ pub enum Origin {
 pub struct WireResponse {
     /// HTTP status code.
     pub status: u16,
-    /// Allowlisted headers only (see [`ALLOWED_HEADERS`]), names lower-case, in order.
+    /// Allowlisted headers only (content type, request ids, rate-limit and retry headers), names lower-case, in order.
     pub headers: Vec<(String, String)>,
     /// The body bytes, unmodified.
     pub body: Bytes,
@@ -104,7 +104,7 @@ impl fmt::Debug for WireResponse {
 
 /// Response headers that may be kept, passed up and recorded. Everything else is dropped at
 /// the transport, so credentials and cookies can never reach a log or a cassette.
-pub const ALLOWED_HEADERS: &[&str] = &[
+pub(crate) const ALLOWED_HEADERS: &[&str] = &[
     "content-type",
     "x-request-id",
     "apim-request-id",
@@ -122,7 +122,7 @@ pub const ALLOWED_HEADERS: &[&str] = &[
 ];
 
 /// Whether a header name is on the allowlist.
-pub fn is_allowed_header(name: &str) -> bool {
+pub(crate) fn is_allowed_header(name: &str) -> bool {
     ALLOWED_HEADERS
         .iter()
         .any(|allowed| allowed.eq_ignore_ascii_case(name))

@@ -5,11 +5,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use nesy_vlm::cassette::{CassetteFile, tools};
 use nesy_vlm::{
     BackendKind, CassetteError, CassetteMode, CassetteOptions, CassetteTransport, ChatRequest, Image,
     Message, Origin, Part, SecretString, TaskContext, Transport, VlmClient, VlmConfig, VlmError,
 };
+use nesy_vlm::{CassetteFile, cassette_tools as tools};
 use serde_json::json;
 use wiremock::matchers::method;
 use wiremock::{Mock, MockServer, ResponseTemplate};

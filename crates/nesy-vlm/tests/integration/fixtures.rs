@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use nesy_vlm::cassette::tools;
+use nesy_vlm::cassette_tools as tools;
 use nesy_vlm::{BackendKind, CassetteMode, CassetteSettings, ChatRequest, Image, Message, Part, VlmClient};
 
 fn fixtures_dir() -> PathBuf {

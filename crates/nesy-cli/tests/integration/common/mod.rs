@@ -1,7 +1,7 @@
 //! Helpers shared by the `nesy adapt` tests.
 #![allow(dead_code)]
 
-pub mod realstyle;
+pub(crate) mod realstyle;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -10,13 +10,13 @@ use nesy_sim::demo::{RecordOptions, record_scene, write_mcap_file};
 use nesy_sim::scene::SceneSpec;
 
 /// The workspace root.
-pub fn workspace() -> PathBuf {
+pub(crate) fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
 /// A scratch directory; kept under `$NESY_TEST_KEEP/<random>` when that variable is set
 /// (to look at a run's outputs), else removed when dropped.
-pub fn scratch() -> tempfile::TempDir {
+pub(crate) fn scratch() -> tempfile::TempDir {
     match std::env::var_os("NESY_TEST_KEEP") {
         Some(root) => {
             std::fs::create_dir_all(&root).expect("creating $NESY_TEST_KEEP");
@@ -30,12 +30,12 @@ pub fn scratch() -> tempfile::TempDir {
 }
 
 /// Runs the `nesy` binary with `args`, without any VLM settings from the environment.
-pub fn nesy(args: &[String]) -> Output {
+pub(crate) fn nesy(args: &[String]) -> Output {
     nesy_with_env(args, &[])
 }
 
 /// Runs the `nesy` binary with `args` and only the VLM settings of `env` (`(name, value)`).
-pub fn nesy_with_env(args: &[String], env: &[(&str, &str)]) -> Output {
+pub(crate) fn nesy_with_env(args: &[String], env: &[(&str, &str)]) -> Output {
     let mut command = Command::new(env!("CARGO_BIN_EXE_nesy"));
     command.args(args).current_dir(workspace());
     for (key, _) in std::env::vars() {
@@ -48,7 +48,7 @@ pub fn nesy_with_env(args: &[String], env: &[(&str, &str)]) -> Output {
 }
 
 /// Records the expert's demo of `scene` into `out` (MCAP) with `size`-pixel views.
-pub fn record_demo(scene: &Path, out: &Path, size: u32) {
+pub(crate) fn record_demo(scene: &Path, out: &Path, size: u32) {
     let spec = SceneSpec::from_file(scene).expect("scene");
     let recording = record_scene(
         &spec,
@@ -65,7 +65,7 @@ pub fn record_demo(scene: &Path, out: &Path, size: u32) {
 /// An operator-induction reply, in a chatty model's style, derived from the "State
 /// difference" section of an induction prompt: the preconditions are the atoms the step
 /// removed (they held before it), the effects are the difference. The verifier accepts it.
-pub fn operator_from_diff(user: &str, n: usize) -> String {
+pub(crate) fn operator_from_diff(user: &str, n: usize) -> String {
     let section = user.rsplit("- State difference:").next().unwrap_or("");
     let mut pre = Vec::new();
     let mut eff = Vec::new();
@@ -99,7 +99,7 @@ pub fn operator_from_diff(user: &str, n: usize) -> String {
 
 /// The text of a chat message as a server receives it: a string, or the text parts of a
 /// multi-part content joined by newlines.
-pub fn message_text(message: &serde_json::Value) -> String {
+pub(crate) fn message_text(message: &serde_json::Value) -> String {
     match &message["content"] {
         serde_json::Value::String(s) => s.clone(),
         serde_json::Value::Array(parts) => parts

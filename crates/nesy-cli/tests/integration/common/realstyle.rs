@@ -14,7 +14,7 @@ use nesy_vlm::{BoxFuture, Origin, Transport, TransportError, WireRequest, WireRe
 use serde_json::json;
 
 /// The model name the cassette records (honest: these are not a model's answers).
-pub const MODEL: &str = "hand-written-replies";
+pub(crate) const MODEL: &str = "hand-written-replies";
 
 const APPROACH_CYLINDER: &str = "Looking at the before/after images, the fingers are now around the red cylinder, which still stands on the table.
 
@@ -306,7 +306,7 @@ release_handle()
 Explanation: the drawer is opened first because it is closed in this scene; the direction is worked out from where the handle sits relative to the cabinet, so the same program works for a mirrored layout. The cylinder is lowered by half its height before grasping, released above the drawer's centre, and the drawer is pushed back closed.";
 
 /// The reply for one request, by task.
-pub fn reply(task: &VlmTask) -> Result<&'static str, String> {
+pub(crate) fn reply(task: &VlmTask) -> Result<&'static str, String> {
     match task {
         VlmTask::Induction(c) => Ok(match (c.request.step, c.request.attempt) {
             (0, _) => APPROACH_CYLINDER,
@@ -332,7 +332,7 @@ pub fn reply(task: &VlmTask) -> Result<&'static str, String> {
 
 /// Serves [`reply`] as chat completions.
 #[derive(Debug, Default)]
-pub struct HandWritten;
+pub(crate) struct HandWritten;
 
 impl Transport for HandWritten {
     fn send<'a>(&'a self, request: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {

@@ -3,54 +3,54 @@
 
 #![allow(dead_code)]
 
-use nesy_core::formula::{AtomPattern, Effect, Formula, Term, TypedVar};
 use nesy_core::rng::SplitMix64;
 use nesy_core::{Atom, Operator, State, Symbol};
+use nesy_core::{AtomPattern, Effect, Formula, Term, TypedVar};
 
 /// The test generators' source of randomness: nesy-core's SplitMix64 with a few helpers.
-pub struct SeedRng(pub SplitMix64);
+pub(crate) struct SeedRng(pub SplitMix64);
 
 impl SeedRng {
-    pub fn new(seed: u64) -> SeedRng {
+    pub(crate) fn new(seed: u64) -> SeedRng {
         SeedRng(SplitMix64::new(seed))
     }
 
-    pub fn below(&mut self, n: usize) -> usize {
+    pub(crate) fn below(&mut self, n: usize) -> usize {
         self.0.below(n)
     }
 
-    pub fn chance(&mut self, percent: u64) -> bool {
+    pub(crate) fn chance(&mut self, percent: u64) -> bool {
         (self.0.below(100) as u64) < percent
     }
 
-    pub fn word(&mut self, items: &[&'static str]) -> &'static str {
+    pub(crate) fn word(&mut self, items: &[&'static str]) -> &'static str {
         items[self.below(items.len())]
     }
 
-    pub fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
+    pub(crate) fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
         &items[self.below(items.len())]
     }
 }
 
 /// Predicates with their arities.
-pub const PREDS: &[(&str, usize)] = &[
+pub(crate) const PREDS: &[(&str, usize)] = &[
     ("OnTopOf", 2),
     ("Open", 1),
     ("GripperOpen", 0),
     ("GripperHolding", 1),
     ("InsideOf", 2),
 ];
-pub const OBJECTS: &[&str] = &["a", "b", "orange", "hinge_lid"];
+pub(crate) const OBJECTS: &[&str] = &["a", "b", "orange", "hinge_lid"];
 /// `x` and `xy` on purpose: a binding of `?x` must never touch `?xy`.
-pub const VARS: &[&str] = &["x", "xy", "y"];
+pub(crate) const VARS: &[&str] = &["x", "xy", "y"];
 
-pub fn ground_atom(rng: &mut SeedRng) -> Atom {
+pub(crate) fn ground_atom(rng: &mut SeedRng) -> Atom {
     let (p, n) = *rng.pick(PREDS);
     let args: Vec<&str> = (0..n).map(|_| *rng.pick(OBJECTS)).collect();
     Atom::new(p, &args)
 }
 
-pub fn state(rng: &mut SeedRng, max: usize) -> State {
+pub(crate) fn state(rng: &mut SeedRng, max: usize) -> State {
     let n = rng.below(max + 1);
     State::from_atoms((0..n).map(|_| ground_atom(rng)))
 }
@@ -63,7 +63,7 @@ fn term(rng: &mut SeedRng, scope: &[Symbol]) -> Term {
     }
 }
 
-pub fn pattern(rng: &mut SeedRng, scope: &[Symbol]) -> AtomPattern {
+pub(crate) fn pattern(rng: &mut SeedRng, scope: &[Symbol]) -> AtomPattern {
     let (p, n) = *rng.pick(PREDS);
     AtomPattern {
         pred: Symbol::new(p),
@@ -86,7 +86,7 @@ fn vars(rng: &mut SeedRng) -> Vec<TypedVar> {
     out
 }
 
-pub fn formula(rng: &mut SeedRng, depth: usize, scope: &mut Vec<Symbol>) -> Formula {
+pub(crate) fn formula(rng: &mut SeedRng, depth: usize, scope: &mut Vec<Symbol>) -> Formula {
     let leaf = depth == 0 || rng.chance(35);
     if leaf {
         return if rng.chance(10) {
@@ -126,7 +126,7 @@ pub fn formula(rng: &mut SeedRng, depth: usize, scope: &mut Vec<Symbol>) -> Form
     }
 }
 
-pub fn effect(rng: &mut SeedRng, depth: usize, scope: &mut Vec<Symbol>) -> Effect {
+pub(crate) fn effect(rng: &mut SeedRng, depth: usize, scope: &mut Vec<Symbol>) -> Effect {
     if depth == 0 || rng.chance(60) {
         return if rng.chance(50) {
             Effect::Add(pattern(rng, scope))
@@ -154,7 +154,7 @@ pub fn effect(rng: &mut SeedRng, depth: usize, scope: &mut Vec<Symbol>) -> Effec
     }
 }
 
-pub fn operator(rng: &mut SeedRng, name: &str) -> Operator {
+pub(crate) fn operator(rng: &mut SeedRng, name: &str) -> Operator {
     let pre: Vec<_> = (0..rng.below(4))
         .map(|_| formula(rng, 3, &mut Vec::new()))
         .collect();
@@ -164,7 +164,7 @@ pub fn operator(rng: &mut SeedRng, name: &str) -> Operator {
     Operator::new(name, pre, eff)
 }
 
-pub fn procedure(rng: &mut SeedRng, max: usize) -> Vec<Operator> {
+pub(crate) fn procedure(rng: &mut SeedRng, max: usize) -> Vec<Operator> {
     let names = [
         "MoveGripperToSurroundOrange",
         "GraspOrange",

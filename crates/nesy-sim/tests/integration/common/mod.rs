@@ -3,23 +3,24 @@
 
 use std::path::PathBuf;
 
-use nesy_sim::{Sim, observe};
+use nesy_sim::perception::observer::observe;
+use nesy_sim::world::Sim;
 
 /// Path of a scene fixture.
-pub fn scene_path(name: &str) -> PathBuf {
+pub(crate) fn scene_path(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../fixtures/scenes")
         .join(format!("{name}.json"))
 }
 
 /// Builds the world of a scene fixture.
-pub fn load(name: &str) -> Sim {
+pub(crate) fn load(name: &str) -> Sim {
     Sim::from_file(&scene_path(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 /// Asserts that the observed state holds every `present` atom and none of `absent`.
 #[track_caller]
-pub fn expect(sim: &Sim, step: &str, present: &[&str], absent: &[&str]) {
+pub(crate) fn expect(sim: &Sim, step: &str, present: &[&str], absent: &[&str]) {
     let state = observe(sim).to_string();
     let atoms: Vec<&str> = state.lines().map(|l| l.trim_start_matches("- ")).collect();
     for p in present {
