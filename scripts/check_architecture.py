@@ -56,7 +56,7 @@ PYO3_OWNER = "nesy-policy"
 DEV_ONLY = "nesy-testkit"
 
 # Crates whose files import each other in no circle.
-ACYCLIC = ["nesy-sim", "nesy-input", "nesy-reasoner", "nesy-oracle", "nesy-pipeline", "nesy-baselines",
+ACYCLIC = ["nesy-sim", "nesy-input", "nesy-reasoner", "nesy-oracle", "nesy-pipeline", "nesy-baselines", "nesy-bench",
            "nesy-cli", "nesy-testkit"]
 
 # Source rules: crate -> [(pattern, why)].

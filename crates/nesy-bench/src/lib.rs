@@ -12,9 +12,9 @@
 //! - [`demos`]: each scenario's demonstration recorded once, keyed by the scenario and the
 //!   simulator's fingerprint.
 //! - [`Shard`], [`merge`]: job arrays and their merge; [`slurm`] writes the `sbatch` file.
-//! - [`plan`]: model calls and images per method and cell, before any call.
+//! - [`call_budget`]: model calls and images per method and cell, before any call.
 //! - [`report`]: `report.md`, `tables/*.csv` and PNG plots.
-//! - [`study`]: the ablation and robustness studies, each a set of variants under one
+//! - [`studies`]: the ablation and robustness studies, each a set of variants under one
 //!   stated error model, reported in the shape of the paper's Table 3 and Table 8.
 //!
 //! Offline, no number is a method's performance: the reference responder bounds NeSyCR
@@ -24,13 +24,15 @@
 //!
 //! ```
 //! use nesy_bench::Variant;
+//! use nesy_bench::methods::parse_variants;
 //!
-//! let variants = Variant::parse_list("nesycr,nesycr+verification=off,replan").unwrap();
+//! let variants = parse_variants("nesycr,nesycr+verification=off,replan").unwrap();
 //! assert_eq!(variants[1].method, "nesycr");
 //! assert_eq!(variants[1].option("verification"), Some("off"));
 //! assert!(Variant::parse("nesycr+verification").is_err());
 //! ```
 
+pub mod call_budget;
 pub mod demos;
 mod error;
 pub mod harness;
@@ -38,19 +40,20 @@ pub mod manifest;
 pub mod merge;
 pub mod meter;
 pub mod methods;
-pub mod plan;
 pub mod pool;
-mod record;
 pub mod report;
 mod shard;
 pub mod slurm;
+mod status;
 pub mod store;
-pub mod study;
+pub mod studies;
 mod unit;
+mod unit_record;
 mod variant;
 
 pub use error::BenchError;
-pub use record::{UnitRecord, UnitStatus};
 pub use shard::Shard;
+pub use status::UnitStatus;
 pub use unit::Selection;
+pub use unit_record::UnitRecord;
 pub use variant::Variant;

@@ -146,7 +146,7 @@ pub struct Manifest {
     pub variants: Vec<VariantEntry>,
     /// The study the variants make up, if the run is one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub study: Option<crate::study::Study>,
+    pub study: Option<crate::studies::Study>,
     /// Every unit, in stable order.
     pub units: Vec<UnitKey>,
     /// The run whose specifications this run re-executes (phase B only), if any.
@@ -176,7 +176,7 @@ impl Manifest {
             settings: &'a RunSettings,
             variants: &'a [VariantEntry],
             #[serde(skip_serializing_if = "Option::is_none")]
-            study: Option<crate::study::Study>,
+            study: Option<crate::studies::Study>,
             units: &'a [UnitKey],
             reexecutes: &'a Option<PathBuf>,
         }

@@ -9,7 +9,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::error::BenchError;
-use crate::record::UnitRecord;
+use crate::unit_record::UnitRecord;
 
 /// The results folder of a run.
 pub fn results_dir(run: &Path) -> PathBuf {
@@ -147,8 +147,9 @@ pub(crate) mod tests {
     use nesy_core::benchmark::{Complexity, Factor};
 
     use super::*;
-    use crate::record::{Effort, Scores, UnitStatus};
+    use crate::status::UnitStatus;
     use crate::unit::UnitKey;
+    use crate::unit_record::{Effort, Scores};
 
     pub(crate) fn record(scenario: &str, variant: &str, status: UnitStatus, sr: f64) -> UnitRecord {
         UnitRecord {

@@ -70,28 +70,6 @@ impl Variant {
         })
     }
 
-    /// Parses a comma-separated list of variants. Commas inside a setting's value are not
-    /// supported; noise settings use `,` and therefore `;` between knobs (see
-    /// [`Variant::option`]). The item `all` stands for [`crate::methods::table_methods`].
-    pub fn parse_list(text: &str) -> Result<Vec<Variant>, BenchError> {
-        let mut variants: Vec<Variant> = Vec::new();
-        for item in text.split(',').filter(|s| !s.trim().is_empty()) {
-            if item.trim() == "all" {
-                for name in crate::methods::table_methods() {
-                    variants.push(Variant::parse(name)?);
-                }
-            } else {
-                variants.push(Variant::parse(item)?);
-            }
-        }
-        if variants.is_empty() {
-            return Err(BenchError::Usage(
-                "no variant given (e.g. --methods nesycr,imitation)".into(),
-            ));
-        }
-        Ok(variants)
-    }
-
     /// A setting's value.
     pub fn option(&self, key: &str) -> Option<&str> {
         self.options.get(key).map(String::as_str)
@@ -145,6 +123,13 @@ pub(crate) fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// The noise knobs of a variant's `noise` setting (`;` or `,` between knobs).
+pub(crate) fn noise_of(spec: &str) -> Result<nesy_oracle::OracleNoise, BenchError> {
+    spec.replace(';', ",")
+        .parse()
+        .map_err(|e| BenchError::Usage(format!("noise={spec:?}: {e}")))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -158,26 +143,7 @@ mod tests {
         let noisy = Variant::parse("nesycr+noise=op-drop=0.1;op-flip=0.05").unwrap();
         assert_eq!(noisy.option("noise"), Some("op-drop=0.1;op-flip=0.05"));
         assert!(Variant::parse("").is_err());
-        let all: Vec<String> = Variant::parse_list("all,imitation")
-            .unwrap()
-            .iter()
-            .map(|v| v.id())
-            .collect();
-        assert_eq!(
-            all,
-            [
-                "nesycr",
-                "demo2code",
-                "gpt4v-robotics",
-                "critic-v",
-                "morevqa",
-                "statler",
-                "llm-dm",
-                "imitation"
-            ]
-        );
         assert!(Variant::parse("nesycr+bad").is_err());
         assert!(Variant::parse("nesycr+a=1+a=2").is_err());
-        assert_eq!(Variant::parse_list("nesycr, imitation").unwrap().len(), 2);
     }
 }

@@ -22,7 +22,7 @@ use super::{
     check_keys,
 };
 use crate::error::BenchError;
-use crate::record::UnitStatus;
+use crate::status::UnitStatus;
 use crate::variant::Variant;
 
 /// A baseline as a harness method.

@@ -25,7 +25,7 @@ use nesy_vlm::VlmClient;
 use serde::Serialize;
 
 use crate::error::BenchError;
-use crate::record::UnitStatus;
+use crate::status::UnitStatus;
 use crate::variant::Variant;
 
 pub use baselines::BaselineMethod;
@@ -258,6 +258,28 @@ pub fn table_methods() -> Vec<&'static str> {
         .collect()
 }
 
+/// Parses a comma-separated list of variants. Commas inside a setting's value are not
+/// supported; noise settings use `,` and therefore `;` between knobs (see
+/// [`Variant::option`]). The item `all` stands for [`table_methods`].
+pub fn parse_variants(text: &str) -> Result<Vec<Variant>, BenchError> {
+    let mut variants: Vec<Variant> = Vec::new();
+    for item in text.split(',').filter(|s| !s.trim().is_empty()) {
+        if item.trim() == "all" {
+            for name in table_methods() {
+                variants.push(Variant::parse(name)?);
+            }
+        } else {
+            variants.push(Variant::parse(item)?);
+        }
+    }
+    if variants.is_empty() {
+        return Err(BenchError::Usage(
+            "no variant given (e.g. --methods nesycr,imitation)".into(),
+        ));
+    }
+    Ok(variants)
+}
+
 /// The method of a name.
 pub fn find(name: &str) -> Result<Arc<dyn Method>, BenchError> {
     registry()
@@ -301,5 +323,34 @@ pub(crate) fn switch(variant: &Variant, key: &str, default: bool) -> Result<bool
         Some(other) => Err(BenchError::Usage(format!(
             "variant {variant}: {key}={other:?}; expected on or off"
         ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn all_stands_for_the_table_methods_in_order() {
+        let all: Vec<String> = parse_variants("all,imitation")
+            .unwrap()
+            .iter()
+            .map(|v| v.id())
+            .collect();
+        assert_eq!(
+            all,
+            [
+                "nesycr",
+                "demo2code",
+                "gpt4v-robotics",
+                "critic-v",
+                "morevqa",
+                "statler",
+                "llm-dm",
+                "imitation"
+            ]
+        );
+        assert_eq!(parse_variants("nesycr, imitation").unwrap().len(), 2);
+        assert!(parse_variants(" , ").is_err());
     }
 }

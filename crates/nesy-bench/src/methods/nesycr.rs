@@ -19,7 +19,7 @@ use super::{
     check_keys, switch,
 };
 use crate::error::BenchError;
-use crate::record::UnitStatus;
+use crate::status::UnitStatus;
 use crate::variant::Variant;
 
 /// What an unresolved adaptation turns into.

@@ -18,7 +18,7 @@ use super::{
     check_keys,
 };
 use crate::error::BenchError;
-use crate::record::UnitStatus;
+use crate::status::UnitStatus;
 use crate::variant::Variant;
 
 /// The replanning control.

@@ -8,7 +8,7 @@
 //! unusable demonstration are excluded from every method alike and listed.
 
 pub mod plot;
-mod study;
+mod study_tables;
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -22,8 +22,9 @@ use crate::error::BenchError;
 use crate::harness::final_records;
 use crate::manifest::{Manifest, Responder};
 use crate::methods::{self, OfflineMeaning, Role};
-use crate::record::{UnitRecord, UnitStatus};
+use crate::status::UnitStatus;
 use crate::store;
+use crate::unit_record::UnitRecord;
 use plot::{Bars, Frame, Lines, Value};
 
 /// Tallies of one group of units.
@@ -293,7 +294,9 @@ pub fn write(run: &Path, options: &ReportOptions) -> Result<ReportFiles, BenchEr
         canvas.save(&path)?;
         files.plots.push(path);
     }
-    let study = manifest.study.map(|s| study::StudyTable::build(s, &ordered));
+    let study = manifest
+        .study
+        .map(|s| study_tables::StudyTable::build(s, &ordered));
     if let Some(table) = &study {
         let path = run.join("tables").join("study.csv");
         std::fs::write(&path, table.csv()).map_err(|e| BenchError::io(&path, e))?;
@@ -310,7 +313,7 @@ pub fn write(run: &Path, options: &ReportOptions) -> Result<ReportFiles, BenchEr
             files.plots.push(path);
         }
     }
-    let study_md = study.as_ref().map(study::StudyTable::markdown);
+    let study_md = study.as_ref().map(study_tables::StudyTable::markdown);
     let md = markdown(
         &manifest,
         &tables,

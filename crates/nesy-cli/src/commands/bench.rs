@@ -14,8 +14,8 @@ use nesy_bench::harness::{self, Prepared};
 use nesy_bench::harness::{BenchProgress, ResponderSetup, RunConfig, StopSignal};
 use nesy_bench::manifest::{Manifest, RunSettings};
 use nesy_bench::methods::{self, OfflineMeaning, Role};
-use nesy_bench::study::Study;
-use nesy_bench::{Selection, Shard, UnitRecord, UnitStatus, Variant};
+use nesy_bench::studies::Study;
+use nesy_bench::{Selection, Shard, UnitRecord, UnitStatus};
 use nesy_policy::WorkerCommand;
 use nesy_vlm::ConfigOverrides;
 
@@ -292,7 +292,7 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
         run_dir,
         variants: match study {
             Some(s) => s.rows().into_iter().map(|r| r.variant).collect(),
-            None => Variant::parse_list(args.methods.as_deref().unwrap_or("nesycr"))?,
+            None => nesy_bench::methods::parse_variants(args.methods.as_deref().unwrap_or("nesycr"))?,
         },
         study,
         selection,
@@ -568,7 +568,7 @@ fn plan(args: RunArgs) -> anyhow::Result<ExitCode> {
     let config = config(&args)?;
     let prepared: Prepared = harness::prepare(&config)?;
     let cache = DemoCache::new(&config.demo_cache, config.settings.image_size);
-    let plan = nesy_bench::plan::plan(&prepared, &cache);
+    let plan = nesy_bench::call_budget::estimate(&prepared, &cache);
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&plan)?)?;
         return Ok(ExitCode::SUCCESS);

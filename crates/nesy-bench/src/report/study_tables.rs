@@ -11,8 +11,9 @@ use nesy_core::metrics::{MeanSe, Tally};
 
 use super::csv_field;
 use super::plot::{self, Bars, Frame, Value};
-use crate::record::{UnitRecord, UnitStatus};
-use crate::study::{Study, StudyRow};
+use crate::status::UnitStatus;
+use crate::studies::{Study, StudyRow};
+use crate::unit_record::UnitRecord;
 
 /// One row's figures.
 #[derive(Debug, Clone)]

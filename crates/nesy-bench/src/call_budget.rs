@@ -100,7 +100,7 @@ pub fn unit_load(unit: &Unit, keyframes: u64, budget: u64) -> Load {
 
 /// One row of a plan: a variant in a cell.
 #[derive(Debug, Clone, Serialize)]
-pub struct PlanRow {
+pub struct BudgetRow {
     /// The variant.
     pub variant: String,
     /// The factor group.
@@ -117,9 +117,9 @@ pub struct PlanRow {
 
 /// The plan of a run.
 #[derive(Debug, Clone, Serialize)]
-pub struct Plan {
+pub struct CallBudget {
     /// Rows, by variant then cell.
-    pub rows: Vec<PlanRow>,
+    pub rows: Vec<BudgetRow>,
     /// The whole run.
     pub total: Load,
     /// Units whose demo is not recorded.
@@ -127,9 +127,9 @@ pub struct Plan {
 }
 
 /// The plan of a prepared run, reading keyframe counts from the demo cache.
-pub fn plan(prepared: &Prepared, cache: &DemoCache) -> Plan {
+pub fn estimate(prepared: &Prepared, cache: &DemoCache) -> CallBudget {
     let mut keyframes: BTreeMap<String, Option<u64>> = BTreeMap::new();
-    let mut rows: BTreeMap<(String, FactorGroup, Complexity), PlanRow> = BTreeMap::new();
+    let mut rows: BTreeMap<(String, FactorGroup, Complexity), BudgetRow> = BTreeMap::new();
     let mut total = Load::default();
     let mut unrecorded = 0;
     for unit in &prepared.units {
@@ -137,7 +137,7 @@ pub fn plan(prepared: &Prepared, cache: &DemoCache) -> Plan {
             .entry(unit.scenario.id.clone())
             .or_insert_with(|| cache.lookup(&unit.scenario).map(|d| d.record.keyframes as u64));
         let key = (unit.key.variant.clone(), unit.factor().group(), unit.complexity());
-        let row = rows.entry(key.clone()).or_insert_with(|| PlanRow {
+        let row = rows.entry(key.clone()).or_insert_with(|| BudgetRow {
             variant: key.0.clone(),
             group: key.1,
             complexity: key.2,
@@ -159,7 +159,7 @@ pub fn plan(prepared: &Prepared, cache: &DemoCache) -> Plan {
             }
         }
     }
-    Plan {
+    CallBudget {
         rows: rows.into_values().collect(),
         total,
         unrecorded,

@@ -313,7 +313,7 @@ mod tests {
 
     #[test]
     fn the_perception_what_if_matches_the_reported_precision_and_recall() {
-        let noise = crate::harness::noise_of(PERCEPTION_WHAT_IF).unwrap();
+        let noise = crate::variant::noise_of(PERCEPTION_WHAT_IF).unwrap();
         let recall = 1.0 - noise.state_drop;
         let precision = recall / (recall + noise.state_inject);
         assert!((recall - 0.71).abs() < 1e-9);

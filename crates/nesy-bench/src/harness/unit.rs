@@ -1,0 +1,540 @@
+//! One unit: its client and responder, phase A (the method's specification and its code)
+//! and phase B (execution in the sandboxed simulator), and its result line.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use nesy_core::benchmark::Factor;
+use nesy_core::format_procedure;
+use nesy_pipeline::states::StateSource;
+use nesy_pipeline::synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest};
+use nesy_pipeline::{AdaptOptions, DemoInput, derive_setting, execute, output, synth, vlm};
+use nesy_policy::Limits;
+use nesy_reasoner::VlmReasoner;
+use nesy_reasoner::codegen::CodeGenerationRequest;
+use nesy_sim::tasks::scenario::Side;
+use nesy_vlm::CassetteFile;
+use nesy_vlm::{CassetteMode, CassetteOptions, CassetteTransport, Transport, VlmClient, VlmConfig};
+use serde::Serialize;
+
+use crate::meter::Metered;
+use crate::methods::{self, Method, MethodFailure, Specification, Specified, UnitInputs};
+use crate::status::UnitStatus;
+use crate::unit::Unit;
+use crate::unit_record::{Agreement, Effort, Scores, SpecSummary, SubtaskScore, UnitRecord};
+use crate::variant::Variant;
+
+use super::config::ResponderSetup;
+use super::reexec::reexecuted;
+use super::shared::{PhaseA, PhaseAFailure, Shared, UnitClient, cpu, scenario_inputs};
+
+pub(super) fn unit_dir(shared: &Shared, unit: &Unit) -> PathBuf {
+    shared
+        .config
+        .run_dir
+        .join("units")
+        .join(unit.key.folder(&unit.variant))
+}
+
+/// `ROOT/<scenario>/<variant>[.r<k>].json`. The suffix is appended, not set: a variant id
+/// holds dots (`noise=op-drop=0.1`) and a repeat ends in `.r<k>`, and `set_extension` would
+/// replace either, so two units would share one recording.
+pub(super) fn cassette_path(unit: &Unit, root: &Path) -> PathBuf {
+    recording_path(&unit.key, &unit.variant, root)
+}
+
+pub(super) fn recording_path(key: &crate::unit::UnitKey, variant: &Variant, root: &Path) -> PathBuf {
+    let mut p = root.join(key.folder(variant)).into_os_string();
+    p.push(".json");
+    PathBuf::from(p)
+}
+
+/// The target scene's goal label and subtask names, for units that never executed.
+pub(super) fn target_label(unit: &Unit) -> (Vec<String>, Vec<String>) {
+    match unit.scenario.generate(Side::Target) {
+        Ok(t) => (
+            t.goal_label,
+            t.scene
+                .goals
+                .iter()
+                .map(|g| g.kind().as_str().to_owned())
+                .collect(),
+        ),
+        Err(_) => (Vec::new(), Vec::new()),
+    }
+}
+
+pub(super) fn failed_record(
+    shared: &Shared,
+    unit: &Unit,
+    status: UnitStatus,
+    error: String,
+    effort: Effort,
+) -> UnitRecord {
+    let (label, subtasks) = target_label(unit);
+    base_record(
+        shared,
+        unit,
+        status,
+        Some(error),
+        Scores::not_executed(label, &subtasks),
+        effort,
+    )
+}
+
+pub(super) fn base_record(
+    shared: &Shared,
+    unit: &Unit,
+    status: UnitStatus,
+    error: Option<String>,
+    scores: Scores,
+    effort: Effort,
+) -> UnitRecord {
+    UnitRecord {
+        key: unit.key.clone(),
+        method: unit.variant.method.clone(),
+        factor: unit.factor(),
+        complexity: unit.complexity(),
+        added_subtasks: unit.scenario.added_subtasks,
+        obstruction_change: unit.scenario.obstruction_change(),
+        seed: unit.seed,
+        config_hash: shared
+            .manifest
+            .variant(&unit.key.variant)
+            .map(|v| v.config_hash.clone())
+            .unwrap_or_default(),
+        status,
+        error,
+        scores,
+        spec: None,
+        states: None,
+        effort,
+        artifacts: Path::new("units")
+            .join(unit.key.folder(&unit.variant))
+            .to_string_lossy()
+            .into_owned(),
+        finished_at: nesy_vlm::now_rfc3339(),
+    }
+}
+
+/// The unit's client: its responder under the meter. The offline responder is given the
+/// demonstration's recorded robot calls.
+pub(super) fn unit_client(
+    shared: &Shared,
+    unit: &Unit,
+    demo: &DemoInput,
+) -> Result<UnitClient, (UnitStatus, String)> {
+    let config = &shared.config;
+    let (client_config, base): (VlmConfig, Arc<dyn Transport>) = match &config.responder {
+        ResponderSetup::Oracle => {
+            let noise = unit.variant.option("noise").unwrap_or("").replace(';', ",");
+            let transport = vlm::oracle_transport(&noise, unit.seed, demo.recorded_calls())
+                .map_err(|e| (UnitStatus::MethodError, e.to_string()))?;
+            let transport: Arc<dyn Transport> = if config.record_cassettes {
+                let path = cassette_path(unit, &config.run_dir.join("cassettes"));
+                record_to(&path, transport, &vlm::oracle_config())?
+            } else {
+                transport
+            };
+            (vlm::oracle_config(), transport)
+        }
+        ResponderSetup::Replay(dir) => {
+            let path = cassette_path(unit, dir);
+            if !path.is_file() {
+                return Err((
+                    UnitStatus::TransportError,
+                    format!("{}: no recorded cassette for this unit", path.display()),
+                ));
+            }
+            let file = CassetteFile::load(&path).map_err(|e| (UnitStatus::TransportError, e.to_string()))?;
+            let c =
+                vlm::replay_config(&path, &file).map_err(|e| (UnitStatus::TransportError, e.to_string()))?;
+            let options = CassetteOptions {
+                allow_playback_repeats: true,
+                ..CassetteOptions::default()
+            };
+            let t = CassetteTransport::open(&path, CassetteMode::None, None, options)
+                .map_err(|e| (UnitStatus::TransportError, e.to_string()))?;
+            (c, Arc::new(t))
+        }
+        ResponderSetup::Live(_) => {
+            let (c, http) = shared
+                .live
+                .clone()
+                .ok_or_else(|| (UnitStatus::MethodError, "no live client".into()))?;
+            let path = cassette_path(unit, &config.run_dir.join("cassettes"));
+            let t = record_to(&path, http, &c)?;
+            (c, t)
+        }
+    };
+    let metered = Metered::new(base, config.settings.max_calls_per_unit, shared.model.clone());
+    let counts = metered.counts();
+    Ok((
+        VlmClient::with_transport(&client_config, Arc::new(metered)),
+        counts,
+    ))
+}
+
+/// A cassette at `path` recording (new episodes; replaying what it already holds) around
+/// `inner`, with the key redacted.
+pub(super) fn record_to(
+    path: &Path,
+    inner: Arc<dyn Transport>,
+    config: &VlmConfig,
+) -> Result<Arc<dyn Transport>, (UnitStatus, String)> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| (UnitStatus::MethodError, format!("{}: {e}", dir.display())))?;
+    }
+    let t = CassetteTransport::open(
+        path,
+        CassetteMode::NewEpisodes,
+        Some(inner),
+        CassetteOptions {
+            model: Some(config.model.clone()),
+            backend: Some(config.backend.as_str().to_owned()),
+            redact: config.api_key.iter().cloned().collect(),
+            ..CassetteOptions::default()
+        },
+    )
+    .map_err(|e| (UnitStatus::MethodError, e.to_string()))?;
+    Ok(Arc::new(t))
+}
+
+/// The code of a specification: the template compiler, or the model's code generation.
+pub(super) async fn make_code(
+    client: &VlmClient,
+    inputs: &UnitInputs,
+    specified: &Specified,
+) -> Result<(String, f64, f64), (UnitStatus, String)> {
+    let started = Instant::now();
+    let target = &inputs.target;
+    let mut instruction = target.instruction(&inputs.demo);
+    let (procedure, plan) = match &specified.spec {
+        Specification::Procedure { procedure, .. } => (procedure.clone(), Vec::new()),
+        Specification::Plan {
+            steps,
+            instruction: rewritten,
+        } => {
+            if let Some(rewritten) = rewritten {
+                instruction = rewritten.clone();
+            }
+            (Vec::new(), steps.clone())
+        }
+    };
+    match specified.codegen {
+        CodegenMode::Template => {
+            let request = SynthesisRequest {
+                instruction,
+                objects: target.objects.clone(),
+                procedure,
+                source: inputs.setting.source_embodiment,
+                target: inputs.setting.target_embodiment,
+                scene: &target.scene,
+            };
+            let reasoner =
+                VlmReasoner::new(client.clone()).map_err(|e| (UnitStatus::MethodError, e.to_string()))?;
+            let p = synth::synthesize(&reasoner, CodegenMode::Template, &request)
+                .await
+                .map_err(|e| synth_status(&e))?;
+            Ok((p.code, 0.0, started.elapsed().as_secs_f64()))
+        }
+        CodegenMode::Vlm => {
+            let reasoner = VlmReasoner::new(client.clone())
+                .map_err(|e| (UnitStatus::MethodError, e.to_string()))?
+                .with_embodiments(inputs.setting.source_embodiment, inputs.setting.target_embodiment)
+                .with_program_check(Arc::new(SandboxChecks));
+            let request = CodeGenerationRequest {
+                instruction,
+                objects: target.objects.clone(),
+                procedure,
+                plan,
+                embodiment: inputs.setting.target_embodiment,
+                // The authors' rule: the extended prompt for the embodiment factors and for
+                // Combination (whose scenarios may change the end effector).
+                extended: matches!(inputs.setting.factor, Factor::Grip | Factor::Vacu | Factor::Comb)
+                    || inputs.setting.source_embodiment != inputs.setting.target_embodiment,
+            };
+            let source = reasoner.generate_code(&request).await.map_err(|e| {
+                let failure = MethodFailure::from_reasoner(e.reasoner_kind(), e.to_string());
+                let status = if failure.status == UnitStatus::MethodError {
+                    UnitStatus::CodegenFailed
+                } else {
+                    failure.status
+                };
+                (status, failure.message)
+            })?;
+            Ok((source.code, started.elapsed().as_secs_f64(), 0.0))
+        }
+    }
+}
+
+pub(super) fn synth_status(e: &SynthError) -> (UnitStatus, String) {
+    match e {
+        SynthError::NoProgram { message, .. } => (UnitStatus::CodegenFailed, message.clone()),
+        SynthError::Call { message, failure } => {
+            let f = MethodFailure::from_reasoner(*failure, message.clone());
+            (f.status, f.message)
+        }
+    }
+}
+
+pub(super) fn write(path: &Path, text: &str) -> Result<(), String> {
+    std::fs::write(path, text).map_err(|e| format!("writing {}: {e}", path.display()))
+}
+
+pub(super) fn write_json(path: &Path, value: &impl Serialize) -> Result<(), String> {
+    write(
+        path,
+        &(serde_json::to_string_pretty(value).unwrap_or_default() + "\n"),
+    )
+}
+
+pub(super) fn agreement(states: &Option<StateSource>) -> Option<Agreement> {
+    match states {
+        Some(StateSource::Vlm {
+            agreement: Some(a), ..
+        }) => Some(*a),
+        _ => None,
+    }
+}
+
+/// Runs one unit to its record. Never fails: every failure becomes the unit's status.
+pub(super) async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
+    let started = Instant::now();
+    let mut effort = Effort::default();
+    let inputs = match scenario_inputs(shared, &unit.scenario).await {
+        Ok(i) => i,
+        Err(e) => {
+            return failed_record(
+                shared,
+                unit,
+                UnitStatus::MethodError,
+                format!("preparing the scenario: {e}"),
+                effort,
+            );
+        }
+    };
+    if !inputs.cached.record.usable() && !shared.config.settings.keep_gapped_demos {
+        let why = inputs.cached.record.unusable_reason().unwrap_or_default();
+        return failed_record(shared, unit, UnitStatus::DemoUnusable, why, effort);
+    }
+    let dir = unit_dir(shared, unit);
+    if let Err(e) = std::fs::create_dir_all(&dir) {
+        return failed_record(
+            shared,
+            unit,
+            UnitStatus::MethodError,
+            format!("{}: {e}", dir.display()),
+            effort,
+        );
+    }
+    let setting = derive_setting(&inputs.demo, &inputs.target, &AdaptOptions::default());
+    let unit_inputs = UnitInputs {
+        demo: inputs.demo.clone(),
+        keyframes: inputs.keyframes.clone(),
+        target: inputs.target.clone(),
+        setting,
+        variant: unit.variant.clone(),
+        seed: unit.seed,
+    };
+    let (client, counts) = match unit_client(shared, unit, &inputs.demo) {
+        Ok(c) => c,
+        Err((status, e)) => return failed_record(shared, unit, status, e, effort),
+    };
+
+    // Phase A: the specification and its code (or the earlier run's, when re-executing).
+    let phase_a = match &shared.config.reexecute {
+        Some(source) => reexecuted(source, unit),
+        None => specify_and_code(&client, &unit_inputs, &dir, unit).await,
+    };
+    let usage = client.finish().ok();
+    let c = counts.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    effort.calls = c.calls;
+    effort.images = c.images;
+    effort.calls_by_purpose = c.by_purpose.clone();
+    if let Some(u) = &usage {
+        effort.tokens = u.total.prompt_tokens + u.total.completion_tokens;
+        effort.cost_usd = u.total.cost_usd;
+        effort.cost_by_purpose = u
+            .by_purpose
+            .iter()
+            .filter(|(_, t)| t.cost_usd > 0.0)
+            .map(|(purpose, t)| (purpose.clone(), t.cost_usd))
+            .collect();
+    }
+    let (code, mut record_base) = match phase_a {
+        Ok(a) => a,
+        Err((status, message, summary)) => {
+            let status = if c.cap_reached {
+                UnitStatus::MethodError
+            } else {
+                status
+            };
+            effort.wall_s = started.elapsed().as_secs_f64();
+            let mut r = failed_record(shared, unit, status, message, effort);
+            r.spec = summary;
+            return r;
+        }
+    };
+    effort.vlm_s = record_base.vlm_s;
+    effort.symbolic_s = record_base.symbolic_s.0;
+    effort.symbolic_world_model_s = record_base.symbolic_s.1;
+    effort.codegen_template_s = record_base.template_s;
+
+    // Phase B: execution in the sandboxed simulator.
+    let target = inputs.target.clone();
+    let worker = shared.config.worker.clone();
+    let limits = Limits {
+        wall_time_ms: shared.config.settings.policy_wall_ms,
+        ..Limits::default()
+    };
+    let exec_dir = dir.clone();
+    let executed = cpu(shared, move || {
+        let scene = output::prepare_dir(&exec_dir, &target, None).map_err(|e| e.to_string())?;
+        write(&exec_dir.join(output::POLICY_FILE), &code)?;
+        execute::execute(&worker, &code, &scene, &limits).map_err(|e| e.to_string())
+    })
+    .await
+    .and_then(|r| r);
+    effort.sim_s = inputs.target.sim_time.as_secs_f64();
+    let report = match executed {
+        Ok(r) => r,
+        Err(e) => {
+            effort.wall_s = started.elapsed().as_secs_f64();
+            let mut r = failed_record(shared, unit, UnitStatus::ExecutionFailed, e, effort);
+            r.spec = record_base.spec.take();
+            return r;
+        }
+    };
+    effort.sim_s += report.result.wall_time_s;
+    let _ = write_json(&dir.join(output::EXECUTION_FILE), &report);
+    let (label, subtask_names) = target_label(unit);
+    let scores = match &report.metrics {
+        Some(m) => Scores {
+            sr: m.sr,
+            gc: m.gc,
+            latched_sr: m.latched_sr,
+            latched_gc: m.latched_gc,
+            pd: m.pd.unwrap_or(0.0),
+            label: m.label.clone(),
+            achieved: m.achieved.clone(),
+            subtasks: m
+                .subtasks
+                .iter()
+                .map(|s| SubtaskScore {
+                    subtask: s.subtask.clone(),
+                    result: s.status,
+                    displaced: s.displaced.clone(),
+                })
+                .collect(),
+        },
+        None => Scores::not_executed(label, &subtask_names),
+    };
+    let (status, error) = if report.success() {
+        (UnitStatus::Succeeded, None)
+    } else {
+        let why = match &report.result.outcome {
+            nesy_policy::Outcome::Ok => {
+                let failed: Vec<String> = report
+                    .metrics
+                    .iter()
+                    .flat_map(|m| &m.subtasks)
+                    .filter(|s| !s.status.is_success() || !s.displaced.is_empty())
+                    .map(|s| {
+                        if s.displaced.is_empty() {
+                            format!("{} {}", s.subtask, s.status)
+                        } else {
+                            format!("{} displaced {}", s.subtask, s.displaced.join(" "))
+                        }
+                    })
+                    .collect();
+                format!("the policy ran to its end; {}", failed.join(", "))
+            }
+            nesy_policy::Outcome::PythonError(e) => {
+                format!(
+                    "the policy raised {}: {}{}",
+                    e.exception,
+                    e.message,
+                    e.line
+                        .map(|l| format!(" (policy.py line {l})"))
+                        .unwrap_or_default()
+                )
+            }
+            other => format!("the policy ended with {}", other.kind()),
+        };
+        (UnitStatus::ExecutionFailed, Some(why))
+    };
+    effort.wall_s = started.elapsed().as_secs_f64();
+    let mut r = base_record(shared, unit, status, error, scores, effort);
+    r.spec = record_base.spec.take();
+    r.states = record_base.states;
+    r
+}
+
+pub(super) async fn specify_and_code(
+    client: &VlmClient,
+    inputs: &UnitInputs,
+    dir: &Path,
+    unit: &Unit,
+) -> Result<(String, PhaseA), PhaseAFailure> {
+    let method: Arc<dyn Method> =
+        methods::find(&unit.variant.method).map_err(|e| (UnitStatus::MethodError, e.to_string(), None))?;
+    let specified = match method.specify(inputs, client).await {
+        Ok(s) => s,
+        Err(f) => {
+            if let Some(a) = &f.adaptation {
+                let _ = write_json(&dir.join(output::ADAPTATION_FILE), a.as_ref());
+            }
+            let summary = f.iterations.map(|(iterations, budget)| SpecSummary {
+                kind: "none".into(),
+                steps: 0,
+                verified: false,
+                iterations: Some(iterations),
+                budget: Some(budget),
+            });
+            return Err((f.status, f.message, summary));
+        }
+    };
+    let summary = SpecSummary {
+        kind: specified.spec.kind().into(),
+        steps: specified.spec.len(),
+        verified: matches!(specified.spec, Specification::Procedure { verified: true, .. }),
+        iterations: specified.iterations.map(|i| i.0),
+        budget: specified.iterations.map(|i| i.1),
+    };
+    let spec_text = match &specified.spec {
+        Specification::Procedure { procedure, .. } => format_procedure(procedure),
+        Specification::Plan { steps, .. } => steps
+            .iter()
+            .enumerate()
+            .map(|(i, s)| format!("{}. {s}", i + 1))
+            .collect::<Vec<_>>()
+            .join("\n"),
+    };
+    let _ = write_json(
+        &dir.join("spec.json"),
+        &serde_json::json!({
+            "summary": summary,
+            "text": spec_text,
+            "notes": specified.notes,
+        }),
+    );
+    if let Some(a) = &specified.adaptation {
+        let _ = write_json(&dir.join(output::ADAPTATION_FILE), a);
+    }
+    let (code, vlm_code_s, template_s) = make_code(client, inputs, &specified)
+        .await
+        .map_err(|(s, m)| (s, m, Some(summary.clone())))?;
+    Ok((
+        code,
+        PhaseA {
+            spec: Some(summary),
+            states: agreement(&specified.states),
+            vlm_s: specified.vlm_s + vlm_code_s,
+            symbolic_s: specified.symbolic_s,
+            template_s,
+        },
+    ))
+}
