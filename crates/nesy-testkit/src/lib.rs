@@ -14,6 +14,8 @@
 //! ```
 
 use std::path::PathBuf;
+#[cfg(feature = "policy-worker")]
+use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
@@ -130,4 +132,53 @@ impl Transport for InFlightCounter {
     fn label(&self) -> String {
         "counter".into()
     }
+}
+
+/// A named test of a test binary built with `harness = false`.
+#[cfg(feature = "policy-worker")]
+pub type NamedTest = (&'static str, fn());
+
+/// The `main` of a test binary that executes policies in-process through a library entry
+/// point: the sandbox starts its worker by re-executing the running binary with
+/// [`nesy_policy::WORKER_SUBCOMMAND`], so this binary is its own worker. Called so, it serves
+/// one episode; otherwise it runs `tests` (those whose name contains the first free command
+/// line argument, if one is given), each catching its own panic, and closes with a line
+/// `N passed, N failed`.
+///
+/// The worker the tests then hand to the library is [`own_worker`].
+#[cfg(feature = "policy-worker")]
+pub fn run_tests_or_worker(tests: &[NamedTest]) -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some(nesy_policy::WORKER_SUBCOMMAND) {
+        return nesy_policy::worker_main(&nesy_policy::SimEpisodes);
+    }
+    let filter = args.iter().find(|a| !a.starts_with('-')).cloned();
+    let (mut passed, mut failed) = (0, 0);
+    for (name, test) in tests {
+        if filter.as_deref().is_some_and(|f| !name.contains(f)) {
+            continue;
+        }
+        match std::panic::catch_unwind(test) {
+            Ok(()) => {
+                println!("test {name} ... ok");
+                passed += 1;
+            }
+            Err(_) => {
+                println!("test {name} ... FAILED");
+                failed += 1;
+            }
+        }
+    }
+    println!("{passed} passed, {failed} failed");
+    if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}
+
+/// This test binary as the sandbox's worker (see [`run_tests_or_worker`]).
+#[cfg(feature = "policy-worker")]
+pub fn own_worker() -> nesy_policy::WorkerCommand {
+    nesy_policy::WorkerCommand::current_exe().expect("the running test binary")
 }
