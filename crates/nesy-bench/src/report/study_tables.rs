@@ -331,8 +331,8 @@ impl StudyTable {
                 })
                 .collect()
         };
-        Some(super::two_panel_lines(
-            super::SrPd {
+        Some(super::figures::two_panel_lines(
+            super::figures::SrPd {
                 header: "SR and PD against the complexity gap (auxiliary suite)",
                 x_label: "subtasks added to the demonstrated one",
                 categories: &categories,
