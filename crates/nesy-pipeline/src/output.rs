@@ -21,6 +21,7 @@ use nesy_core::format_procedure;
 use serde::Serialize;
 use serde_json::json;
 
+use crate::execute::ExecutionReport;
 use crate::inputs::TargetInput;
 use crate::states::StateSource;
 use crate::synth::SynthesizedPolicy;
@@ -386,6 +387,20 @@ pub fn write_all(run: &AdaptRun, target: &TargetInput, dir: &Path) -> Result<(),
 /// `report.md`: the run for a human, with the target views embedded.
 pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
     let mut md = String::new();
+    write_run_header(&mut md, run);
+    write_target(&mut md, run, target);
+    write_world_model(&mut md, run);
+    write_adaptation(&mut md, run);
+    write_policy(&mut md, run);
+    if let Some(execution) = &run.execution {
+        write_execution(&mut md, execution);
+    }
+    write_time(&mut md, run);
+    md
+}
+
+/// The title, the inputs, the setting and where the states came from.
+fn write_run_header(md: &mut String, run: &AdaptRun) {
     let _ = writeln!(md, "# nesy adapt: {}\n", run.status.as_str());
     let _ = writeln!(md, "- demo: `{}`", run.demo_path.display());
     let _ = writeln!(md, "- target: `{}`", run.target_path.display());
@@ -410,14 +425,20 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
         ),
     };
     let _ = writeln!(md, "- states: {states}\n");
+}
 
+/// The target's instruction, marked views and initial state.
+fn write_target(md: &mut String, run: &AdaptRun, target: &TargetInput) {
     let _ = writeln!(md, "## Target scene\n");
     let _ = writeln!(md, "Instruction: {}\n", run.instruction);
     for view in &target.views {
         let _ = write!(md, "![{0} view](target_{0}_marked.png) ", view.camera);
     }
     let _ = writeln!(md, "\n\nInitial state:\n\n```\n{}\n```\n", run.target_state);
+}
 
+/// How many operators were induced and verified, and the goal.
+fn write_world_model(md: &mut String, run: &AdaptRun) {
     let counts = induction_counts(&run.adaptation);
     let wm = &run.adaptation.world_model;
     let _ = writeln!(md, "## World model\n");
@@ -434,7 +455,10 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
         }
     );
     let _ = writeln!(md, "Goal: `{}`\n", wm.goal);
+}
 
+/// Each violation found and each proposal's verdict, then the procedures.
+fn write_adaptation(md: &mut String, run: &AdaptRun) {
     let _ = writeln!(md, "## Counterfactual adaptation\n");
     for v in violations(&run.adaptation) {
         match v.kind {
@@ -470,7 +494,10 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
         );
     }
     let _ = writeln!(md, "\n```\n{}```\n", procedure_text(run));
+}
 
+/// The program and how it was obtained, or why there is none.
+fn write_policy(md: &mut String, run: &AdaptRun) {
     let _ = writeln!(md, "## Policy\n");
     match (&run.policy, &run.codegen_error) {
         (Some(p), _) => {
@@ -483,12 +510,12 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
                 "`policy.py`, from {how}:\n\n```python\n{}\n```\n",
                 p.code.trim_end()
             );
-            write_rejected_programs(&mut md, &p.rejected);
+            write_rejected_programs(md, &p.rejected);
         }
         (None, Some(e)) => {
             let _ = writeln!(md, "Code synthesis failed: {e}\n");
             if let SynthError::NoProgram { replies, .. } = e {
-                write_rejected_programs(&mut md, replies);
+                write_rejected_programs(md, replies);
             }
         }
         (None, None) => {
@@ -498,50 +525,56 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
             );
         }
     }
-    if let Some(execution) = &run.execution {
-        let _ = writeln!(md, "## Execution\n");
-        let r = &execution.result;
-        let actions = r.trace.iter().filter(|e| e.call.is_action()).count();
-        let _ = writeln!(
-            md,
-            "Outcome `{}`; {} API calls ({} actions); {:.2} s.\n",
-            r.outcome.kind(),
-            r.trace.len(),
-            actions,
-            r.wall_time_s
-        );
-        match &execution.metrics {
-            Some(m) => {
-                for s in &m.subtasks {
-                    let _ = writeln!(md, "- {}: {:?}", s.subtask, s.status);
-                }
-                let _ = writeln!(
-                    md,
-                    "\nSR {:.0}, GC {:.2}, PD {}\n",
-                    m.sr,
-                    m.gc,
-                    m.pd.map(|p| format!("{p:.2}")).unwrap_or_else(|| "n/a".into())
-                );
+}
+
+/// The episode's outcome, its goal checks and its API trace.
+fn write_execution(md: &mut String, execution: &ExecutionReport) {
+    let _ = writeln!(md, "## Execution\n");
+    let r = &execution.result;
+    let actions = r.trace.iter().filter(|e| e.call.is_action()).count();
+    let _ = writeln!(
+        md,
+        "Outcome `{}`; {} API calls ({} actions); {:.2} s.\n",
+        r.outcome.kind(),
+        r.trace.len(),
+        actions,
+        r.wall_time_s
+    );
+    match &execution.metrics {
+        Some(m) => {
+            for s in &m.subtasks {
+                let _ = writeln!(md, "- {}: {:?}", s.subtask, s.status);
             }
-            None => {
-                let _ = writeln!(md, "No goal checks were reported for this episode.\n");
-            }
-        }
-        let _ = writeln!(md, "API trace:\n\n```");
-        for e in &r.trace {
             let _ = writeln!(
                 md,
-                "{:>3} {} {}",
-                e.index,
-                serde_json::to_string(&e.call).unwrap_or_default(),
-                match &e.result {
-                    Ok(_) => "ok".to_owned(),
-                    Err(err) => format!("REFUSED: {err}"),
-                }
+                "\nSR {:.0}, GC {:.2}, PD {}\n",
+                m.sr,
+                m.gc,
+                m.pd.map(|p| format!("{p:.2}")).unwrap_or_else(|| "n/a".into())
             );
         }
-        let _ = writeln!(md, "```\n");
+        None => {
+            let _ = writeln!(md, "No goal checks were reported for this episode.\n");
+        }
     }
+    let _ = writeln!(md, "API trace:\n\n```");
+    for e in &r.trace {
+        let _ = writeln!(
+            md,
+            "{:>3} {} {}",
+            e.index,
+            serde_json::to_string(&e.call).unwrap_or_default(),
+            match &e.result {
+                Ok(_) => "ok".to_owned(),
+                Err(err) => format!("REFUSED: {err}"),
+            }
+        );
+    }
+    let _ = writeln!(md, "```\n");
+}
+
+/// The time breakdown (the paper's Table 9).
+fn write_time(md: &mut String, run: &AdaptRun) {
     let t = &run.timing;
     let _ = writeln!(md, "## Time\n");
     let _ = writeln!(
@@ -559,5 +592,4 @@ pub fn report_markdown(run: &AdaptRun, target: &TargetInput) -> String {
         t.sim_s,
         t.total_s
     );
-    md
 }

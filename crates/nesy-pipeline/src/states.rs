@@ -109,37 +109,17 @@ pub async fn symbolic_states(
     vocabulary: &Vocabulary,
     progress: &dyn Progress,
 ) -> Result<SymbolicStates, PipelineError> {
-    let truth = demo.demo.states();
     let source_atom = setting
         .embodiment_in_state
         .then(|| embodiment_atom(setting.source_embodiment));
-    let truth = truth.map(|states| match source_atom {
-        // A demo recorded without the embodiment atom gets it on every state, as the authors
-        // append `(FingerGripper)` to gripper demos adapted to suction.
-        Some(atom) => states.iter().map(|s| with_atom(s, atom)).collect::<Vec<_>>(),
-        None => states,
-    });
+    let truth = ground_truth(demo, source_atom);
     let use_vlm = match mode {
         StatesMode::Observed => false,
         StatesMode::Vlm => true,
         StatesMode::Auto => truth.is_none(),
     };
     if !use_vlm {
-        let demo_states = truth.ok_or_else(|| {
-            let missing = demo
-                .demo
-                .keyframes
-                .iter()
-                .find(|k| k.state.is_none())
-                .map(|k| k.index)
-                .unwrap_or_default();
-            PipelineError::Demo {
-                path: demo.path.clone(),
-                message: format!(
-                    "keyframe {missing} has no ground-truth state; use --states vlm for demos without ground truth"
-                ),
-            }
-        })?;
+        let demo_states = truth.ok_or_else(|| missing_ground_truth(demo))?;
         progress.detail("ground-truth states");
         return Ok(SymbolicStates {
             demo_states,
@@ -150,6 +130,68 @@ pub async fn symbolic_states(
     }
 
     let started = Instant::now();
+    let requests = translation_requests(demo, target, setting, vocabulary, truth.as_deref(), source_atom)?;
+    let total = requests.len();
+    let results = translate_all(reasoner, requests, progress).await?;
+    let rejected_atoms = results.iter().map(|(_, t)| t.rejected.len()).sum();
+    let reasked_replies = results.iter().map(|(_, t)| t.reasked.len()).sum();
+    let agreement = agreement(&results);
+    let mut states: Vec<State> = results.into_iter().map(|(_, t)| t.state).collect();
+    let target_state = states.pop().ok_or_else(|| PipelineError::States {
+        message: "no translation of the target's state".into(),
+        kind: None,
+    })?;
+    Ok(SymbolicStates {
+        demo_states: states,
+        target_state,
+        source: StateSource::Vlm {
+            translated: total,
+            rejected_atoms,
+            reasked_replies,
+            agreement,
+        },
+        vlm_time: started.elapsed(),
+    })
+}
+
+/// The demo's ground-truth states, if every keyframe has one, each with the source
+/// embodiment's atom when the setting states it.
+fn ground_truth(demo: &DemoInput, source_atom: Option<Atom>) -> Option<Vec<State>> {
+    demo.demo.states().map(|states| match source_atom {
+        // A demo recorded without the embodiment atom gets it on every state, as the authors
+        // append `(FingerGripper)` to gripper demos adapted to suction.
+        Some(atom) => states.iter().map(|s| with_atom(s, atom)).collect(),
+        None => states,
+    })
+}
+
+/// Why observed states cannot be had: the first keyframe without a ground-truth state.
+fn missing_ground_truth(demo: &DemoInput) -> PipelineError {
+    let missing = demo
+        .demo
+        .keyframes
+        .iter()
+        .find(|k| k.state.is_none())
+        .map(|k| k.index)
+        .unwrap_or_default();
+    PipelineError::Demo {
+        path: demo.path.clone(),
+        message: format!(
+            "keyframe {missing} has no ground-truth state; use --states vlm for demos without ground truth"
+        ),
+    }
+}
+
+/// One state-translation request per demo keyframe and a last one for the target, each with
+/// the atoms already known (the embodiment's) and the ground truth when there is one.
+fn translation_requests(
+    demo: &DemoInput,
+    target: &TargetInput,
+    setting: &Setting,
+    vocabulary: &Vocabulary,
+    truth: Option<&[State]>,
+    source_atom: Option<Atom>,
+) -> Result<Vec<StateTranslationRequest>, PipelineError> {
     let keyframes = DemoKeyframes::from_demo(demo)?;
     let known = State::from_atoms(source_atom);
     let mut requests = Vec::new();
@@ -168,7 +210,7 @@ pub async fn symbolic_states(
             vocabulary: vocabulary.clone(),
             known: known.clone(),
             views: views.clone(),
-            ground_truth: truth.as_ref().and_then(|t| t.get(k.index).cloned()),
+            ground_truth: truth.and_then(|t| t.get(k.index).cloned()),
         });
     }
     let target_known = State::from_atoms(
@@ -186,8 +228,16 @@ pub async fn symbolic_states(
         views: target.marked_views()?,
         ground_truth: Some(target.observed.clone()),
     });
+    Ok(requests)
+}
 
-    // The calls are independent: run them concurrently (the client caps concurrency).
+/// Runs the translations concurrently (the client caps how many calls are in flight) and
+/// returns them in request order.
+async fn translate_all(
+    reasoner: &VlmReasoner,
+    requests: Vec<StateTranslationRequest>,
+    progress: &dyn Progress,
+) -> Result<Vec<(StateTranslationRequest, TranslatedState)>, PipelineError> {
     let total = requests.len();
     let mut set = tokio::task::JoinSet::new();
     for (i, request) in requests.into_iter().enumerate() {
@@ -212,38 +262,33 @@ pub async fn symbolic_states(
         progress.detail(&format!("state translation {done}/{total}"));
         results[i] = Some((request, translated));
     }
-    let results: Vec<_> = results.into_iter().flatten().collect();
+    Ok(results.into_iter().flatten().collect())
+}
 
-    let mut rejected_atoms = 0;
-    let mut reasked_replies = 0;
+/// Precision, recall and F1 of the translations against ground truth, micro-averaged over
+/// every request that has one; `None` when none has.
+fn agreement(results: &[(StateTranslationRequest, TranslatedState)]) -> Option<Agreement> {
     let (mut tp, mut predicted, mut actual) = (0usize, 0usize, 0usize);
-    let mut states = Vec::with_capacity(total);
-    for (request, translated) in &results {
-        rejected_atoms += translated.rejected.len();
-        reasked_replies += translated.reasked.len();
-        if let Some(truth) = &request.ground_truth {
-            // The reference is the part of the truth the prompt could express: its tier's
-            // predicates and the atoms given as known. Atoms of predicates outside the tier
-            // are never accepted from any reply, so counting them would lower recall for a
-            // perfect translator.
-            let in_tier: Vec<_> = request
-                .vocabulary
-                .tier(request.tier)
-                .iter()
-                .map(|p| p.name)
-                .collect();
-            let expressible = |a: &&Atom| in_tier.contains(&a.pred()) || request.known.contains(a);
-            predicted += translated.state.len();
-            actual += truth.iter().filter(expressible).count();
-            tp += translated.state.iter().filter(|a| truth.contains(a)).count();
-        }
-        states.push(translated.state.clone());
+    for (request, translated) in results {
+        let Some(truth) = &request.ground_truth else {
+            continue;
+        };
+        // The reference is the part of the truth the prompt could express: its tier's
+        // predicates and the atoms given as known. Atoms of predicates outside the tier are
+        // never accepted from any reply, so counting them would lower recall for a perfect
+        // translator.
+        let in_tier: Vec<_> = request
+            .vocabulary
+            .tier(request.tier)
+            .iter()
+            .map(|p| p.name)
+            .collect();
+        let expressible = |a: &&Atom| in_tier.contains(&a.pred()) || request.known.contains(a);
+        predicted += translated.state.len();
+        actual += truth.iter().filter(expressible).count();
+        tp += translated.state.iter().filter(|a| truth.contains(a)).count();
     }
-    let target_state = states.pop().ok_or_else(|| PipelineError::States {
-        message: "no translation of the target's state".into(),
-        kind: None,
-    })?;
-    let agreement = (actual > 0).then(|| {
+    (actual > 0).then(|| {
         let precision = if predicted == 0 {
             0.0
         } else {
@@ -261,16 +306,5 @@ pub async fn symbolic_states(
             f1,
             counts: [tp, predicted, actual].map(|n| n as u64),
         }
-    });
-    Ok(SymbolicStates {
-        demo_states: states,
-        target_state,
-        source: StateSource::Vlm {
-            translated: total,
-            rejected_atoms,
-            reasked_replies,
-            agreement,
-        },
-        vlm_time: started.elapsed(),
     })
 }

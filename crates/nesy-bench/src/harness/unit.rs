@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use nesy_core::benchmark::Factor;
 use nesy_core::format_procedure;
+use nesy_pipeline::execute::ExecutionReport;
 use nesy_pipeline::states::StateSource;
 use nesy_pipeline::synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest};
 use nesy_pipeline::{AdaptOptions, DemoInput, derive_setting, execute, output, synth, vlm};
@@ -14,11 +15,11 @@ use nesy_policy::Limits;
 use nesy_reasoner::VlmReasoner;
 use nesy_reasoner::codegen::CodeGenerationRequest;
 use nesy_sim::tasks::scenario::Side;
-use nesy_vlm::CassetteFile;
+use nesy_vlm::{CassetteFile, RunUsage};
 use nesy_vlm::{CassetteMode, CassetteOptions, CassetteTransport, Transport, VlmClient, VlmConfig};
 use serde::Serialize;
 
-use crate::meter::Metered;
+use crate::meter::{CallCounts, Metered};
 use crate::methods::{self, Method, MethodFailure, Specification, Specified, UnitInputs};
 use crate::status::UnitStatus;
 use crate::unit::Unit;
@@ -27,7 +28,7 @@ use crate::variant::Variant;
 
 use super::config::ResponderSetup;
 use super::reexec::reexecuted;
-use super::shared::{PhaseA, PhaseAFailure, Shared, UnitClient, cpu, scenario_inputs};
+use super::shared::{PhaseA, PhaseAFailure, ScenarioInputs, Shared, UnitClient, cpu, scenario_inputs};
 
 pub(super) fn unit_dir(shared: &Shared, unit: &Unit) -> PathBuf {
     shared
@@ -304,40 +305,9 @@ pub(super) fn agreement(states: &Option<StateSource>) -> Option<Agreement> {
 pub(super) async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
     let started = Instant::now();
     let mut effort = Effort::default();
-    let inputs = match scenario_inputs(shared, &unit.scenario).await {
-        Ok(i) => i,
-        Err(e) => {
-            return failed_record(
-                shared,
-                unit,
-                UnitStatus::MethodError,
-                format!("preparing the scenario: {e}"),
-                effort,
-            );
-        }
-    };
-    if !inputs.cached.record.usable() && !shared.config.settings.keep_gapped_demos {
-        let why = inputs.cached.record.unusable_reason().unwrap_or_default();
-        return failed_record(shared, unit, UnitStatus::DemoUnusable, why, effort);
-    }
-    let dir = unit_dir(shared, unit);
-    if let Err(e) = std::fs::create_dir_all(&dir) {
-        return failed_record(
-            shared,
-            unit,
-            UnitStatus::MethodError,
-            format!("{}: {e}", dir.display()),
-            effort,
-        );
-    }
-    let setting = derive_setting(&inputs.demo, &inputs.target, &AdaptOptions::default());
-    let unit_inputs = UnitInputs {
-        demo: inputs.demo.clone(),
-        keyframes: inputs.keyframes.clone(),
-        target: inputs.target.clone(),
-        setting,
-        variant: unit.variant.clone(),
-        seed: unit.seed,
+    let (inputs, dir, unit_inputs) = match prepare_unit(shared, unit).await {
+        Ok(prepared) => prepared,
+        Err((status, message)) => return failed_record(shared, unit, status, message, effort),
     };
     let (client, counts) = match unit_client(shared, unit, &inputs.demo) {
         Ok(c) => c,
@@ -350,24 +320,12 @@ pub(super) async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
         None => specify_and_code(&client, &unit_inputs, &dir, unit).await,
     };
     let usage = client.finish().ok();
-    let c = counts.lock().unwrap_or_else(|e| e.into_inner()).clone();
-    effort.calls = c.calls;
-    effort.images = c.images;
-    effort.calls_by_purpose = c.by_purpose.clone();
-    if let Some(u) = &usage {
-        effort.tokens = u.total.prompt_tokens + u.total.completion_tokens;
-        effort.cost_usd = u.total.cost_usd;
-        effort.cost_by_purpose = u
-            .by_purpose
-            .iter()
-            .filter(|(_, t)| t.cost_usd > 0.0)
-            .map(|(purpose, t)| (purpose.clone(), t.cost_usd))
-            .collect();
-    }
+    let counts = counts.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    account_calls(&mut effort, &counts, usage.as_ref());
     let (code, mut record_base) = match phase_a {
         Ok(a) => a,
         Err((status, message, summary)) => {
-            let status = if c.cap_reached {
+            let status = if counts.cap_reached {
                 UnitStatus::MethodError
             } else {
                 status
@@ -384,20 +342,7 @@ pub(super) async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
     effort.codegen_template_s = record_base.template_s;
 
     // Phase B: execution in the sandboxed simulator.
-    let target = inputs.target.clone();
-    let worker = shared.config.worker.clone();
-    let limits = Limits {
-        wall_time_ms: shared.config.settings.policy_wall_ms,
-        ..Limits::default()
-    };
-    let exec_dir = dir.clone();
-    let executed = cpu(shared, move || {
-        let scene = output::prepare_dir(&exec_dir, &target, None).map_err(|e| e.to_string())?;
-        write(&exec_dir.join(output::POLICY_FILE), &code)?;
-        execute::execute(&worker, &code, &scene, &limits).map_err(|e| e.to_string())
-    })
-    .await
-    .and_then(|r| r);
+    let executed = execute_code(shared, &inputs, &dir, code).await;
     effort.sim_s = inputs.target.sim_time.as_secs_f64();
     let report = match executed {
         Ok(r) => r,
@@ -409,9 +354,98 @@ pub(super) async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
         }
     };
     effort.sim_s += report.result.wall_time_s;
-    let _ = write_json(&dir.join(output::EXECUTION_FILE), &report);
-    let (label, subtask_names) = target_label(unit);
-    let scores = match &report.metrics {
+    if let Err(e) = write_json(&dir.join(output::EXECUTION_FILE), &report) {
+        // The episode's evidence could not be kept: the unit runs again on resume rather
+        // than be scored without it.
+        effort.wall_s = started.elapsed().as_secs_f64();
+        let message =
+            format!("the execution record could not be written ({e}); the unit runs again on resume");
+        return failed_record(shared, unit, UnitStatus::Interrupted, message, effort);
+    }
+    let scores = scores_of(&report, unit);
+    let (status, error) = execution_verdict(&report);
+    effort.wall_s = started.elapsed().as_secs_f64();
+    let mut r = base_record(shared, unit, status, error, scores, effort);
+    r.spec = record_base.spec.take();
+    r.states = record_base.states;
+    r
+}
+
+/// The unit's scenario inputs, its directory and the method's inputs; or why it cannot run
+/// (its scenario could not be prepared, its demonstration is unusable, its directory cannot
+/// be made).
+async fn prepare_unit(
+    shared: &Arc<Shared>,
+    unit: &Unit,
+) -> Result<(Arc<ScenarioInputs>, PathBuf, UnitInputs), (UnitStatus, String)> {
+    let inputs = scenario_inputs(shared, &unit.scenario)
+        .await
+        .map_err(|e| (UnitStatus::MethodError, format!("preparing the scenario: {e}")))?;
+    if !inputs.cached.record.usable() && !shared.config.settings.keep_gapped_demos {
+        let why = inputs.cached.record.unusable_reason().unwrap_or_default();
+        return Err((UnitStatus::DemoUnusable, why));
+    }
+    let dir = unit_dir(shared, unit);
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| (UnitStatus::MethodError, format!("{}: {e}", dir.display())))?;
+    let setting = derive_setting(&inputs.demo, &inputs.target, &AdaptOptions::default());
+    let unit_inputs = UnitInputs {
+        demo: inputs.demo.clone(),
+        keyframes: inputs.keyframes.clone(),
+        target: inputs.target.clone(),
+        setting,
+        variant: unit.variant.clone(),
+        seed: unit.seed,
+    };
+    Ok((inputs, dir, unit_inputs))
+}
+
+/// The unit's model calls, images, tokens and cost, from the meter's counts and the client's
+/// accounting.
+fn account_calls(effort: &mut Effort, counts: &CallCounts, usage: Option<&RunUsage>) {
+    effort.calls = counts.calls;
+    effort.images = counts.images;
+    effort.calls_by_purpose = counts.by_purpose.clone();
+    if let Some(u) = usage {
+        effort.tokens = u.total.prompt_tokens + u.total.completion_tokens;
+        effort.cost_usd = u.total.cost_usd;
+        effort.cost_by_purpose = u
+            .by_purpose
+            .iter()
+            .filter(|(_, t)| t.cost_usd > 0.0)
+            .map(|(purpose, t)| (purpose.clone(), t.cost_usd))
+            .collect();
+    }
+}
+
+/// Phase B: the program written beside the target scene and run in the sandboxed worker,
+/// under a CPU slot.
+async fn execute_code(
+    shared: &Shared,
+    inputs: &ScenarioInputs,
+    dir: &Path,
+    code: String,
+) -> Result<ExecutionReport, String> {
+    let target = inputs.target.clone();
+    let worker = shared.config.worker.clone();
+    let limits = Limits {
+        wall_time_ms: shared.config.settings.policy_wall_ms,
+        ..Limits::default()
+    };
+    let exec_dir = dir.to_owned();
+    cpu(shared, move || {
+        let scene = output::prepare_dir(&exec_dir, &target, None).map_err(|e| e.to_string())?;
+        write(&exec_dir.join(output::POLICY_FILE), &code)?;
+        execute::execute(&worker, &code, &scene, &limits).map_err(|e| e.to_string())
+    })
+    .await
+    .and_then(|r| r)
+}
+
+/// The unit's scores: the episode's goal checks, or zeros with the target's label when no
+/// check was reported.
+fn scores_of(report: &ExecutionReport, unit: &Unit) -> Scores {
+    match &report.metrics {
         Some(m) => Scores {
             sr: m.sr,
             gc: m.gc,
@@ -430,47 +464,49 @@ pub(super) async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
                 })
                 .collect(),
         },
-        None => Scores::not_executed(label, &subtask_names),
+        None => {
+            let (label, subtask_names) = target_label(unit);
+            Scores::not_executed(label, &subtask_names)
+        }
+    }
+}
+
+/// Succeeded, or execution failed with why: the subtasks that failed or left objects out
+/// of place, the exception the policy raised, or how else the episode ended.
+fn execution_verdict(report: &ExecutionReport) -> (UnitStatus, Option<String>) {
+    if report.success() {
+        return (UnitStatus::Succeeded, None);
+    }
+    let why = match &report.result.outcome {
+        nesy_policy::Outcome::Ok => {
+            let failed: Vec<String> = report
+                .metrics
+                .iter()
+                .flat_map(|m| &m.subtasks)
+                .filter(|s| !s.status.is_success() || !s.displaced.is_empty())
+                .map(|s| {
+                    if s.displaced.is_empty() {
+                        format!("{} {}", s.subtask, s.status)
+                    } else {
+                        format!("{} displaced {}", s.subtask, s.displaced.join(" "))
+                    }
+                })
+                .collect();
+            format!("the policy ran to its end; {}", failed.join(", "))
+        }
+        nesy_policy::Outcome::PythonError(e) => {
+            format!(
+                "the policy raised {}: {}{}",
+                e.exception,
+                e.message,
+                e.line
+                    .map(|l| format!(" (policy.py line {l})"))
+                    .unwrap_or_default()
+            )
+        }
+        other => format!("the policy ended with {}", other.kind()),
     };
-    let (status, error) = if report.success() {
-        (UnitStatus::Succeeded, None)
-    } else {
-        let why = match &report.result.outcome {
-            nesy_policy::Outcome::Ok => {
-                let failed: Vec<String> = report
-                    .metrics
-                    .iter()
-                    .flat_map(|m| &m.subtasks)
-                    .filter(|s| !s.status.is_success() || !s.displaced.is_empty())
-                    .map(|s| {
-                        if s.displaced.is_empty() {
-                            format!("{} {}", s.subtask, s.status)
-                        } else {
-                            format!("{} displaced {}", s.subtask, s.displaced.join(" "))
-                        }
-                    })
-                    .collect();
-                format!("the policy ran to its end; {}", failed.join(", "))
-            }
-            nesy_policy::Outcome::PythonError(e) => {
-                format!(
-                    "the policy raised {}: {}{}",
-                    e.exception,
-                    e.message,
-                    e.line
-                        .map(|l| format!(" (policy.py line {l})"))
-                        .unwrap_or_default()
-                )
-            }
-            other => format!("the policy ended with {}", other.kind()),
-        };
-        (UnitStatus::ExecutionFailed, Some(why))
-    };
-    effort.wall_s = started.elapsed().as_secs_f64();
-    let mut r = base_record(shared, unit, status, error, scores, effort);
-    r.spec = record_base.spec.take();
-    r.states = record_base.states;
-    r
+    (UnitStatus::ExecutionFailed, Some(why))
 }
 
 pub(super) async fn specify_and_code(
