@@ -251,9 +251,51 @@ fn propose_checked(
         ctx.target_embodiment,
         config,
     );
-    let procedure = &req.procedure;
+    let violation = identify(ctx)?;
+    let mut found = Candidates::default();
+    match (violation.kind, violation.failing_step) {
+        (ViolationKind::Goal, _) | (_, None) => append_to_goal(&planning, ctx, &violation, &mut found)?,
+        (_, Some(i)) => {
+            convert_from(&planning, ctx, &violation, i, &mut found);
+            insert_before(&planning, ctx, &violation, i, &mut found);
+            remove_around(ctx, &violation, i, &mut found);
+        }
+    }
+    if !checked {
+        return found.patches.into_iter().next().ok_or_else(|| {
+            OraclePatchError::Unresolvable(if found.reasons.is_empty() {
+                "no candidate patch for the guessed step".into()
+            } else {
+                found.reasons.join("; ")
+            })
+        });
+    }
+    let best = found
+        .patches
+        .into_iter()
+        .filter_map(|p| score(&req.procedure, &req.initial_state, &violation, p))
+        .max_by(|a, b| a.key.cmp(&b.key).then(b.patch.at.cmp(&a.patch.at)));
+    match best {
+        Some(s) => Ok(s.patch),
+        None if found.reasons.is_empty() => Err(OraclePatchError::Unresolvable(
+            "no candidate patch passes verification".into(),
+        )),
+        None => Err(OraclePatchError::Unresolvable(found.reasons.join("; "))),
+    }
+}
 
-    // Identification ablated: find the violation ourselves.
+/// The patches proposed so far, and why the planner found none where it failed.
+#[derive(Default)]
+struct Candidates {
+    patches: Vec<ProposedPatch>,
+    reasons: Vec<String>,
+}
+
+/// The violation to repair: the request's, or, with identification ablated, the first
+/// failing step found by replaying the procedure from the initial state.
+fn identify(ctx: &PatchContext) -> Result<ViolationInfo, OraclePatchError> {
+    let req = &ctx.request;
+    let procedure = &req.procedure;
     let (kind, failing, unmet, error_state) = match req.kind {
         ViolationKind::Unidentified => {
             let report = verify_procedure(&req.initial_state, procedure, None);
@@ -269,155 +311,176 @@ fn propose_checked(
         }
         kind => (kind, req.failing_step, req.unmet.clone(), req.error_state.clone()),
     };
-    let violation = ViolationInfo {
+    Ok(ViolationInfo {
         kind,
         failing_step: failing,
         action: failing.and_then(|i| procedure.get(i)).map(|o| o.name.clone()),
-        unmet: unmet.clone(),
-        state: error_state.clone(),
-    };
-    let goal_of =
-        |unmet: &[UnmetPrecondition]| Formula::And(unmet.iter().map(|u| u.literal.clone()).collect());
+        unmet,
+        state: error_state,
+    })
+}
 
-    let mut candidates: Vec<ProposedPatch> = Vec::new();
-    let mut reasons: Vec<String> = Vec::new();
-    match (kind, failing) {
-        (ViolationKind::Goal, _) | (_, None) => {
-            let Some(last) = procedure.last() else {
-                return Err(OraclePatchError::Unresolvable("the procedure is empty".into()));
-            };
-            // A goal literal that held when the request was made is not among the unmet
-            // ones, so a plan to the unmet literals alone may undo it (open a drawer the goal
-            // wants closed). The verifier's feedback names such literals; like a model
-            // reading it, the next plan reaches them too.
-            let mut wanted = unmet.clone();
-            for f in &req.feedback {
-                if let Problem::NotResolved {
-                    failing_step: None,
-                    unmet: left,
-                } = &f.problem
-                {
-                    for u in left {
-                        if !wanted.iter().any(|w| w.literal == u.literal) {
-                            wanted.push(u.clone());
-                        }
-                    }
-                }
-            }
-            match planning.plan(&error_state, &goal_of(&wanted)) {
-                Ok((plan, _)) => {
-                    let mut replace = vec![last.clone()];
-                    replace.extend(plan);
-                    candidates.push(ProposedPatch {
-                        strategy: Strategy::Append,
-                        search: vec![last.clone()],
-                        replace,
-                        at: procedure.len() - 1,
-                        rationale: "every action applies but the goal does not hold yet; a plan over the true domain reaches the unmet goal literals after the last action.".into(),
-                    });
-                }
-                Err(e) => reasons.push(e),
-            }
-        }
-        (_, Some(i)) => {
-            let erroneous = &procedure[i];
-            let mut preds = Vec::new();
-            unmet.iter().for_each(|u| formula_preds(&u.literal, &mut preds));
-            let cross = preds
-                .iter()
-                .any(|p| is_other_embodiment_pred(p.as_str(), ctx.target_embodiment));
-            if cross {
-                match convert(&planning, &error_state, &procedure[i..]) {
-                    Ok(replace) => candidates.push(ProposedPatch {
-                        strategy: Strategy::Convert,
-                        search: procedure[i..].to_vec(),
-                        replace,
-                        at: i,
-                        rationale: format!(
-                            "{} needs the other end effector; the rest of the plan is rewritten for the {} so that each action's physical effects are reached in turn.",
-                            erroneous.name,
-                            ctx.target_embodiment.description()
-                        ),
-                    }),
-                    Err(e) => reasons.push(e),
-                }
-            }
-            // Plan to all of the erroneous action's preconditions (so that making the unmet
-            // ones true does not undo the others, e.g. the hand must be empty again after
-            // moving a blocker away), and to the unmet ones alone as a fallback.
-            let whole = Formula::And(erroneous.pre.to_vec());
-            for goal in [whole, goal_of(&unmet)] {
-                match planning.plan(&error_state, &goal) {
-                    Ok((plan, _)) if !plan.is_empty() => {
-                        let mut replace = plan;
-                        replace.push(erroneous.clone());
-                        candidates.push(ProposedPatch {
-                            strategy: Strategy::Insert,
-                            search: vec![erroneous.clone()],
-                            replace,
-                            at: i,
-                            rationale: format!(
-                                "{} fails because {} do not hold; the inserted actions make them true first.",
-                                erroneous.name,
-                                unmet
-                                    .iter()
-                                    .map(|u| u.literal.to_string())
-                                    .collect::<Vec<_>>()
-                                    .join(", ")
-                            ),
-                        });
-                    }
-                    Ok(_) => {}
-                    Err(e) => reasons.push(e),
-                }
-            }
-            // Redundant windows around the erroneous action, when it is redundant itself:
-            // what it would do already holds (applying its effects changes nothing).
-            let states = rollout(&req.initial_state, procedure);
-            let redundant = apply_unchecked(&error_state, erroneous) == error_state;
-            for k in (i.saturating_sub(4)..=i).filter(|_| redundant) {
-                let Some(before) = states.get(k) else { continue };
-                let mut s = before.clone();
-                for j in k..procedure.len().min(i + 5) {
-                    s = apply_unchecked(&s, &procedure[j]);
-                    if j < i {
-                        continue;
-                    }
-                    if physics_atoms(&s) == physics_atoms(before) {
-                        candidates.push(ProposedPatch {
-                            strategy: Strategy::Remove,
-                            search: procedure[k..=j].to_vec(),
-                            replace: Vec::new(),
-                            at: k,
-                            rationale: format!(
-                                "in this scene {} and the actions serving it change nothing physical: what they achieve already holds, so they are removed.",
-                                erroneous.name
-                            ),
-                        });
-                    }
+/// A conjunction of the unmet literals.
+fn goal_of(unmet: &[UnmetPrecondition]) -> Formula {
+    Formula::And(unmet.iter().map(|u| u.literal.clone()).collect())
+}
+
+/// Every action applies but the goal does not hold: a plan from the end state to the unmet
+/// goal literals, appended after the last action.
+fn append_to_goal(
+    planning: &Planning<'_>,
+    ctx: &PatchContext,
+    violation: &ViolationInfo,
+    found: &mut Candidates,
+) -> Result<(), OraclePatchError> {
+    let req = &ctx.request;
+    let procedure = &req.procedure;
+    let Some(last) = procedure.last() else {
+        return Err(OraclePatchError::Unresolvable("the procedure is empty".into()));
+    };
+    // A goal literal that held when the request was made is not among the unmet ones, so a
+    // plan to the unmet literals alone may undo it (open a drawer the goal wants closed).
+    // The verifier's feedback names such literals; like a model reading it, the next plan
+    // reaches them too.
+    let mut wanted = violation.unmet.clone();
+    for f in &req.feedback {
+        if let Problem::NotResolved {
+            failing_step: None,
+            unmet: left,
+        } = &f.problem
+        {
+            for u in left {
+                if !wanted.iter().any(|w| w.literal == u.literal) {
+                    wanted.push(u.clone());
                 }
             }
         }
     }
-    if !checked {
-        return candidates.into_iter().next().ok_or_else(|| {
-            OraclePatchError::Unresolvable(if reasons.is_empty() {
-                "no candidate patch for the guessed step".into()
-            } else {
-                reasons.join("; ")
-            })
-        });
+    match planning.plan(&violation.state, &goal_of(&wanted)) {
+        Ok((plan, _)) => {
+            let mut replace = vec![last.clone()];
+            replace.extend(plan);
+            found.patches.push(ProposedPatch {
+                strategy: Strategy::Append,
+                search: vec![last.clone()],
+                replace,
+                at: procedure.len() - 1,
+                rationale: "every action applies but the goal does not hold yet; a plan over the true domain reaches the unmet goal literals after the last action.".into(),
+            });
+        }
+        Err(e) => found.reasons.push(e),
     }
-    let best = candidates
-        .into_iter()
-        .filter_map(|p| score(procedure, &req.initial_state, &violation, p))
-        .max_by(|a, b| a.key.cmp(&b.key).then(b.patch.at.cmp(&a.patch.at)));
-    match best {
-        Some(s) => Ok(s.patch),
-        None if reasons.is_empty() => Err(OraclePatchError::Unresolvable(
-            "no candidate patch passes verification".into(),
-        )),
-        None => Err(OraclePatchError::Unresolvable(reasons.join("; "))),
+    Ok(())
+}
+
+/// When step `i` fails on the other end effector's predicates: the rest of the procedure
+/// rewritten for the target's end effector.
+fn convert_from(
+    planning: &Planning<'_>,
+    ctx: &PatchContext,
+    violation: &ViolationInfo,
+    i: usize,
+    found: &mut Candidates,
+) {
+    let procedure = &ctx.request.procedure;
+    let mut preds = Vec::new();
+    violation
+        .unmet
+        .iter()
+        .for_each(|u| formula_preds(&u.literal, &mut preds));
+    let cross = preds
+        .iter()
+        .any(|p| is_other_embodiment_pred(p.as_str(), ctx.target_embodiment));
+    if !cross {
+        return;
+    }
+    match convert(planning, &violation.state, &procedure[i..]) {
+        Ok(replace) => found.patches.push(ProposedPatch {
+            strategy: Strategy::Convert,
+            search: procedure[i..].to_vec(),
+            replace,
+            at: i,
+            rationale: format!(
+                "{} needs the other end effector; the rest of the plan is rewritten for the {} so that each action's physical effects are reached in turn.",
+                procedure[i].name,
+                ctx.target_embodiment.description()
+            ),
+        }),
+        Err(e) => found.reasons.push(e),
+    }
+}
+
+/// Actions inserted before step `i` that make its preconditions hold: planned to all of
+/// them (so that making the unmet ones true does not undo the others, e.g. the hand must be
+/// empty again after moving a blocker away), and to the unmet ones alone as a fallback.
+fn insert_before(
+    planning: &Planning<'_>,
+    ctx: &PatchContext,
+    violation: &ViolationInfo,
+    i: usize,
+    found: &mut Candidates,
+) {
+    let erroneous = &ctx.request.procedure[i];
+    let whole = Formula::And(erroneous.pre.to_vec());
+    for goal in [whole, goal_of(&violation.unmet)] {
+        match planning.plan(&violation.state, &goal) {
+            Ok((plan, _)) if !plan.is_empty() => {
+                let mut replace = plan;
+                replace.push(erroneous.clone());
+                found.patches.push(ProposedPatch {
+                    strategy: Strategy::Insert,
+                    search: vec![erroneous.clone()],
+                    replace,
+                    at: i,
+                    rationale: format!(
+                        "{} fails because {} do not hold; the inserted actions make them true first.",
+                        erroneous.name,
+                        violation
+                            .unmet
+                            .iter()
+                            .map(|u| u.literal.to_string())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                });
+            }
+            Ok(_) => {}
+            Err(e) => found.reasons.push(e),
+        }
+    }
+}
+
+/// When step `i` is redundant in this scene (applying its effects changes nothing): the
+/// windows of actions around it whose physical effects cancel out, removed.
+fn remove_around(ctx: &PatchContext, violation: &ViolationInfo, i: usize, found: &mut Candidates) {
+    let req = &ctx.request;
+    let procedure = &req.procedure;
+    let erroneous = &procedure[i];
+    if apply_unchecked(&violation.state, erroneous) != violation.state {
+        return;
+    }
+    let states = rollout(&req.initial_state, procedure);
+    for k in i.saturating_sub(4)..=i {
+        let Some(before) = states.get(k) else { continue };
+        let mut s = before.clone();
+        for j in k..procedure.len().min(i + 5) {
+            s = apply_unchecked(&s, &procedure[j]);
+            if j < i {
+                continue;
+            }
+            if physics_atoms(&s) == physics_atoms(before) {
+                found.patches.push(ProposedPatch {
+                    strategy: Strategy::Remove,
+                    search: procedure[k..=j].to_vec(),
+                    replace: Vec::new(),
+                    at: k,
+                    rationale: format!(
+                        "in this scene {} and the actions serving it change nothing physical: what they achieve already holds, so they are removed.",
+                        erroneous.name
+                    ),
+                });
+            }
+        }
     }
 }
 
