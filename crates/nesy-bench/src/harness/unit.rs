@@ -509,6 +509,19 @@ fn execution_verdict(report: &ExecutionReport) -> (UnitStatus, Option<String>) {
     (UnitStatus::ExecutionFailed, Some(why))
 }
 
+/// A unit artifact that could not be written: the unit is recorded as interrupted, so that
+/// it runs again on resume rather than be scored without its evidence.
+fn unkept(summary: Option<SpecSummary>) -> impl FnOnce(String) -> PhaseAFailure {
+    move |e| {
+        (
+            UnitStatus::Interrupted,
+            format!("a unit artifact could not be written ({e}); the unit runs again on resume"),
+            summary,
+        )
+    }
+}
+
+/// Phase A: the method's specification, its artifacts written, and its code.
 pub(super) async fn specify_and_code(
     client: &VlmClient,
     inputs: &UnitInputs,
@@ -521,7 +534,7 @@ pub(super) async fn specify_and_code(
         Ok(s) => s,
         Err(f) => {
             if let Some(a) = &f.adaptation {
-                let _ = write_json(&dir.join(output::ADAPTATION_FILE), a.as_ref());
+                write_json(&dir.join(output::ADAPTATION_FILE), a.as_ref()).map_err(unkept(None))?;
             }
             let summary = f.iterations.map(|(iterations, budget)| SpecSummary {
                 kind: "none".into(),
@@ -549,16 +562,17 @@ pub(super) async fn specify_and_code(
             .collect::<Vec<_>>()
             .join("\n"),
     };
-    let _ = write_json(
+    write_json(
         &dir.join("spec.json"),
         &serde_json::json!({
             "summary": summary,
             "text": spec_text,
             "notes": specified.notes,
         }),
-    );
+    )
+    .map_err(unkept(Some(summary.clone())))?;
     if let Some(a) = &specified.adaptation {
-        let _ = write_json(&dir.join(output::ADAPTATION_FILE), a);
+        write_json(&dir.join(output::ADAPTATION_FILE), a).map_err(unkept(Some(summary.clone())))?;
     }
     let (code, vlm_code_s, template_s) = make_code(client, inputs, &specified)
         .await
