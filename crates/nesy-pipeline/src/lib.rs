@@ -93,7 +93,7 @@ pub struct AdaptOptions {
     /// the running executable.
     pub worker: Option<WorkerCommand>,
     /// The run directory: the target scene and the program are written here before
-    /// execution, and [`output::write_all`] writes the rest.
+    /// execution, and [`output::RunDir::write_all`] writes the rest.
     pub out_dir: PathBuf,
 }
 
@@ -305,7 +305,7 @@ pub async fn adapt_episode(
 /// Runs stages 2–6 on a demo and a target with `client`'s model: states, world model and
 /// adaptation, code synthesis, and execution when `options.execute`. The target scene and
 /// the program are written to `options.out_dir` before execution, so a crash loses neither;
-/// [`output::write_all`] writes the rest of the run directory.
+/// [`output::RunDir::write_all`] writes the rest of the run directory.
 pub async fn run(
     demo: &DemoInput,
     target: &TargetInput,
@@ -398,7 +398,8 @@ pub async fn run(
     })?;
 
     // Execution. The scene and the program are written first, so a crash loses nothing.
-    let scene_path = output::prepare_dir(&options.out_dir, target, policy.as_ref())?;
+    let run_dir = output::RunDir::create(&options.out_dir)?;
+    let scene_path = run_dir.prepare(target, policy.as_ref().map(|p| p.code.as_str()))?;
     let mut execution = None;
     if let (true, Some(p)) = (options.execute, &policy) {
         progress.stage("executing the policy in the sandbox");

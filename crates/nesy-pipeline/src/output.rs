@@ -24,7 +24,6 @@ use serde_json::json;
 use crate::execute::ExecutionReport;
 use crate::inputs::TargetInput;
 use crate::states::StateSource;
-use crate::synth::SynthesizedPolicy;
 use crate::synth::{CodegenMode, SynthError};
 use crate::{AdaptRun, PipelineError};
 
@@ -62,58 +61,130 @@ pub struct RunFailure<'a> {
     pub target: &'a Path,
 }
 
-/// Writes `failure.json` and the target scene into `dir` for a run that stopped with
-/// `error` before it had an outcome, so no failed run leaves an empty directory. Errors of
-/// bad input (the demo, the scene, the settings) write nothing: they happen before the run.
-pub fn write_failure(
-    dir: &Path,
-    target: &TargetInput,
-    error: &PipelineError,
-) -> Result<Option<PathBuf>, PipelineError> {
-    if error.is_bad_input() {
-        return Ok(None);
+/// A run directory: where one episode's files go, each under its fixed name. Every write
+/// names the file it could not write; none is dropped. `nesy adapt`, the pipeline's
+/// execution step and the benchmark's units all write through it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RunDir {
+    path: PathBuf,
+}
+
+impl RunDir {
+    /// The directory at `path`, created (with its parents) if missing.
+    pub fn create(path: impl Into<PathBuf>) -> Result<RunDir, PipelineError> {
+        let path = path.into();
+        std::fs::create_dir_all(&path).map_err(|e| PipelineError::write(&path, e))?;
+        Ok(RunDir { path })
     }
-    std::fs::create_dir_all(dir).map_err(|e| PipelineError::write(dir, e))?;
-    write(&dir.join(TARGET_SCENE_FILE), &target.scene.to_json_pretty())?;
-    let path = dir.join(FAILURE_FILE);
-    write_json(
-        &path,
-        &RunFailure {
-            status: "failed",
-            error: error.to_string(),
-            failure: error.reasoner_kind(),
-            target: &target.path,
-        },
-    )?;
-    Ok(Some(path))
-}
 
-/// Writes a file, naming it on failure.
-pub fn write(path: &Path, contents: &str) -> Result<(), PipelineError> {
-    std::fs::write(path, contents).map_err(|e| PipelineError::write(path, e))
-}
-
-/// Writes a value as pretty JSON with a trailing newline.
-pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), PipelineError> {
-    let text = serde_json::to_string_pretty(value)
-        .map_err(|e| PipelineError::write(path, std::io::Error::other(e)))?;
-    write(path, &(text + "\n"))
-}
-
-/// Creates the run directory and writes what execution needs before it starts: the target
-/// scene as run and, when there is one, the program. Returns the scene file's path.
-pub fn prepare_dir(
-    dir: &Path,
-    target: &TargetInput,
-    policy: Option<&SynthesizedPolicy>,
-) -> Result<PathBuf, PipelineError> {
-    std::fs::create_dir_all(dir).map_err(|e| PipelineError::write(dir, e))?;
-    let scene_path = dir.join(TARGET_SCENE_FILE);
-    write(&scene_path, &target.scene.to_json_pretty())?;
-    if let Some(p) = policy {
-        write(&dir.join(POLICY_FILE), &p.code)?;
+    /// The directory.
+    pub fn path(&self) -> &Path {
+        &self.path
     }
-    Ok(scene_path)
+
+    /// The path of the file `name` in the directory.
+    pub fn file(&self, name: &str) -> PathBuf {
+        self.path.join(name)
+    }
+
+    /// Writes the text file `name`; returns its path.
+    pub fn write_text(&self, name: &str, contents: &str) -> Result<PathBuf, PipelineError> {
+        let path = self.file(name);
+        std::fs::write(&path, contents).map_err(|e| PipelineError::write(&path, e))?;
+        Ok(path)
+    }
+
+    /// Writes `value` as pretty JSON with a trailing newline to the file `name`; returns its
+    /// path.
+    pub fn write_json(&self, name: &str, value: &impl Serialize) -> Result<PathBuf, PipelineError> {
+        let text = serde_json::to_string_pretty(value)
+            .map_err(|e| PipelineError::write(self.file(name), std::io::Error::other(e)))?;
+        self.write_text(name, &(text + "\n"))
+    }
+
+    /// Writes what execution needs before it starts: the target scene as run and, when
+    /// there is one, the program. Returns the scene file's path.
+    pub fn prepare(&self, target: &TargetInput, program: Option<&str>) -> Result<PathBuf, PipelineError> {
+        let scene_path = self.write_text(TARGET_SCENE_FILE, &target.scene.to_json_pretty())?;
+        if let Some(code) = program {
+            self.write_text(POLICY_FILE, code)?;
+        }
+        Ok(scene_path)
+    }
+
+    /// Writes `failure.json` and the target scene for a run that stopped with `error`
+    /// before it had an outcome, so no failed run leaves an empty directory. Errors of bad
+    /// input (the demo, the scene, the settings) write nothing: they happen before the run.
+    pub fn write_failure(
+        &self,
+        target: &TargetInput,
+        error: &PipelineError,
+    ) -> Result<Option<PathBuf>, PipelineError> {
+        if error.is_bad_input() {
+            return Ok(None);
+        }
+        self.write_text(TARGET_SCENE_FILE, &target.scene.to_json_pretty())?;
+        let path = self.write_json(
+            FAILURE_FILE,
+            &RunFailure {
+                status: "failed",
+                error: error.to_string(),
+                failure: error.reasoner_kind(),
+                target: &target.path,
+            },
+        )?;
+        Ok(Some(path))
+    }
+
+    /// Writes every output of `run`.
+    pub fn write_all(&self, run: &AdaptRun, target: &TargetInput) -> Result<(), PipelineError> {
+        self.prepare(target, run.policy.as_ref().map(|p| p.code.as_str()))?;
+        let wm = &run.adaptation.world_model;
+        self.write_json(
+            WORLD_MODEL_FILE,
+            &json!({
+                "demo": run.demo_path,
+                "tier": run.setting.tier,
+                "states": run.demo_states,
+                "procedure": wm.procedure,
+                "procedure_text": format_procedure(&wm.procedure),
+                "goal": wm.goal.to_string(),
+                "unverified_steps": wm.unverified_steps,
+                "verified": wm.is_verified(),
+            }),
+        )?;
+        let outcome_name = if run.adaptation.outcome.is_adapted() {
+            "adapted"
+        } else {
+            "unresolved"
+        };
+        self.write_json(
+            ADAPTATION_FILE,
+            &json!({
+                "status": outcome_name,
+                "budget": run.setting.budget,
+                "target_state": run.target_state,
+                "violations": violations(&run.adaptation),
+                "proposals": proposals(&run.adaptation),
+                "inductions": inductions(&run.adaptation),
+                "outcome": run.adaptation.outcome,
+                "trace": run.adaptation.trace,
+            }),
+        )?;
+        self.write_text(PROCEDURE_FILE, &procedure_text(run))?;
+        if let Some(execution) = &run.execution {
+            self.write_json(EXECUTION_FILE, execution)?;
+        }
+        for view in &target.views {
+            for (suffix, image) in [("", &view.image), ("_marked", &view.marked)] {
+                let path = self.file(&format!("target_{}{suffix}.png", view.camera));
+                std::fs::write(&path, image.to_png()).map_err(|e| PipelineError::write(&path, e))?;
+            }
+        }
+        self.write_text(REPORT_FILE, &report_markdown(run, target))?;
+        self.write_json(SUMMARY_FILE, run)?;
+        Ok(())
+    }
 }
 
 /// One violation the symbolic executor found while identifying (Eq. 6).
@@ -332,56 +403,6 @@ pub fn procedure_text(run: &AdaptRun) -> String {
     }
     text.push('\n');
     text
-}
-
-/// Writes every output of `run` into `dir`.
-pub fn write_all(run: &AdaptRun, target: &TargetInput, dir: &Path) -> Result<(), PipelineError> {
-    prepare_dir(dir, target, run.policy.as_ref())?;
-    let wm = &run.adaptation.world_model;
-    write_json(
-        &dir.join(WORLD_MODEL_FILE),
-        &json!({
-            "demo": run.demo_path,
-            "tier": run.setting.tier,
-            "states": run.demo_states,
-            "procedure": wm.procedure,
-            "procedure_text": format_procedure(&wm.procedure),
-            "goal": wm.goal.to_string(),
-            "unverified_steps": wm.unverified_steps,
-            "verified": wm.is_verified(),
-        }),
-    )?;
-    let outcome_name = if run.adaptation.outcome.is_adapted() {
-        "adapted"
-    } else {
-        "unresolved"
-    };
-    write_json(
-        &dir.join(ADAPTATION_FILE),
-        &json!({
-            "status": outcome_name,
-            "budget": run.setting.budget,
-            "target_state": run.target_state,
-            "violations": violations(&run.adaptation),
-            "proposals": proposals(&run.adaptation),
-            "inductions": inductions(&run.adaptation),
-            "outcome": run.adaptation.outcome,
-            "trace": run.adaptation.trace,
-        }),
-    )?;
-    write(&dir.join(PROCEDURE_FILE), &procedure_text(run))?;
-    if let Some(execution) = &run.execution {
-        write_json(&dir.join(EXECUTION_FILE), execution)?;
-    }
-    for view in &target.views {
-        for (suffix, image) in [("", &view.image), ("_marked", &view.marked)] {
-            let path = dir.join(format!("target_{}{suffix}.png", view.camera));
-            std::fs::write(&path, image.to_png()).map_err(|e| PipelineError::write(&path, e))?;
-        }
-    }
-    write(&dir.join(REPORT_FILE), &report_markdown(run, target))?;
-    write_json(&dir.join(SUMMARY_FILE), run)?;
-    Ok(())
 }
 
 /// `report.md`: the run for a human, with the target views embedded.

@@ -74,7 +74,10 @@ fn quick_start() {
     let execution = run.execution.as_ref().expect("executed");
     let metrics = execution.metrics.as_ref().expect("the scene has goal checks");
     assert_eq!(metrics.sr, 1.0, "{:?}", execution.result.outcome);
-    output::write_all(&run, &target, out.path()).unwrap();
+    output::RunDir::create(out.path())
+        .unwrap()
+        .write_all(&run, &target)
+        .unwrap();
     for file in [
         "world_model.json",
         "adaptation.json",

@@ -7,7 +7,9 @@ use std::time::Instant;
 
 use nesy_core::benchmark::Factor;
 use nesy_core::format_procedure;
+use nesy_pipeline::PipelineError;
 use nesy_pipeline::execute::ExecutionReport;
+use nesy_pipeline::output::RunDir;
 use nesy_pipeline::states::StateSource;
 use nesy_pipeline::synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest};
 use nesy_pipeline::{AdaptOptions, DemoInput, derive_setting, execute, output, synth, vlm};
@@ -17,7 +19,6 @@ use nesy_reasoner::codegen::CodeGenerationRequest;
 use nesy_sim::tasks::scenario::Side;
 use nesy_vlm::{CassetteFile, RunUsage};
 use nesy_vlm::{CassetteMode, CassetteOptions, CassetteTransport, Transport, VlmClient, VlmConfig};
-use serde::Serialize;
 
 use crate::meter::{CallCounts, Metered};
 use crate::methods::{self, Method, MethodFailure, Specification, Specified, UnitInputs};
@@ -281,17 +282,6 @@ pub(super) fn synth_status(e: &SynthError) -> (UnitStatus, String) {
     }
 }
 
-pub(super) fn write(path: &Path, text: &str) -> Result<(), String> {
-    std::fs::write(path, text).map_err(|e| format!("writing {}: {e}", path.display()))
-}
-
-pub(super) fn write_json(path: &Path, value: &impl Serialize) -> Result<(), String> {
-    write(
-        path,
-        &(serde_json::to_string_pretty(value).unwrap_or_default() + "\n"),
-    )
-}
-
 pub(super) fn agreement(states: &Option<StateSource>) -> Option<Agreement> {
     match states {
         Some(StateSource::Vlm {
@@ -354,7 +344,7 @@ pub(super) async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
         }
     };
     effort.sim_s += report.result.wall_time_s;
-    if let Err(e) = write_json(&dir.join(output::EXECUTION_FILE), &report) {
+    if let Err(e) = dir.write_json(output::EXECUTION_FILE, &report) {
         // The episode's evidence could not be kept: the unit runs again on resume rather
         // than be scored without it.
         effort.wall_s = started.elapsed().as_secs_f64();
@@ -377,7 +367,7 @@ pub(super) async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
 async fn prepare_unit(
     shared: &Arc<Shared>,
     unit: &Unit,
-) -> Result<(Arc<ScenarioInputs>, PathBuf, UnitInputs), (UnitStatus, String)> {
+) -> Result<(Arc<ScenarioInputs>, RunDir, UnitInputs), (UnitStatus, String)> {
     let inputs = scenario_inputs(shared, &unit.scenario)
         .await
         .map_err(|e| (UnitStatus::MethodError, format!("preparing the scenario: {e}")))?;
@@ -385,9 +375,7 @@ async fn prepare_unit(
         let why = inputs.cached.record.unusable_reason().unwrap_or_default();
         return Err((UnitStatus::DemoUnusable, why));
     }
-    let dir = unit_dir(shared, unit);
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| (UnitStatus::MethodError, format!("{}: {e}", dir.display())))?;
+    let dir = RunDir::create(unit_dir(shared, unit)).map_err(|e| (UnitStatus::MethodError, e.to_string()))?;
     let setting = derive_setting(&inputs.demo, &inputs.target, &AdaptOptions::default());
     let unit_inputs = UnitInputs {
         demo: inputs.demo.clone(),
@@ -423,7 +411,7 @@ fn account_calls(effort: &mut Effort, counts: &CallCounts, usage: Option<&RunUsa
 async fn execute_code(
     shared: &Shared,
     inputs: &ScenarioInputs,
-    dir: &Path,
+    dir: &RunDir,
     code: String,
 ) -> Result<ExecutionReport, String> {
     let target = inputs.target.clone();
@@ -432,10 +420,11 @@ async fn execute_code(
         wall_time_ms: shared.config.settings.policy_wall_ms,
         ..Limits::default()
     };
-    let exec_dir = dir.to_owned();
+    let exec_dir = dir.clone();
     cpu(shared, move || {
-        let scene = output::prepare_dir(&exec_dir, &target, None).map_err(|e| e.to_string())?;
-        write(&exec_dir.join(output::POLICY_FILE), &code)?;
+        let scene = exec_dir
+            .prepare(&target, Some(&code))
+            .map_err(|e| e.to_string())?;
         execute::execute(&worker, &code, &scene, &limits).map_err(|e| e.to_string())
     })
     .await
@@ -511,7 +500,7 @@ fn execution_verdict(report: &ExecutionReport) -> (UnitStatus, Option<String>) {
 
 /// A unit artifact that could not be written: the unit is recorded as interrupted, so that
 /// it runs again on resume rather than be scored without its evidence.
-fn unkept(summary: Option<SpecSummary>) -> impl FnOnce(String) -> PhaseAFailure {
+fn unkept(summary: Option<SpecSummary>) -> impl FnOnce(PipelineError) -> PhaseAFailure {
     move |e| {
         (
             UnitStatus::Interrupted,
@@ -521,11 +510,14 @@ fn unkept(summary: Option<SpecSummary>) -> impl FnOnce(String) -> PhaseAFailure 
     }
 }
 
+/// A unit's specification: its summary, its text and the method's notes.
+const SPEC_FILE: &str = "spec.json";
+
 /// Phase A: the method's specification, its artifacts written, and its code.
 pub(super) async fn specify_and_code(
     client: &VlmClient,
     inputs: &UnitInputs,
-    dir: &Path,
+    dir: &RunDir,
     unit: &Unit,
 ) -> Result<(String, PhaseA), PhaseAFailure> {
     let method: Arc<dyn Method> =
@@ -534,7 +526,8 @@ pub(super) async fn specify_and_code(
         Ok(s) => s,
         Err(f) => {
             if let Some(a) = &f.adaptation {
-                write_json(&dir.join(output::ADAPTATION_FILE), a.as_ref()).map_err(unkept(None))?;
+                dir.write_json(output::ADAPTATION_FILE, a.as_ref())
+                    .map_err(unkept(None))?;
             }
             let summary = f.iterations.map(|(iterations, budget)| SpecSummary {
                 kind: "none".into(),
@@ -562,8 +555,8 @@ pub(super) async fn specify_and_code(
             .collect::<Vec<_>>()
             .join("\n"),
     };
-    write_json(
-        &dir.join("spec.json"),
+    dir.write_json(
+        SPEC_FILE,
         &serde_json::json!({
             "summary": summary,
             "text": spec_text,
@@ -572,7 +565,8 @@ pub(super) async fn specify_and_code(
     )
     .map_err(unkept(Some(summary.clone())))?;
     if let Some(a) = &specified.adaptation {
-        write_json(&dir.join(output::ADAPTATION_FILE), a).map_err(unkept(Some(summary.clone())))?;
+        dir.write_json(output::ADAPTATION_FILE, a)
+            .map_err(unkept(Some(summary.clone())))?;
     }
     let (code, vlm_code_s, template_s) = make_code(client, inputs, &specified)
         .await

@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use anyhow::Context as _;
 use nesy_core::adapt::AdaptConfig;
-use nesy_pipeline::output::{induction_counts, proposals, violations};
+use nesy_pipeline::output::{RunDir, induction_counts, proposals, violations};
 use nesy_pipeline::states::{StateSource, StatesMode};
 use nesy_pipeline::synth::CodegenMode;
 use nesy_pipeline::vlm::{VlmSetup, VlmSource};
@@ -104,18 +104,27 @@ pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
         Ok(run) => run,
         Err(error) => {
             progress.stage("");
-            // A run that stops before it has an outcome still leaves its record behind.
-            if let Ok(Some(path)) = pipeline::output::write_failure(&options.out_dir, &target, &error) {
-                eprintln!(
-                    "nesy adapt: the run stopped before an outcome; {} records why",
-                    path.display()
-                );
+            // A run that stops before it has an outcome still leaves its record behind (bad
+            // input stops before the run and writes nothing).
+            if !error.is_bad_input() {
+                let recorded =
+                    RunDir::create(&options.out_dir).and_then(|dir| dir.write_failure(&target, &error));
+                match recorded {
+                    Ok(Some(path)) => eprintln!(
+                        "nesy adapt: the run stopped before an outcome; {} records why",
+                        path.display()
+                    ),
+                    Ok(None) => {}
+                    Err(write_error) => {
+                        eprintln!("nesy adapt: the failure could not be recorded: {write_error}")
+                    }
+                }
             }
             return Err(error.into());
         }
     };
     progress.stage("writing the outputs");
-    pipeline::output::write_all(&run, &target, &run.out_dir)?;
+    RunDir::create(&run.out_dir)?.write_all(&run, &target)?;
     progress.stage("");
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&run)?)?;
