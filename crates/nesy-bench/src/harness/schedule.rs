@@ -2,6 +2,7 @@
 //! each scenario's inputs loaded once, and one result line per finished unit.
 
 use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
@@ -31,23 +32,7 @@ pub async fn run(
     prepared.manifest.write_or_check(&config.run_dir)?;
     let manifest = Manifest::read(&config.run_dir)?;
     let done = final_records(&config.run_dir)?;
-    let hashes: HashMap<&str, &str> = manifest
-        .variants
-        .iter()
-        .map(|v| (v.id.as_str(), v.config_hash.as_str()))
-        .collect();
-    for r in done.values() {
-        if hashes.get(r.key.variant.as_str()) != Some(&r.config_hash.as_str()) {
-            return Err(BenchError::Mismatch {
-                path: store::results_dir(&config.run_dir),
-                message: format!(
-                    "unit {} was recorded with another configuration (hash {}); use a new run directory",
-                    r.key.name(),
-                    r.config_hash
-                ),
-            });
-        }
-    }
+    check_configurations(&config.run_dir, &manifest, &done)?;
     let mine = config.shard.select(&prepared.units);
     let pending: Vec<Unit> = mine
         .iter()
@@ -55,15 +40,7 @@ pub async fn run(
         .cloned()
         .collect();
     progress.start(mine.len(), pending.len());
-    let live = match &config.responder {
-        ResponderSetup::Live(overrides) => {
-            let c = VlmConfig::resolve(overrides, &ProcessEnv)
-                .map_err(|e| BenchError::Usage(format!("resolving the VLM configuration: {e}")))?;
-            let http = VlmClient::http_transport(&c).map_err(|e| BenchError::Usage(e.to_string()))?;
-            Some((c, Arc::new(http) as Arc<dyn Transport>))
-        }
-        _ => None,
-    };
+    let live = live_transport(&config.responder)?;
     let shared = Arc::new(Shared {
         cache: DemoCache::new(&config.demo_cache, config.settings.image_size),
         cpu: Arc::new(Semaphore::new(config.cpu_jobs.max(1))),
@@ -89,23 +66,8 @@ pub async fn run(
     let total_pending = queue.len();
     loop {
         while set.len() < config.jobs.max(1) && stopped.is_none() {
-            if stop.is_stopped() {
-                stopped = Some("interrupted".to_owned());
-                break;
-            }
-            if let Some(limit) = config.max_cost_usd
-                && *shared.cost.lock().unwrap_or_else(|e| e.into_inner()) >= limit
-            {
-                stopped = Some(format!("the cost guard: US$ {limit} reached (--max-cost-usd)"));
-                break;
-            }
-            if let Some(rate) = config.max_error_rate
-                && finished >= 10
-                && errors as f64 / finished as f64 > rate
-            {
-                stopped = Some(format!(
-                    "the error guard: {errors} of {finished} finished units failed to reach the model (--max-error-rate {rate})"
-                ));
+            if let Some(reason) = stop_reason(&config, &stop, &shared, finished, errors) {
+                stopped = Some(reason);
                 break;
             }
             let Some(unit) = queue.pop_front() else { break };
@@ -132,17 +94,7 @@ pub async fn run(
         {
             // Units in flight are recorded as interrupted and run again on resume.
             set.abort_all();
-            for unit in in_flight.values() {
-                let record = failed_record(
-                    &shared,
-                    unit,
-                    UnitStatus::Interrupted,
-                    "the run was stopped".into(),
-                    Effort::default(),
-                );
-                writer.append(&record)?;
-                *statuses.entry(record.status.as_str().into()).or_default() += 1;
-            }
+            record_interrupted(&shared, in_flight.values(), &mut writer, &mut statuses)?;
             break;
         }
         let Some(joined) = set.join_next().await else {
@@ -184,6 +136,96 @@ pub async fn run(
         stopped,
         wall_s: started.elapsed().as_secs_f64(),
     })
+}
+
+/// Refuses a run directory whose recorded units were made under another configuration of
+/// their variant: mixing them would score two configurations as one.
+fn check_configurations(
+    run_dir: &Path,
+    manifest: &Manifest,
+    done: &HashMap<String, UnitRecord>,
+) -> Result<(), BenchError> {
+    let hashes: HashMap<&str, &str> = manifest
+        .variants
+        .iter()
+        .map(|v| (v.id.as_str(), v.config_hash.as_str()))
+        .collect();
+    for r in done.values() {
+        if hashes.get(r.key.variant.as_str()) != Some(&r.config_hash.as_str()) {
+            return Err(BenchError::Mismatch {
+                path: store::results_dir(run_dir),
+                message: format!(
+                    "unit {} was recorded with another configuration (hash {}); use a new run directory",
+                    r.key.name(),
+                    r.config_hash
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The HTTP transport every unit shares, for a live responder.
+fn live_transport(responder: &ResponderSetup) -> Result<Option<(VlmConfig, Arc<dyn Transport>)>, BenchError> {
+    Ok(match responder {
+        ResponderSetup::Live(overrides) => {
+            let c = VlmConfig::resolve(overrides, &ProcessEnv)
+                .map_err(|e| BenchError::Usage(format!("resolving the VLM configuration: {e}")))?;
+            let http = VlmClient::http_transport(&c).map_err(|e| BenchError::Usage(e.to_string()))?;
+            Some((c, Arc::new(http) as Arc<dyn Transport>))
+        }
+        _ => None,
+    })
+}
+
+/// Why no further unit may start: the run was stopped, the cost guard or the error guard
+/// was reached.
+fn stop_reason(
+    config: &RunConfig,
+    stop: &StopSignal,
+    shared: &Shared,
+    finished: usize,
+    errors: usize,
+) -> Option<String> {
+    if stop.is_stopped() {
+        return Some("interrupted".to_owned());
+    }
+    if let Some(limit) = config.max_cost_usd
+        && *shared.cost.lock().unwrap_or_else(|e| e.into_inner()) >= limit
+    {
+        return Some(format!("the cost guard: US$ {limit} reached (--max-cost-usd)"));
+    }
+    if let Some(rate) = config.max_error_rate
+        && finished >= 10
+        && errors as f64 / finished as f64 > rate
+    {
+        return Some(format!(
+            "the error guard: {errors} of {finished} finished units failed to reach the model (--max-error-rate {rate})"
+        ));
+    }
+    None
+}
+
+/// Records the units in flight when the run was stopped as interrupted, to run again on
+/// resume.
+fn record_interrupted<'a>(
+    shared: &Shared,
+    in_flight: impl Iterator<Item = &'a Unit>,
+    writer: &mut ResultsWriter,
+    statuses: &mut BTreeMap<String, usize>,
+) -> Result<(), BenchError> {
+    for unit in in_flight {
+        let record = failed_record(
+            shared,
+            unit,
+            UnitStatus::Interrupted,
+            "the run was stopped".into(),
+            Effort::default(),
+        );
+        writer.append(&record)?;
+        *statuses.entry(record.status.as_str().into()).or_default() += 1;
+    }
+    Ok(())
 }
 
 /// Units of a run that have no final record yet, by name.

@@ -2,6 +2,7 @@
 //! optionally execute, a verified code policy. The work is done by `nesy_pipeline`; this
 //! module parses flags, owns the async runtime, shows progress and prints the summary.
 
+use std::fmt::Write as _;
 use std::io::IsTerminal as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -222,8 +223,18 @@ impl Progress for Spinner {
 
 /// The terminal summary.
 pub(crate) fn summary(run: &AdaptRun) -> String {
-    use std::fmt::Write as _;
     let mut out = String::new();
+    summarize_inputs(&mut out, run);
+    summarize_world_model(&mut out, run);
+    summarize_adaptation(&mut out, run);
+    summarize_policy(&mut out, run);
+    summarize_execution(&mut out, run);
+    summarize_time(&mut out, run);
+    out
+}
+
+/// The status, the demo, the target and where the states came from.
+fn summarize_inputs(out: &mut String, run: &AdaptRun) {
     let s = &run.setting;
     let _ = writeln!(out, "nesy adapt: {}", run.status.as_str().to_uppercase());
     let _ = writeln!(
@@ -254,6 +265,10 @@ pub(crate) fn summary(run: &AdaptRun) -> String {
         ),
     };
     let _ = writeln!(out, "  states    {states}");
+}
+
+/// How many operators were induced and whether all verified.
+fn summarize_world_model(out: &mut String, run: &AdaptRun) {
     let wm = &run.adaptation.world_model;
     let counts = induction_counts(&run.adaptation);
     let _ = writeln!(
@@ -267,6 +282,10 @@ pub(crate) fn summary(run: &AdaptRun) -> String {
         },
         counts.summary()
     );
+}
+
+/// The violations found and the proposals' verdicts, then the procedure.
+fn summarize_adaptation(out: &mut String, run: &AdaptRun) {
     let found = violations(&run.adaptation);
     let props = proposals(&run.adaptation);
     let accepted = props.iter().filter(|p| p.verdict == "accepted").count();
@@ -277,7 +296,7 @@ pub(crate) fn summary(run: &AdaptRun) -> String {
         props.len(),
         accepted,
         props.len() - accepted,
-        s.budget
+        run.setting.budget
     );
     for v in &found {
         let _ = match v.kind {
@@ -307,6 +326,10 @@ pub(crate) fn summary(run: &AdaptRun) -> String {
             );
         }
     }
+}
+
+/// Where the program came from, or why there is none.
+fn summarize_policy(out: &mut String, run: &AdaptRun) {
     if let Some(p) = &run.policy {
         let mode = match p.mode {
             CodegenMode::Vlm => "VLM code generation",
@@ -329,6 +352,10 @@ pub(crate) fn summary(run: &AdaptRun) -> String {
             first.lines().next().unwrap_or_default()
         );
     }
+}
+
+/// The episode's outcome and goal checks, when the policy ran.
+fn summarize_execution(out: &mut String, run: &AdaptRun) {
     if let Some(x) = &run.execution {
         let r = &x.result;
         let _ = writeln!(
@@ -368,6 +395,10 @@ pub(crate) fn summary(run: &AdaptRun) -> String {
             }
         }
     }
+}
+
+/// The time breakdown and where the outputs are.
+fn summarize_time(out: &mut String, run: &AdaptRun) {
     let t = &run.timing;
     let _ = writeln!(
         out,
@@ -385,5 +416,4 @@ pub(crate) fn summary(run: &AdaptRun) -> String {
         "  outputs   {}/ (report.md, adaptation.json, ...)",
         run.out_dir.display()
     );
-    out
 }

@@ -54,7 +54,10 @@ fn record_realstyle_fixture() {
             Arc::new(NoProgress),
         ))
         .unwrap();
-    pipeline::output::RunDir::create(&run.out_dir).unwrap().write_all(&run, &target).unwrap();
+    pipeline::output::RunDir::create(&run.out_dir)
+        .unwrap()
+        .write_all(&run, &target)
+        .unwrap();
     assert!(run.adapted().is_some(), "{:?}", run.adaptation.outcome);
 }
 
