@@ -50,7 +50,7 @@ pub mod synth;
 mod timing;
 pub mod vlm;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -366,31 +366,16 @@ pub async fn run(
     };
 
     // Code synthesis (never for an unresolved adaptation).
-    let mut policy = None;
-    let mut codegen_error = None;
-    if let adapt::Outcome::Adapted { procedure, .. } = &adaptation.outcome {
-        progress.stage("code synthesis");
-        let request = SynthesisRequest {
-            instruction: target.instruction(demo),
-            objects: target.objects.clone(),
-            procedure: procedure.clone(),
-            source: setting.source_embodiment,
-            target: setting.target_embodiment,
-            scene: &target.scene,
-        };
-        let synth_started = Instant::now();
-        match synth::synthesize(&reasoner, options.codegen, &request).await {
-            Ok(p) => policy = Some(p),
-            Err(e) => {
-                status = RunStatus::CodegenFailed;
-                codegen_error = Some(e);
-            }
-        }
-        let spent = synth_started.elapsed().as_secs_f64();
-        match options.codegen {
-            CodegenMode::Vlm => timing.vlm_s += spent,
-            CodegenMode::Template => timing.codegen_template_s += spent,
-        }
+    let inputs = SynthesisInputs {
+        demo,
+        target,
+        setting: &setting,
+        adaptation: &adaptation,
+        options,
+    };
+    let (policy, codegen_error) = synthesize_adapted(&reasoner, inputs, &mut timing, progress.as_ref()).await;
+    if codegen_error.is_some() {
+        status = RunStatus::CodegenFailed;
     }
 
     let usage = reasoner.client().finish().map_err(|e| PipelineError::Finish {
@@ -403,22 +388,7 @@ pub async fn run(
     let mut execution = None;
     if let (true, Some(p)) = (options.execute, &policy) {
         progress.stage("executing the policy in the sandbox");
-        let worker = match &options.worker {
-            Some(w) => w.clone(),
-            None => WorkerCommand::current_exe().map_err(|e| PipelineError::Execute {
-                scene: scene_path.clone(),
-                message: format!("locating the nesy executable: {e}"),
-            })?,
-        };
-        let code = p.code.clone();
-        let limits = options.limits.clone();
-        let path = scene_path.clone();
-        let report = tokio::task::spawn_blocking(move || execute::execute(&worker, &code, &path, &limits))
-            .await
-            .map_err(|e| PipelineError::Execute {
-                scene: scene_path.clone(),
-                message: format!("the execution task ended abnormally: {e}"),
-            })??;
+        let report = execute_policy(&p.code, &scene_path, options).await?;
         timing.sim_s += report.result.wall_time_s;
         if !report.success() {
             status = RunStatus::ExecutionFailed;
@@ -444,4 +414,72 @@ pub async fn run(
         timing,
         usage,
     })
+}
+
+/// What code synthesis needs from the run so far.
+struct SynthesisInputs<'a> {
+    demo: &'a DemoInput,
+    target: &'a TargetInput,
+    setting: &'a Setting,
+    adaptation: &'a Adaptation,
+    options: &'a AdaptOptions,
+}
+
+/// Step 5: the adapted procedure becomes a program, by the model or the template compiler,
+/// its time counted as model time or template-compiler time. Nothing is synthesized for an
+/// unresolved adaptation.
+async fn synthesize_adapted(
+    reasoner: &VlmReasoner,
+    inputs: SynthesisInputs<'_>,
+    timing: &mut TimeBreakdown,
+    progress: &dyn Progress,
+) -> (Option<SynthesizedPolicy>, Option<SynthError>) {
+    let adapt::Outcome::Adapted { procedure, .. } = &inputs.adaptation.outcome else {
+        return (None, None);
+    };
+    progress.stage("code synthesis");
+    let request = SynthesisRequest {
+        instruction: inputs.target.instruction(inputs.demo),
+        objects: inputs.target.objects.clone(),
+        procedure: procedure.clone(),
+        source: inputs.setting.source_embodiment,
+        target: inputs.setting.target_embodiment,
+        scene: &inputs.target.scene,
+    };
+    let synth_started = Instant::now();
+    let result = synth::synthesize(reasoner, inputs.options.codegen, &request).await;
+    let spent = synth_started.elapsed().as_secs_f64();
+    match inputs.options.codegen {
+        CodegenMode::Vlm => timing.vlm_s += spent,
+        CodegenMode::Template => timing.codegen_template_s += spent,
+    }
+    match result {
+        Ok(p) => (Some(p), None),
+        Err(e) => (None, Some(e)),
+    }
+}
+
+/// Step 6: the program in the sandboxed worker against the scene written at `scene_path`,
+/// on the blocking pool.
+async fn execute_policy(
+    code: &str,
+    scene_path: &Path,
+    options: &AdaptOptions,
+) -> Result<ExecutionReport, PipelineError> {
+    let worker = match &options.worker {
+        Some(w) => w.clone(),
+        None => WorkerCommand::current_exe().map_err(|e| PipelineError::Execute {
+            scene: scene_path.to_owned(),
+            message: format!("locating the nesy executable: {e}"),
+        })?,
+    };
+    let code = code.to_owned();
+    let limits = options.limits.clone();
+    let path = scene_path.to_owned();
+    tokio::task::spawn_blocking(move || execute::execute(&worker, &code, &path, &limits))
+        .await
+        .map_err(|e| PipelineError::Execute {
+            scene: scene_path.to_owned(),
+            message: format!("the execution task ended abnormally: {e}"),
+        })?
 }

@@ -313,23 +313,7 @@ fn sweep(
         threads,
         |_, (s, side)| run_one(s, *side),
         |i, result: &SceneResult| {
-            eprintln!(
-                "{:>4}/{total} {} {:<6} {}{}{}",
-                i + 1,
-                result.scenario,
-                result.side,
-                if result.full_success { "ok" } else { "FAIL" },
-                if result.displaced.is_empty() {
-                    String::new()
-                } else {
-                    format!(" (displaced: {})", result.displaced.join(", "))
-                },
-                result
-                    .expert_error
-                    .as_deref()
-                    .map(|e| format!(": {e}"))
-                    .unwrap_or_default()
-            );
+            eprintln!("{}", sweep_line(i, total, result));
             if let Some(file) = &mut report_file {
                 use std::io::Write;
                 let json = serde_json::to_string(result).unwrap_or_default();
@@ -339,7 +323,34 @@ fn sweep(
             }
         },
     );
-    let wall = started.elapsed().as_secs_f64();
+    print_sweep_summary(&results, started.elapsed().as_secs_f64(), threads)
+}
+
+/// One scene's line on stderr as it finishes: its position, id, side, verdict, any object
+/// left out of place and the expert's error.
+fn sweep_line(i: usize, total: usize, result: &SceneResult) -> String {
+    format!(
+        "{:>4}/{total} {} {:<6} {}{}{}",
+        i + 1,
+        result.scenario,
+        result.side,
+        if result.full_success { "ok" } else { "FAIL" },
+        if result.displaced.is_empty() {
+            String::new()
+        } else {
+            format!(" (displaced: {})", result.displaced.join(", "))
+        },
+        result
+            .expert_error
+            .as_deref()
+            .map(|e| format!(": {e}"))
+            .unwrap_or_default()
+    )
+}
+
+/// The sweep's counts, overall and by side, then the scenes to look at: those that pass only
+/// by the authors' latch and those that fail. Exit 1 when there is any.
+fn print_sweep_summary(results: &[SceneResult], wall: f64, threads: usize) -> anyhow::Result<ExitCode> {
     let latched = results.iter().filter(|r| r.full_success).count();
     let clean = results
         .iter()
