@@ -145,108 +145,10 @@ impl Study {
 
     /// The rows, the full method first.
     pub fn rows(self) -> Vec<StudyRow> {
-        let nesycr = || Variant::plain("nesycr");
         match self {
-            Study::Ablation => {
-                let noisy = || nesycr().with("noise", ABLATION_NOISE);
-                vec![
-                    StudyRow {
-                        label: "NeSyCR",
-                        variant: noisy(),
-                        reading: "every check on",
-                    },
-                    StudyRow {
-                        label: "w/o verification (Eq. 8)",
-                        variant: noisy().with("verification", "off"),
-                        reading: "a proposal whose SEARCH matches is accepted without checking that it resolves the violation; identification still runs on the patched procedure",
-                    },
-                    StudyRow {
-                        label: "w/o conflict (Eq. 6)",
-                        variant: noisy().with("identification", "off"),
-                        reading: "requests carry only the procedure and the target state; the responder localises the failure itself, missing it at the stated rate",
-                    },
-                    StudyRow {
-                        label: "w/o both",
-                        variant: noisy().with("identification", "off").with("verification", "off"),
-                        reading: "one revision with no signal, retried only when it cannot be read or does not match",
-                    },
-                    StudyRow {
-                        label: "w/o dynamics (Eq. 4), reading A",
-                        variant: noisy().with("world-model", "off"),
-                        reading: "reading A: induced operators exist but are never checked against the demonstration (the first parsable reply per transition is kept); identification and verification still run on them",
-                    },
-                    StudyRow {
-                        label: "w/o dynamics (Eq. 4), reading B",
-                        variant: noisy()
-                            .with("world-model", "off")
-                            .with("identification", "off")
-                            .with("verification", "off")
-                            .with("on-unresolved", "compile-last"),
-                        reading: "reading B, as the loop can express it: the symbolic tool checks nothing. Induced operators stay the model's own unchecked account of the demonstration; nothing identifies or verifies, so the loop makes one revision with no signal; the revised procedure is compiled and executed whatever the executor would say of it. Offline, the responder localises the failure with its own unchecked operators, missing at the stated rate",
-                    },
-                ]
-            }
-            Study::Robustness => {
-                let vlm = || nesycr().with("states", "vlm");
-                vec![
-                    StudyRow {
-                        label: "None",
-                        variant: vlm(),
-                        reading: "translated states equal the ground truth; exact transition check, as in every row not marked otherwise",
-                    },
-                    StudyRow {
-                        label: "10 % Drop",
-                        variant: vlm().with("noise", ROBUSTNESS_DROP),
-                        reading: "10 % of each demo keyframe's binary relations removed",
-                    },
-                    StudyRow {
-                        label: "10 % Noise (injected)",
-                        variant: vlm().with("noise", ROBUSTNESS_INJECT),
-                        reading: "10 % false binary relations added to each demo keyframe; none removed",
-                    },
-                    StudyRow {
-                        label: "10 % Drop, changed-atoms check",
-                        variant: vlm()
-                            .with("noise", ROBUSTNESS_DROP)
-                            .with("transition-check", "changed-atoms"),
-                        reading: "as 10 % Drop, with operators checked only on the atoms the transition changes (`TransitionCheck::ChangedAtoms`), closer to Eq. 4's entailment than the exact check",
-                    },
-                    StudyRow {
-                        label: "10 % Noise, changed-atoms check",
-                        variant: vlm()
-                            .with("noise", ROBUSTNESS_INJECT)
-                            .with("transition-check", "changed-atoms"),
-                        reading: "as 10 % Noise, with the changed-atoms transition check",
-                    },
-                    StudyRow {
-                        label: "Perception what-if (P 0.97, R 0.71)",
-                        variant: vlm().with("noise", PERCEPTION_WHAT_IF),
-                        reading: "every scene, demo and target, perceived at the paper's reported real-scene precision and recall; a what-if, not a measurement",
-                    },
-                ]
-            }
-            Study::ComplexityGap => vec![
-                StudyRow {
-                    label: "NeSyCR, target's goal",
-                    variant: nesycr().with("goal", "target"),
-                    reading: "the goal is the target task's, as its instruction states it (the scene's goal atoms, every object let go); the loop patches the demonstrated procedure until it reaches that goal",
-                },
-                StudyRow {
-                    label: "NeSyCR, demonstrated goal",
-                    variant: nesycr(),
-                    reading: "the goal derived from the demonstration, which never shows the added subtasks: the loop cannot know they are wanted",
-                },
-                StudyRow {
-                    label: "Imitation (control)",
-                    variant: Variant::plain("imitation"),
-                    reading: "the demonstrated procedure, unadapted, compiled and executed in the target",
-                },
-                StudyRow {
-                    label: "Replan (control)",
-                    variant: Variant::plain("replan"),
-                    reading: "nesy-core's planner from the target's state to its goal over the true domain, no demonstration",
-                },
-            ],
+            Study::Ablation => ablation_rows(),
+            Study::Robustness => robustness_rows(),
+            Study::ComplexityGap => complexity_gap_rows(),
         }
     }
 
@@ -260,6 +162,119 @@ impl fmt::Display for Study {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
     }
+}
+
+/// NeSyCR.
+fn nesycr() -> Variant {
+    Variant::plain("nesycr")
+}
+
+/// The ablation's rows (Table 3's shape), all under the ablation's error model.
+fn ablation_rows() -> Vec<StudyRow> {
+    let noisy = || nesycr().with("noise", ABLATION_NOISE);
+    vec![
+        StudyRow {
+            label: "NeSyCR",
+            variant: noisy(),
+            reading: "every check on",
+        },
+        StudyRow {
+            label: "w/o verification (Eq. 8)",
+            variant: noisy().with("verification", "off"),
+            reading: "a proposal whose SEARCH matches is accepted without checking that it resolves the violation; identification still runs on the patched procedure",
+        },
+        StudyRow {
+            label: "w/o conflict (Eq. 6)",
+            variant: noisy().with("identification", "off"),
+            reading: "requests carry only the procedure and the target state; the responder localises the failure itself, missing it at the stated rate",
+        },
+        StudyRow {
+            label: "w/o both",
+            variant: noisy().with("identification", "off").with("verification", "off"),
+            reading: "one revision with no signal, retried only when it cannot be read or does not match",
+        },
+        StudyRow {
+            label: "w/o dynamics (Eq. 4), reading A",
+            variant: noisy().with("world-model", "off"),
+            reading: "reading A: induced operators exist but are never checked against the demonstration (the first parsable reply per transition is kept); identification and verification still run on them",
+        },
+        StudyRow {
+            label: "w/o dynamics (Eq. 4), reading B",
+            variant: noisy()
+                .with("world-model", "off")
+                .with("identification", "off")
+                .with("verification", "off")
+                .with("on-unresolved", "compile-last"),
+            reading: "reading B, as the loop can express it: the symbolic tool checks nothing. Induced operators stay the model's own unchecked account of the demonstration; nothing identifies or verifies, so the loop makes one revision with no signal; the revised procedure is compiled and executed whatever the executor would say of it. Offline, the responder localises the failure with its own unchecked operators, missing at the stated rate",
+        },
+    ]
+}
+
+/// The robustness rows (Table 8's shape): translated states, perturbed as each row says.
+fn robustness_rows() -> Vec<StudyRow> {
+    let vlm = || nesycr().with("states", "vlm");
+    vec![
+        StudyRow {
+            label: "None",
+            variant: vlm(),
+            reading: "translated states equal the ground truth; exact transition check, as in every row not marked otherwise",
+        },
+        StudyRow {
+            label: "10 % Drop",
+            variant: vlm().with("noise", ROBUSTNESS_DROP),
+            reading: "10 % of each demo keyframe's binary relations removed",
+        },
+        StudyRow {
+            label: "10 % Noise (injected)",
+            variant: vlm().with("noise", ROBUSTNESS_INJECT),
+            reading: "10 % false binary relations added to each demo keyframe; none removed",
+        },
+        StudyRow {
+            label: "10 % Drop, changed-atoms check",
+            variant: vlm()
+                .with("noise", ROBUSTNESS_DROP)
+                .with("transition-check", "changed-atoms"),
+            reading: "as 10 % Drop, with operators checked only on the atoms the transition changes (`TransitionCheck::ChangedAtoms`), closer to Eq. 4's entailment than the exact check",
+        },
+        StudyRow {
+            label: "10 % Noise, changed-atoms check",
+            variant: vlm()
+                .with("noise", ROBUSTNESS_INJECT)
+                .with("transition-check", "changed-atoms"),
+            reading: "as 10 % Noise, with the changed-atoms transition check",
+        },
+        StudyRow {
+            label: "Perception what-if (P 0.97, R 0.71)",
+            variant: vlm().with("noise", PERCEPTION_WHAT_IF),
+            reading: "every scene, demo and target, perceived at the paper's reported real-scene precision and recall; a what-if, not a measurement",
+        },
+    ]
+}
+
+/// The complexity-gap rows: NeSyCR with either goal and the two model-free controls.
+fn complexity_gap_rows() -> Vec<StudyRow> {
+    vec![
+        StudyRow {
+            label: "NeSyCR, target's goal",
+            variant: nesycr().with("goal", "target"),
+            reading: "the goal is the target task's, as its instruction states it (the scene's goal atoms, every object let go); the loop patches the demonstrated procedure until it reaches that goal",
+        },
+        StudyRow {
+            label: "NeSyCR, demonstrated goal",
+            variant: nesycr(),
+            reading: "the goal derived from the demonstration, which never shows the added subtasks: the loop cannot know they are wanted",
+        },
+        StudyRow {
+            label: "Imitation (control)",
+            variant: Variant::plain("imitation"),
+            reading: "the demonstrated procedure, unadapted, compiled and executed in the target",
+        },
+        StudyRow {
+            label: "Replan (control)",
+            variant: Variant::plain("replan"),
+            reading: "nesy-core's planner from the target's state to its goal over the true domain, no demonstration",
+        },
+    ]
 }
 
 #[cfg(test)]

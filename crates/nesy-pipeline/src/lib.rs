@@ -320,14 +320,7 @@ pub async fn run(
         ..TimeBreakdown::default()
     };
     let setting = derive_setting(demo, target, options);
-    let keyframes = Arc::new(DemoKeyframes::from_demo(demo)?);
-    let reasoner = VlmReasoner::new(client)
-        .map_err(|e| PipelineError::VlmSetup {
-            message: format!("loading nesy's prompts: {e}"),
-        })?
-        .with_keyframes(keyframes)
-        .with_embodiments(setting.source_embodiment, setting.target_embodiment)
-        .with_program_check(Arc::new(SandboxChecks));
+    let reasoner = build_reasoner(client, demo, &setting)?;
 
     progress.stage("symbolic states");
     let vocabulary = Vocabulary::new();
@@ -350,11 +343,7 @@ pub async fn run(
 
     progress.stage("world model and adaptation");
     let adapted = adapt_episode(reasoner, &demonstration, &target_task, &config, progress.clone()).await?;
-    timing.vlm_s += adapted.vlm.as_secs_f64();
-    timing.symbolic_s = adapted.symbolic.as_secs_f64();
-    timing.symbolic_world_model_s = adapted.symbolic_world_model.as_secs_f64();
-    timing.symbolic_adaptation_s = (timing.symbolic_s - timing.symbolic_world_model_s).max(0.0);
-    timing.adapt_wall_s = adapted.wall.as_secs_f64();
+    adapted.add_times(&mut timing);
     let AdaptedEpisode {
         adaptation, reasoner, ..
     } = adapted;
@@ -414,6 +403,35 @@ pub async fn run(
         timing,
         usage,
     })
+}
+
+/// NeSyCR's reasoner over `client`: the demo's keyframe images, both end effectors, and the
+/// sandbox's static checks on generated programs.
+fn build_reasoner(
+    client: nesy_vlm::VlmClient,
+    demo: &DemoInput,
+    setting: &Setting,
+) -> Result<VlmReasoner, PipelineError> {
+    let keyframes = Arc::new(DemoKeyframes::from_demo(demo)?);
+    Ok(VlmReasoner::new(client)
+        .map_err(|e| PipelineError::VlmSetup {
+            message: format!("loading nesy's prompts: {e}"),
+        })?
+        .with_keyframes(keyframes)
+        .with_embodiments(setting.source_embodiment, setting.target_embodiment)
+        .with_program_check(Arc::new(SandboxChecks)))
+}
+
+impl AdaptedEpisode {
+    /// Adds the episode's model time, symbolic time (world model and adaptation) and wall
+    /// time to `timing`.
+    fn add_times(&self, timing: &mut TimeBreakdown) {
+        timing.vlm_s += self.vlm.as_secs_f64();
+        timing.symbolic_s = self.symbolic.as_secs_f64();
+        timing.symbolic_world_model_s = self.symbolic_world_model.as_secs_f64();
+        timing.symbolic_adaptation_s = (timing.symbolic_s - timing.symbolic_world_model_s).max(0.0);
+        timing.adapt_wall_s = self.wall.as_secs_f64();
+    }
 }
 
 /// What code synthesis needs from the run so far.

@@ -59,8 +59,7 @@ pub async fn run(
     // The next scenario's inputs are prepared while this one's units run: the units of one
     // scenario wait on its single recording, which kept every other core idle in a cold run.
     // Dropped at the end of the run, which aborts what is still pending.
-    let mut prefetch: tokio::task::JoinSet<()> = tokio::task::JoinSet::new();
-    let mut prefetched: std::collections::HashSet<String> = std::collections::HashSet::new();
+    let mut prefetch = Prefetch::default();
     let mut in_flight: HashMap<String, Unit> = HashMap::new();
     let (mut finished, mut errors) = (0usize, 0usize);
     let total_pending = queue.len();
@@ -71,16 +70,7 @@ pub async fn run(
                 break;
             }
             let Some(unit) = queue.pop_front() else { break };
-            prefetched.insert(unit.scenario.id.clone());
-            if let Some(next) = queue.iter().find(|u| u.scenario.id != unit.scenario.id)
-                && prefetched.insert(next.scenario.id.clone())
-            {
-                let (shared, scenario) = (shared.clone(), next.scenario.clone());
-                prefetch.spawn(async move {
-                    // A failure is stored in the scenario's slot and reported by its units.
-                    let _ = scenario_inputs(&shared, &scenario).await;
-                });
-            }
+            prefetch.next_scenario(&shared, &unit, &queue);
             let shared = shared.clone();
             in_flight.insert(unit.key.name(), unit.clone());
             set.spawn(async move {
@@ -110,12 +100,7 @@ pub async fn run(
         in_flight.remove(&key.name());
         writer.append(&record)?;
         finished += 1;
-        if matches!(
-            record.status,
-            UnitStatus::TransportError | UnitStatus::RequestRefused
-        ) {
-            errors += 1;
-        }
+        errors += usize::from(reached_no_model(record.status));
         *shared.cost.lock().unwrap_or_else(|e| e.into_inner()) += record.effort.cost_usd;
         *statuses.entry(record.status.as_str().into()).or_default() += 1;
         progress.unit_done(&record, finished, total_pending);
@@ -136,6 +121,36 @@ pub async fn run(
         stopped,
         wall_s: started.elapsed().as_secs_f64(),
     })
+}
+
+/// Whether a unit ended without reaching the model (what the error guard counts).
+fn reached_no_model(status: UnitStatus) -> bool {
+    matches!(status, UnitStatus::TransportError | UnitStatus::RequestRefused)
+}
+
+/// The next scenario's inputs, prepared while this one's units run.
+#[derive(Default)]
+struct Prefetch {
+    /// Dropped at the end of the run, which aborts what is still pending.
+    tasks: tokio::task::JoinSet<()>,
+    /// Scenarios already started or prefetched.
+    seen: std::collections::HashSet<String>,
+}
+
+impl Prefetch {
+    /// Starts preparing the first scenario after `unit`'s in the queue, once.
+    fn next_scenario(&mut self, shared: &Arc<Shared>, unit: &Unit, queue: &std::collections::VecDeque<Unit>) {
+        self.seen.insert(unit.scenario.id.clone());
+        if let Some(next) = queue.iter().find(|u| u.scenario.id != unit.scenario.id)
+            && self.seen.insert(next.scenario.id.clone())
+        {
+            let (shared, scenario) = (shared.clone(), next.scenario.clone());
+            self.tasks.spawn(async move {
+                // A failure is stored in the scenario's slot and reported by its units.
+                let _ = scenario_inputs(&shared, &scenario).await;
+            });
+        }
+    }
 }
 
 /// Refuses a run directory whose recorded units were made under another configuration of

@@ -227,34 +227,7 @@ impl StudyTable {
         );
         let added: Vec<u8> = self.added_counts();
         if !added.is_empty() {
-            let _ = writeln!(
-                md,
-                "By added subtasks (the target's subtasks beyond the demonstration's one): SR as above, PD over the successful units, n = scenarios.\n"
-            );
-            let _ = write!(md, "| row |");
-            for k in &added {
-                let _ = write!(md, " +{k} SR | +{k} PD |");
-            }
-            let _ = writeln!(md);
-            let _ = writeln!(md, "|---|{}", "---|---|".repeat(added.len()));
-            for r in &self.rows {
-                let _ = write!(md, "| {} |", r.row.label);
-                for k in &added {
-                    match r.by_added.get(k) {
-                        Some(a) => {
-                            let _ = write!(md, " {} (n={}) | {} |", shown(&a.sr), a.scenarios, shown(&a.pd));
-                        }
-                        None => {
-                            let _ = write!(md, " — | — |");
-                        }
-                    }
-                }
-                let _ = writeln!(md);
-            }
-            let _ = writeln!(
-                md,
-                "\n![SR and PD against the added subtasks](plots/complexity_gap.png)\n"
-            );
+            self.write_by_added(&mut md, &added);
         }
         let _ = writeln!(md, "How the units ended:\n");
         for r in &self.rows {
@@ -267,6 +240,39 @@ impl StudyTable {
         }
         let _ = writeln!(md);
         md
+    }
+
+    /// The complexity gap's table: each row's SR and PD by the number of subtasks the target
+    /// adds to the demonstration's, and its figure.
+    fn write_by_added(&self, md: &mut String, added: &[u8]) {
+        let _ = writeln!(
+            md,
+            "By added subtasks (the target's subtasks beyond the demonstration's one): SR as above, PD over the successful units, n = scenarios.\n"
+        );
+        let _ = write!(md, "| row |");
+        for k in added {
+            let _ = write!(md, " +{k} SR | +{k} PD |");
+        }
+        let _ = writeln!(md);
+        let _ = writeln!(md, "|---|{}", "---|---|".repeat(added.len()));
+        for r in &self.rows {
+            let _ = write!(md, "| {} |", r.row.label);
+            for k in added {
+                match r.by_added.get(k) {
+                    Some(a) => {
+                        let _ = write!(md, " {} (n={}) | {} |", shown(&a.sr), a.scenarios, shown(&a.pd));
+                    }
+                    None => {
+                        let _ = write!(md, " — | — |");
+                    }
+                }
+            }
+            let _ = writeln!(md);
+        }
+        let _ = writeln!(
+            md,
+            "\n![SR and PD against the added subtasks](plots/complexity_gap.png)\n"
+        );
     }
 
     /// The added-subtask counts any row has records for, ascending.
