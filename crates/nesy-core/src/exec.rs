@@ -482,20 +482,11 @@ impl CompiledProcedure {
     /// Verifies the procedure from `init`, stopping at the first failing step; checks the
     /// goal if every step applied.
     pub fn verify(&self, init: &State) -> Report {
-        // Atoms of `init` that no step or goal mentions can never change or matter; they
-        // ride along untouched and rejoin the reported states.
-        let mut bits = vec![0u64; self.facts.words()];
-        let mut untouched = Vec::new();
-        for a in init.iter() {
-            match self.facts.index.get(a) {
-                Some(&i) => set(&mut bits, i, true),
-                None => untouched.push(*a),
-            }
-        }
+        let (mut bits, untouched) = self.encode_init(init);
         let mut steps = Vec::with_capacity(self.steps.len());
         let mut first_failure = None;
         let mut failing_state = None;
-        let (mut adds, mut dels) = (Vec::new(), Vec::new());
+        let mut scratch = EffectScratch::default();
         for (index, step) in self.steps.iter().enumerate() {
             let action = step.grounded.name.clone();
             if first_failure.is_some() {
@@ -510,46 +501,9 @@ impl CompiledProcedure {
                 Err(error) => StepStatus::Invalid { error: error.clone() },
                 Ok((eff, pre)) => {
                     if pre.iter().all(|c| c.holds(&bits)) {
-                        adds.clear();
-                        dels.clear();
-                        adds.extend_from_slice(&eff.adds);
-                        dels.extend_from_slice(&eff.dels);
-                        for (c, f, add) in &eff.conditional {
-                            if c.holds(&bits) {
-                                if *add { adds.push(*f) } else { dels.push(*f) }
-                            }
-                        }
-                        let added: Vec<Atom> = adds
-                            .iter()
-                            .filter(|&&f| !get(&bits, f))
-                            .map(|&f| self.facts.atoms[f as usize])
-                            .collect();
-                        let removed: Vec<Atom> = dels
-                            .iter()
-                            .filter(|&&f| get(&bits, f) && !adds.contains(&f))
-                            .map(|&f| self.facts.atoms[f as usize])
-                            .collect();
-                        for &d in &dels {
-                            set(&mut bits, d, false);
-                        }
-                        for &a in &adds {
-                            set(&mut bits, a, true);
-                        }
-                        let mut added = added;
-                        added.sort_unstable();
-                        added.dedup();
-                        let mut removed = removed;
-                        removed.sort_unstable();
-                        removed.dedup();
-                        StepStatus::Applied { added, removed }
+                        self.apply_effects(eff, &mut bits, &mut scratch)
                     } else {
-                        let state = self.state_of(&bits, &untouched);
-                        match &step.grounded.compiled {
-                            Ok(compiled) => StepStatus::Failed {
-                                violation: compiled.violation(&state, &step.grounded.source),
-                            },
-                            Err(error) => StepStatus::Invalid { error: error.clone() },
-                        }
+                        self.failed_status(step, &bits, &untouched)
                     }
                 }
             };
@@ -564,14 +518,103 @@ impl CompiledProcedure {
             });
         }
         let final_state = self.state_of(&bits, &untouched);
-        let (goal, goal_error) = match (&self.goal, first_failure) {
+        let (goal, goal_error) = self.check_goal(first_failure, &bits, &final_state);
+        Report {
+            steps,
+            first_failure,
+            failing_state,
+            final_state,
+            goal,
+            goal_error,
+        }
+    }
+
+    /// `init` as bits over this procedure's facts, and the atoms of `init` outside them.
+    fn encode_init(&self, init: &State) -> (Bits, Vec<Atom>) {
+        // Atoms of `init` that no step or goal mentions can never change or matter; they
+        // ride along untouched and rejoin the reported states.
+        let mut bits = vec![0u64; self.facts.words()];
+        let mut untouched = Vec::new();
+        for a in init.iter() {
+            match self.facts.index.get(a) {
+                Some(&i) => set(&mut bits, i, true),
+                None => untouched.push(*a),
+            }
+        }
+        (bits, untouched)
+    }
+
+    /// Applies a step whose preconditions hold to `bits` and reports the atoms it changed.
+    /// Deletions go first, so an atom a step both adds and deletes ends up true.
+    fn apply_effects(
+        &self,
+        eff: &IndexedEffects,
+        bits: &mut Bits,
+        scratch: &mut EffectScratch,
+    ) -> StepStatus {
+        let EffectScratch { adds, dels } = scratch;
+        adds.clear();
+        dels.clear();
+        adds.extend_from_slice(&eff.adds);
+        dels.extend_from_slice(&eff.dels);
+        for (c, f, add) in &eff.conditional {
+            if c.holds(bits) {
+                if *add { adds.push(*f) } else { dels.push(*f) }
+            }
+        }
+        let added: Vec<Atom> = adds
+            .iter()
+            .filter(|&&f| !get(bits, f))
+            .map(|&f| self.facts.atoms[f as usize])
+            .collect();
+        let removed: Vec<Atom> = dels
+            .iter()
+            .filter(|&&f| get(bits, f) && !adds.contains(&f))
+            .map(|&f| self.facts.atoms[f as usize])
+            .collect();
+        for &d in dels.iter() {
+            set(bits, d, false);
+        }
+        for &a in adds.iter() {
+            set(bits, a, true);
+        }
+        let mut added = added;
+        added.sort_unstable();
+        added.dedup();
+        let mut removed = removed;
+        removed.sort_unstable();
+        removed.dedup();
+        StepStatus::Applied { added, removed }
+    }
+
+    /// The status of a step whose preconditions do not hold in `bits`: the violation,
+    /// explained over the full state.
+    fn failed_status(&self, step: &CompiledStep, bits: &Bits, untouched: &[Atom]) -> StepStatus {
+        let state = self.state_of(bits, untouched);
+        match &step.grounded.compiled {
+            Ok(compiled) => StepStatus::Failed {
+                violation: compiled.violation(&state, &step.grounded.source),
+            },
+            Err(error) => StepStatus::Invalid { error: error.clone() },
+        }
+    }
+
+    /// The goal check once every step applied (`first_failure` is `None`), or why the goal
+    /// could not be grounded; neither if a step failed or there is no goal.
+    fn check_goal(
+        &self,
+        first_failure: Option<usize>,
+        bits: &Bits,
+        final_state: &State,
+    ) -> (Option<GoalCheck>, Option<GroundError>) {
+        match (&self.goal, first_failure) {
             (Some(Ok(conjuncts)), None) => {
                 let unmet: Vec<UnmetPrecondition> = conjuncts
                     .iter()
-                    .filter(|(_, _, cond)| !cond.holds(&bits))
+                    .filter(|(_, _, cond)| !cond.holds(bits))
                     .map(|(literal, ground, _)| {
                         let mut atoms = Vec::new();
-                        ground.explain(&final_state, &mut atoms);
+                        ground.explain(final_state, &mut atoms);
                         UnmetPrecondition {
                             literal: literal.clone(),
                             atoms,
@@ -588,16 +631,16 @@ impl CompiledProcedure {
             }
             (Some(Err(e)), None) => (None, Some(e.clone())),
             _ => (None, None),
-        };
-        Report {
-            steps,
-            first_failure,
-            failing_state,
-            final_state,
-            goal,
-            goal_error,
         }
     }
+}
+
+/// The add and delete lists of the step being applied, kept across steps so their
+/// buffers are allocated once per verification.
+#[derive(Default)]
+struct EffectScratch {
+    adds: Vec<u32>,
+    dels: Vec<u32>,
 }
 
 #[cfg(test)]

@@ -15,6 +15,7 @@ use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
+use crate::atom::Atom;
 use crate::formula::{Formula, TypedVar, fmt_typed_vars};
 use crate::operator::Operator;
 use crate::state::State;
@@ -180,35 +181,8 @@ pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
         let kw = section_name(doc, s)?;
         let body = &s.list().unwrap_or(&[])[1..];
         match kw.as_str() {
-            ":requirements" => {
-                for r in body {
-                    let t = r.token().map(|t| t.to_ascii_lowercase()).unwrap_or_default();
-                    if !SUPPORTED_REQUIREMENTS.contains(&t.as_str()) {
-                        return Err(err(
-                            doc,
-                            r.span.start,
-                            ParseErrorKind::Unsupported,
-                            format!("a supported requirement ({})", SUPPORTED_REQUIREMENTS.join(" ")),
-                        ));
-                    }
-                    domain.requirements.push(t);
-                }
-            }
-            ":types" => {
-                for (n, t, at) in conv.typed_list(body, false)? {
-                    if domain.types.iter().any(|(d, _)| *d == n) {
-                        return Err(duplicate(doc, at, "type", n));
-                    }
-                    domain.types.push((
-                        n,
-                        if t.as_str() == "thing" {
-                            Symbol::new("object")
-                        } else {
-                            t
-                        },
-                    ));
-                }
-            }
+            ":requirements" => parse_requirements(doc, body, &mut domain.requirements)?,
+            ":types" => parse_types(doc, &conv, body, &mut domain.types)?,
             ":constants" => {
                 for (n, t, at) in conv.typed_list(body, false)? {
                     if domain.constants.iter().any(|(c, _)| *c == n) {
@@ -217,28 +191,7 @@ pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
                     domain.constants.push((n, t));
                 }
             }
-            ":predicates" => {
-                for p in body {
-                    let Some((head, params)) = p.list().and_then(|l| l.split_first()) else {
-                        return Err(err(
-                            doc,
-                            p.span.start,
-                            ParseErrorKind::Syntax,
-                            "a predicate declaration `(name ?x ...)`",
-                        ));
-                    };
-                    let name = conv.expect_name(head, "a predicate name")?;
-                    if domain.predicates.iter().any(|d| d.name == name) {
-                        return Err(duplicate(doc, head.span.start, "predicate", name));
-                    }
-                    let params = conv
-                        .typed_list(params, true)?
-                        .into_iter()
-                        .map(|(name, ty, _)| TypedVar { name, ty })
-                        .collect();
-                    domain.predicates.push(PredicateDecl { name, params });
-                }
-            }
+            ":predicates" => parse_predicates(doc, &conv, body, &mut domain.predicates)?,
             ":action" => action_exprs.push(s),
             _ => {
                 return Err(err(
@@ -258,12 +211,7 @@ pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
             .declare(*t, *parent)
             .map_err(|e| err(doc, 0, ParseErrorKind::Reference, e.to_string()))?;
     }
-    let declared: Vec<(Symbol, usize)> = domain
-        .predicates
-        .iter()
-        .map(|p| (p.name, p.params.len()))
-        .collect();
-    let conv = Converter::new(doc, true).with_predicates(declared);
+    let conv = Converter::new(doc, true).with_predicates(predicate_arities(&domain.predicates));
     for s in action_exprs {
         let action = parse_action(doc, &conv, s, &universe)?;
         if domain.actions.iter().any(|a| a.name == action.name) {
@@ -272,6 +220,87 @@ pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
         domain.actions.push(action);
     }
     Ok(domain)
+}
+
+/// Each declared predicate's name and arity, which atoms are checked against.
+fn predicate_arities(predicates: &[PredicateDecl]) -> Vec<(Symbol, usize)> {
+    predicates.iter().map(|p| (p.name, p.params.len())).collect()
+}
+
+/// Reads a `:requirements` section's flags into `requirements`, rejecting any this parser
+/// would misread.
+fn parse_requirements(
+    doc: &str,
+    body: &[SExpr<'_>],
+    requirements: &mut Vec<String>,
+) -> Result<(), ParseError> {
+    for r in body {
+        let t = r.token().map(|t| t.to_ascii_lowercase()).unwrap_or_default();
+        if !SUPPORTED_REQUIREMENTS.contains(&t.as_str()) {
+            return Err(err(
+                doc,
+                r.span.start,
+                ParseErrorKind::Unsupported,
+                format!("a supported requirement ({})", SUPPORTED_REQUIREMENTS.join(" ")),
+            ));
+        }
+        requirements.push(t);
+    }
+    Ok(())
+}
+
+/// Reads a `:types` section into `types`. A type listed without a parent (read as `thing`)
+/// gets `object`, the root type PDDL gives it.
+fn parse_types(
+    doc: &str,
+    conv: &Converter<'_>,
+    body: &[SExpr<'_>],
+    types: &mut Vec<(Symbol, Symbol)>,
+) -> Result<(), ParseError> {
+    for (n, t, at) in conv.typed_list(body, false)? {
+        if types.iter().any(|(d, _)| *d == n) {
+            return Err(duplicate(doc, at, "type", n));
+        }
+        types.push((
+            n,
+            if t.as_str() == "thing" {
+                Symbol::new("object")
+            } else {
+                t
+            },
+        ));
+    }
+    Ok(())
+}
+
+/// Reads a `:predicates` section's declarations into `predicates`.
+fn parse_predicates(
+    doc: &str,
+    conv: &Converter<'_>,
+    body: &[SExpr<'_>],
+    predicates: &mut Vec<PredicateDecl>,
+) -> Result<(), ParseError> {
+    for p in body {
+        let Some((head, params)) = p.list().and_then(|l| l.split_first()) else {
+            return Err(err(
+                doc,
+                p.span.start,
+                ParseErrorKind::Syntax,
+                "a predicate declaration `(name ?x ...)`",
+            ));
+        };
+        let name = conv.expect_name(head, "a predicate name")?;
+        if predicates.iter().any(|d| d.name == name) {
+            return Err(duplicate(doc, head.span.start, "predicate", name));
+        }
+        let params = conv
+            .typed_list(params, true)?
+            .into_iter()
+            .map(|(name, ty, _)| TypedVar { name, ty })
+            .collect();
+        predicates.push(PredicateDecl { name, params });
+    }
+    Ok(())
 }
 
 /// A name declared a second time: PDDL has no overloading, and a silent redefinition would
@@ -379,12 +408,7 @@ fn parse_action(
 /// Parses a PDDL problem. Atoms and the goal are checked against the domain's predicates.
 pub fn parse_problem(doc: &str, domain: &Domain) -> Result<Problem, ParseError> {
     let (name, sections) = define(doc, "problem")?;
-    let declared: Vec<(Symbol, usize)> = domain
-        .predicates
-        .iter()
-        .map(|p| (p.name, p.params.len()))
-        .collect();
-    let conv = Converter::new(doc, true).with_predicates(declared);
+    let conv = Converter::new(doc, true).with_predicates(predicate_arities(&domain.predicates));
     let mut dom_name = None;
     let mut objects = Vec::new();
     let mut init = Vec::new();
@@ -393,59 +417,10 @@ pub fn parse_problem(doc: &str, domain: &Domain) -> Result<Problem, ParseError> 
         let kw = section_name(doc, s)?;
         let body = &s.list().unwrap_or(&[])[1..];
         match kw.as_str() {
-            ":domain" => match body {
-                [n] => {
-                    let n = conv.expect_name(n, "the domain name")?;
-                    if n != domain.name {
-                        return Err(err(
-                            doc,
-                            body[0].span.start,
-                            ParseErrorKind::Reference,
-                            format!("the domain `{}` (the problem names `{n}`)", domain.name),
-                        ));
-                    }
-                    dom_name = Some(n);
-                }
-                _ => return Err(err(doc, s.span.start, ParseErrorKind::Syntax, "`(:domain NAME)`")),
-            },
+            ":domain" => dom_name = Some(parse_domain_ref(doc, &conv, s, body, domain)?),
             ":requirements" => {}
-            ":objects" => {
-                for (n, t, at) in conv.typed_list(body, false)? {
-                    let known = t.as_str() == "thing"
-                        || t.as_str() == "object"
-                        || domain.types.iter().any(|(d, _)| *d == t);
-                    if !known {
-                        return Err(err(
-                            doc,
-                            at,
-                            ParseErrorKind::Reference,
-                            format!("a declared type (`{t}` is not)"),
-                        ));
-                    }
-                    if objects.iter().any(|(o, _)| *o == n) {
-                        return Err(duplicate(doc, at, "object", n));
-                    }
-                    objects.push((n, t));
-                }
-            }
-            ":init" => {
-                for a in body {
-                    let f = conv.formula(a, &mut Vec::new())?;
-                    match &f {
-                        Formula::Atom(p) => init.push(p.as_atom().ok_or_else(|| {
-                            err(doc, a.span.start, ParseErrorKind::Syntax, "a ground atom")
-                        })?),
-                        _ => {
-                            return Err(err(
-                                doc,
-                                a.span.start,
-                                ParseErrorKind::Unsupported,
-                                "a ground atom (the initial state lists true atoms only)",
-                            ));
-                        }
-                    }
-                }
-            }
+            ":objects" => parse_objects(doc, &conv, body, domain, &mut objects)?,
+            ":init" => parse_init(doc, &conv, body, &mut init)?,
             ":goal" => match body {
                 [g] => goal = Some(conv.formula(g, &mut Vec::new())?),
                 _ => {
@@ -490,9 +465,94 @@ pub fn parse_problem(doc: &str, domain: &Domain) -> Result<Problem, ParseError> 
         init: State::from_atoms(init),
         goal,
     };
-    // Every constant in init and goal must be an object or a domain constant.
+    check_mentioned_objects(doc, domain, &problem)?;
+    Ok(problem)
+}
+
+/// The name in a `(:domain NAME)` section `s`, which must be `domain`'s.
+fn parse_domain_ref(
+    doc: &str,
+    conv: &Converter<'_>,
+    s: &SExpr<'_>,
+    body: &[SExpr<'_>],
+    domain: &Domain,
+) -> Result<Symbol, ParseError> {
+    match body {
+        [n] => {
+            let n = conv.expect_name(n, "the domain name")?;
+            if n != domain.name {
+                return Err(err(
+                    doc,
+                    body[0].span.start,
+                    ParseErrorKind::Reference,
+                    format!("the domain `{}` (the problem names `{n}`)", domain.name),
+                ));
+            }
+            Ok(n)
+        }
+        _ => Err(err(doc, s.span.start, ParseErrorKind::Syntax, "`(:domain NAME)`")),
+    }
+}
+
+/// Reads an `:objects` section into `objects`; every type must be `object`, `thing` or one
+/// the domain declares.
+fn parse_objects(
+    doc: &str,
+    conv: &Converter<'_>,
+    body: &[SExpr<'_>],
+    domain: &Domain,
+    objects: &mut Vec<(Symbol, Symbol)>,
+) -> Result<(), ParseError> {
+    for (n, t, at) in conv.typed_list(body, false)? {
+        let known =
+            t.as_str() == "thing" || t.as_str() == "object" || domain.types.iter().any(|(d, _)| *d == t);
+        if !known {
+            return Err(err(
+                doc,
+                at,
+                ParseErrorKind::Reference,
+                format!("a declared type (`{t}` is not)"),
+            ));
+        }
+        if objects.iter().any(|(o, _)| *o == n) {
+            return Err(duplicate(doc, at, "object", n));
+        }
+        objects.push((n, t));
+    }
+    Ok(())
+}
+
+/// Reads an `:init` section's ground atoms into `init`.
+fn parse_init(
+    doc: &str,
+    conv: &Converter<'_>,
+    body: &[SExpr<'_>],
+    init: &mut Vec<Atom>,
+) -> Result<(), ParseError> {
+    for a in body {
+        let f = conv.formula(a, &mut Vec::new())?;
+        match &f {
+            Formula::Atom(p) => init.push(
+                p.as_atom()
+                    .ok_or_else(|| err(doc, a.span.start, ParseErrorKind::Syntax, "a ground atom"))?,
+            ),
+            _ => {
+                return Err(err(
+                    doc,
+                    a.span.start,
+                    ParseErrorKind::Unsupported,
+                    "a ground atom (the initial state lists true atoms only)",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Every constant in init and goal must be an object or a domain constant.
+fn check_mentioned_objects(doc: &str, domain: &Domain, problem: &Problem) -> Result<(), ParseError> {
     let universe = domain
-        .universe(&problem)
+        .universe(problem)
         .map_err(|e| err(doc, 0, ParseErrorKind::Reference, e.to_string()))?;
     let mut mentioned = problem.init.objects();
     problem.goal.constants(&mut mentioned);
@@ -505,7 +565,7 @@ pub fn parse_problem(doc: &str, domain: &Domain) -> Result<Problem, ParseError> 
             format!("a declared object (`{unknown}` is not in :objects)"),
         ));
     }
-    Ok(problem)
+    Ok(())
 }
 
 /// Byte offset of the first whole-token occurrence of `name` (case-insensitive), for

@@ -196,6 +196,24 @@ fn evaluate(
     })
 }
 
+/// The lid schema a transition can stand for, when the lid's state changes. A lid swing is
+/// recorded one waypoint at a time, and a waypoint half-way leaves the lid neither open nor
+/// closed: where the lid's state changes, the change decides between the opening and
+/// closing schemas; where it does not (`None`), the scores do.
+fn lid_direction(previous: &State, next: &State) -> Option<&'static str> {
+    let lid = Symbol::new("hinge_lid");
+    let has = |s: &State, p: &str| s.contains(&nesy_core::Atom::from_symbols(Symbol::new(p), [lid]));
+    let (p_open, p_closed) = (has(previous, "Open"), has(previous, "Closed"));
+    let (n_open, n_closed) = (has(next, "Open"), has(next, "Closed"));
+    if (n_open && !p_open) || (p_closed && !n_closed) {
+        Some("open-hinge-lid")
+    } else if (n_closed && !p_closed) || (p_open && !n_open) {
+        Some("close-hinge-lid")
+    } else {
+        None
+    }
+}
+
 /// Answers an induction request from the transition's recorded call (when the
 /// demonstration has one) and the true domain.
 pub fn induce(
@@ -230,20 +248,7 @@ pub fn induce(
             None => true,
         })
         .collect();
-    // A lid swing is recorded one waypoint at a time, and a waypoint half-way leaves the lid
-    // neither open nor closed: where the lid's state changes, the change decides between the
-    // opening and closing schemas; where it does not, the scores do.
-    let lid = Symbol::new("hinge_lid");
-    let has = |s: &State, p: &str| s.contains(&nesy_core::Atom::from_symbols(Symbol::new(p), [lid]));
-    let (p_open, p_closed) = (has(&req.previous, "Open"), has(&req.previous, "Closed"));
-    let (n_open, n_closed) = (has(&req.next, "Open"), has(&req.next, "Closed"));
-    let direction = if (n_open && !p_open) || (p_closed && !n_closed) {
-        Some("open-hinge-lid")
-    } else if (n_closed && !p_closed) || (p_open && !n_open) {
-        Some("close-hinge-lid")
-    } else {
-        None
-    };
+    let direction = lid_direction(&req.previous, &req.next);
     let schemas: Vec<Operator> = schemas
         .into_iter()
         .filter(|s| {

@@ -12,7 +12,7 @@ use crate::formula::Formula;
 use crate::operator::Operator;
 use crate::patch::{AppliedPatch, apply_patch};
 use crate::state::State;
-use crate::text::{RefinementReply, normalize_reply, parse_refinement_reply};
+use crate::text::{ParseError, RefinementReply, normalize_reply, parse_refinement_reply};
 use crate::types::Universe;
 
 /// The universe the loop verifies over: every object of the target's initial state, the
@@ -217,129 +217,178 @@ pub async fn explore<R: Reasoner>(
     trace: &mut Trace,
 ) -> Result<ExplorationResult, AdaptError> {
     let ablation = config.ablation;
-    let goal = &world_model.goal;
-    let mut procedure = world_model.procedure.clone();
-    // Every verification of this loop runs over the same initial state and goal, and
-    // successive procedures share most actions: each distinct action is grounded once.
-    let mut cache = GroundingCache::default();
-    let mut universe = loop_universe(&target.init, &procedure, goal, &target.task.objects);
-    let mut report = verify(&target.init, &mut universe, &procedure, goal, &mut cache);
-    let mut best = (progress(&report), procedure.clone());
-    let mut feedback: Vec<Feedback> = Vec::new();
-    let mut last_violation: Option<ViolationInfo> = None;
-    let mut iteration = 0;
+    let mut state = ExplorationLoop::new(world_model, target, ablation);
     // With identification and verification both ablated nothing tells the loop whether a
     // revision helped, so it makes one revision (retrying only replies that fail to parse
     // or match) and stops.
     let single_shot = !ablation.identification && !ablation.verification;
-    let mut revised = false;
-    // Identification is recorded once per procedure version, not once per proposal.
-    let mut identified = false;
-    // Incremented whenever a patch is accepted; with the violation, it says whether the last
-    // request can be reused.
-    let mut procedure_version = 0usize;
-    let mut cached_request: Option<(usize, PatchRequest)> = None;
     loop {
-        if (ablation.identification || ablation.verification) && !identified {
-            identified = true;
-            trace.events.push(TraceEvent::Identification {
-                iteration,
-                procedure: procedure.clone(),
-                report: report.clone(),
-            });
-        }
-        let violation = identify(&report, &procedure);
-        let finished = if single_shot { revised } else { violation.is_none() };
-        if finished || iteration >= config.budget {
-            return Ok(finish(procedure, report, best.1, last_violation, iteration));
+        state.record_identification(trace);
+        let violation = identify(&state.report, &state.procedure);
+        let finished = if single_shot {
+            state.revised
+        } else {
+            violation.is_none()
+        };
+        if finished || state.iteration >= config.budget {
+            return Ok(state.finish());
         }
         let violation = violation.unwrap_or_else(|| unidentified(target));
-        if last_violation.as_ref().is_some_and(|v| *v != violation) {
-            feedback.clear();
-        }
-        // A rejected proposal leaves the procedure and the violation as they were: the next
-        // request differs only in its iteration and feedback, so the previous one is reused
-        // instead of copying the procedure again.
-        let reusable = cached_request
-            .take()
-            .filter(|(v, _)| *v == procedure_version && last_violation.as_ref() == Some(&violation));
-        let request = match reusable {
-            Some((_, mut request)) => {
-                request.iteration = iteration;
-                request.feedback = feedback.clone();
-                request
-            }
-            None => patch_request(
-                ablation.identification,
-                iteration,
-                target,
-                &procedure,
-                &violation,
-                &feedback,
-            ),
-        };
-        let visible = if ablation.identification {
-            violation.clone()
-        } else {
-            unidentified(target)
-        };
-        last_violation = Some(violation);
+        let (request, visible) = state.next_request(violation);
         let reply = match reasoner.propose_patch(&request).await {
             Ok(reply) => reply,
             // The reasoner has no proposal at all (an offline responder's planner found none):
             // asking again would get the same answer, so the loop stops, unresolved.
             Err(e) if e.kind == ReasonerErrorKind::Exhausted => {
                 trace.events.push(TraceEvent::GaveUp {
-                    iteration,
+                    iteration: state.iteration,
                     message: e.message,
                 });
                 // The loop only asks while there is a violation, so the report is not valid
                 // here and `finish` returns the unresolved outcome.
-                return Ok(finish(procedure, report, best.1, last_violation, iteration));
+                return Ok(state.finish());
             }
             Err(e) => return Err(e.into()),
         };
-        cached_request = Some((procedure_version, request));
-        let this_iteration = iteration;
-        iteration += 1;
+        state.cached_request = Some((state.procedure_version, request));
+        let this_iteration = state.iteration;
+        state.iteration += 1;
+        state.handle_reply(this_iteration, reply, &visible, trace);
+    }
+}
 
+/// What the exploration loop carries from one proposal to the next.
+struct ExplorationLoop<'a> {
+    target: &'a Target,
+    goal: &'a Formula,
+    ablation: Ablation,
+    procedure: Vec<Operator>,
+    /// Every verification of this loop runs over the same initial state and goal, and
+    /// successive procedures share most actions: each distinct action is grounded once.
+    cache: GroundingCache,
+    universe: Universe,
+    report: Report,
+    /// The procedure that got furthest so far, returned if the loop ends unresolved.
+    best: (Progress, Vec<Operator>),
+    feedback: Vec<Feedback>,
+    last_violation: Option<ViolationInfo>,
+    iteration: usize,
+    /// Whether a patch was accepted: a single-shot loop stops after one.
+    revised: bool,
+    /// Identification is recorded once per procedure version, not once per proposal.
+    identified: bool,
+    /// Incremented whenever a patch is accepted; with the violation, it says whether the
+    /// last request can be reused.
+    procedure_version: usize,
+    cached_request: Option<(usize, PatchRequest)>,
+}
+
+impl<'a> ExplorationLoop<'a> {
+    /// Verifies the world model's procedure on the target, the starting point of the loop.
+    fn new(world_model: &'a WorldModel, target: &'a Target, ablation: Ablation) -> Self {
+        let goal = &world_model.goal;
+        let procedure = world_model.procedure.clone();
+        let mut cache = GroundingCache::default();
+        let mut universe = loop_universe(&target.init, &procedure, goal, &target.task.objects);
+        let report = verify(&target.init, &mut universe, &procedure, goal, &mut cache);
+        let best = (progress(&report), procedure.clone());
+        ExplorationLoop {
+            target,
+            goal,
+            ablation,
+            procedure,
+            cache,
+            universe,
+            report,
+            best,
+            feedback: Vec::new(),
+            last_violation: None,
+            iteration: 0,
+            revised: false,
+            identified: false,
+            procedure_version: 0,
+            cached_request: None,
+        }
+    }
+
+    /// Traces the current procedure's verification, once per procedure version, when
+    /// identification or verification is on.
+    fn record_identification(&mut self, trace: &mut Trace) {
+        if (self.ablation.identification || self.ablation.verification) && !self.identified {
+            self.identified = true;
+            trace.events.push(TraceEvent::Identification {
+                iteration: self.iteration,
+                procedure: self.procedure.clone(),
+                report: self.report.clone(),
+            });
+        }
+    }
+
+    /// The outcome when the loop stops now.
+    fn finish(self) -> ExplorationResult {
+        finish(
+            self.procedure,
+            self.report,
+            self.best.1,
+            self.last_violation,
+            self.iteration,
+        )
+    }
+
+    /// The patch request for `violation`, and the violation the reasoner is shown (none
+    /// without identification). Feedback about an earlier violation is dropped first.
+    fn next_request(&mut self, violation: ViolationInfo) -> (PatchRequest, ViolationInfo) {
+        if self.last_violation.as_ref().is_some_and(|v| *v != violation) {
+            self.feedback.clear();
+        }
+        // A rejected proposal leaves the procedure and the violation as they were: the next
+        // request differs only in its iteration and feedback, so the previous one is reused
+        // instead of copying the procedure again.
+        let reusable = self.cached_request.take().filter(|(v, _)| {
+            *v == self.procedure_version && self.last_violation.as_ref() == Some(&violation)
+        });
+        let request = match reusable {
+            Some((_, mut request)) => {
+                request.iteration = self.iteration;
+                request.feedback = self.feedback.clone();
+                request
+            }
+            None => patch_request(
+                self.ablation.identification,
+                self.iteration,
+                self.target,
+                &self.procedure,
+                &violation,
+                &self.feedback,
+            ),
+        };
+        let visible = if self.ablation.identification {
+            violation.clone()
+        } else {
+            unidentified(self.target)
+        };
+        self.last_violation = Some(violation);
+        (request, visible)
+    }
+
+    /// Parses, applies and verifies the reply to proposal `this_iteration`, then accepts
+    /// or rejects it.
+    fn handle_reply(
+        &mut self,
+        this_iteration: usize,
+        reply: String,
+        visible: &ViolationInfo,
+        trace: &mut Trace,
+    ) {
         let parsed = parse_refinement_reply(&normalize_reply(&reply));
         let near = visible
             .failing_step
             .unwrap_or(if visible.kind == ViolationKind::Goal {
-                procedure.len()
+                self.procedure.len()
             } else {
                 0
             });
-        let attempt = (|| {
-            let r = parsed
-                .as_ref()
-                .map_err(|e| Problem::Unparsable { error: e.clone() })?;
-            if r.patches.len() > 1 {
-                return Err(Problem::MultiplePatches {
-                    count: r.patches.len(),
-                });
-            }
-            let inserted: Vec<&Operator> = r.patches[0].replace.iter().collect();
-            // Names: the scene's, the initial state's, and those the procedure already uses
-            // (a patch may keep an action on an object the target no longer needs).
-            let objects = (!target.scene_names.is_empty()).then(|| {
-                known_objects(
-                    &target.scene_names,
-                    [&target.init],
-                    procedure.iter().flat_map(|op| op.constants()),
-                )
-            });
-            let unknown = unknown_symbols(&inserted, &target.task.vocabulary, objects.as_deref());
-            if !unknown.is_empty() {
-                return Err(Problem::UnknownSymbols { unknown });
-            }
-            let applied = apply_patch(&procedure, &r.patches[0], near)
-                .map_err(|error| Problem::PatchDidNotApply { error })?;
-            let new_report = verify(&target.init, &mut universe, &applied.procedure, goal, &mut cache);
-            check_proposal(ablation, &visible, &applied, &new_report, &report)?;
-            Ok((applied, new_report))
-        })();
+        let attempt = self.try_reply(parsed.as_ref(), visible, near);
         let parsed = parsed.ok();
         match attempt {
             Ok((applied, new_report)) => {
@@ -348,24 +397,22 @@ pub async fn explore<R: Reasoner>(
                     reply,
                     parsed,
                     verdict: Verdict::Accepted {
-                        checked: ablation.verification,
+                        checked: self.ablation.verification,
                     },
                     procedure_after: Some(applied.procedure.clone()),
                 });
-                procedure = applied.procedure;
-                procedure_version += 1;
-                report = new_report;
-                revised = true;
-                identified = false;
-                feedback.clear();
-                let p = progress(&report);
-                if p > best.0 {
-                    best = (p, procedure.clone());
-                }
+                self.accept(applied, new_report);
             }
             Err(problem) => {
-                let fb = rejection(this_iteration, &reply, parsed.as_ref(), &procedure, near, problem);
-                feedback.push(fb.clone());
+                let fb = rejection(
+                    this_iteration,
+                    &reply,
+                    parsed.as_ref(),
+                    &self.procedure,
+                    near,
+                    problem,
+                );
+                self.feedback.push(fb.clone());
                 trace.events.push(TraceEvent::Proposal {
                     iteration: this_iteration,
                     reply,
@@ -374,6 +421,68 @@ pub async fn explore<R: Reasoner>(
                     procedure_after: None,
                 });
             }
+        }
+    }
+
+    /// The patched procedure and its report if the reply holds one patch, names only known
+    /// symbols, applies near step `near` and passes [`check_proposal`]; else the problem.
+    fn try_reply(
+        &mut self,
+        parsed: Result<&RefinementReply, &ParseError>,
+        visible: &ViolationInfo,
+        near: usize,
+    ) -> Result<(AppliedPatch, Report), Problem> {
+        let r = parsed.map_err(|e| Problem::Unparsable { error: e.clone() })?;
+        if r.patches.len() > 1 {
+            return Err(Problem::MultiplePatches {
+                count: r.patches.len(),
+            });
+        }
+        let inserted: Vec<&Operator> = r.patches[0].replace.iter().collect();
+        self.check_symbols(&inserted)?;
+        let applied = apply_patch(&self.procedure, &r.patches[0], near)
+            .map_err(|error| Problem::PatchDidNotApply { error })?;
+        let new_report = verify(
+            &self.target.init,
+            &mut self.universe,
+            &applied.procedure,
+            self.goal,
+            &mut self.cache,
+        );
+        check_proposal(self.ablation, visible, &applied, &new_report, &self.report)?;
+        Ok((applied, new_report))
+    }
+
+    /// Rejects inserted actions that name a predicate or object the target does not know.
+    fn check_symbols(&self, inserted: &[&Operator]) -> Result<(), Problem> {
+        let target = self.target;
+        // Names: the scene's, the initial state's, and those the procedure already uses
+        // (a patch may keep an action on an object the target no longer needs).
+        let objects = (!target.scene_names.is_empty()).then(|| {
+            known_objects(
+                &target.scene_names,
+                [&target.init],
+                self.procedure.iter().flat_map(|op| op.constants()),
+            )
+        });
+        let unknown = unknown_symbols(inserted, &target.task.vocabulary, objects.as_deref());
+        if !unknown.is_empty() {
+            return Err(Problem::UnknownSymbols { unknown });
+        }
+        Ok(())
+    }
+
+    /// Makes an accepted patch the current procedure, remembering it if it gets furthest.
+    fn accept(&mut self, applied: AppliedPatch, new_report: Report) {
+        self.procedure = applied.procedure;
+        self.procedure_version += 1;
+        self.report = new_report;
+        self.revised = true;
+        self.identified = false;
+        self.feedback.clear();
+        let p = progress(&self.report);
+        if p > self.best.0 {
+            self.best = (p, self.procedure.clone());
         }
     }
 }

@@ -12,7 +12,7 @@ use crate::formula::Formula;
 use crate::operator::Operator;
 use crate::state::State;
 use crate::symbol::Symbol;
-use crate::text::{normalize_reply, parse_induction_reply};
+use crate::text::{InductionReply, ParseError, normalize_reply, parse_induction_reply};
 
 /// The verified symbolic world model W of a demonstration.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -135,81 +135,19 @@ pub async fn construct_world_model<R: Reasoner>(
     let tries = config.induction_tries.max(1);
     let mut procedure = Vec::with_capacity(demo.states.len() - 1);
     let mut unverified_steps = Vec::new();
-    let demo_objects = known_objects(&demo.task.objects, &demo.states, []);
+    let induction = Induction {
+        demo,
+        config,
+        demo_objects: known_objects(&demo.task.objects, &demo.states, []),
+        tries,
+    };
     for (step, pair) in demo.states.windows(2).enumerate() {
-        let (prev, next) = (&pair[0], &pair[1]);
-        let mut feedback: Vec<Feedback> = Vec::new();
-        let mut last_parsed: Option<Operator> = None;
-        let mut accepted = None;
-        for attempt in 0..tries {
-            let request = InductionRequest {
-                step,
-                attempt,
-                previous: prev.clone(),
-                next: next.clone(),
-                diff: prev.diff(next),
-                task: demo.task.clone(),
-                feedback: feedback.clone(),
-            };
-            let reply = reasoner.induce_operator(&request).await?;
-            let parsed = parse_induction_reply(&normalize_reply(&reply));
-            let problem = match &parsed {
-                Err(error) => Some(Problem::Unparsable { error: error.clone() }),
-                Ok(r) => {
-                    // Names are read before anything is verified, with or without the check.
-                    let unknown = unknown_symbols(
-                        &[&r.operator],
-                        &demo.task.vocabulary,
-                        Some(demo_objects.as_slice()),
-                    );
-                    if !unknown.is_empty() {
-                        Some(Problem::UnknownSymbols { unknown })
-                    } else if !config.ablation.world_model {
-                        None
-                    } else {
-                        check_transition(
-                            prev,
-                            next,
-                            &r.operator,
-                            &demo.task.objects,
-                            config.transition_check,
-                        )
-                        .err()
-                    }
-                }
-            };
-            let verdict = match &problem {
-                None => Verdict::Accepted {
-                    checked: config.ablation.world_model,
-                },
-                Some(p) => {
-                    let fb = Feedback {
-                        attempt,
-                        reply: reply.clone(),
-                        problem: p.clone(),
-                        message: describe(p),
-                    };
-                    feedback.push(fb.clone());
-                    Verdict::Rejected { feedback: fb }
-                }
-            };
-            let parsed_ok = parsed.ok();
-            if let Some(r) = &parsed_ok {
-                last_parsed = Some(r.operator.clone());
-            }
-            let done = problem.is_none();
-            trace.events.push(TraceEvent::Induction {
-                step,
-                attempt,
-                reply,
-                parsed: parsed_ok.clone(),
-                verdict,
-            });
-            if done {
-                accepted = parsed_ok.map(|r| r.operator);
-                break;
-            }
-        }
+        let transition = Transition {
+            step,
+            prev: &pair[0],
+            next: &pair[1],
+        };
+        let (accepted, last_parsed) = induction.induce(reasoner, &transition, trace).await?;
         match (accepted, last_parsed) {
             (Some(op), _) => procedure.push(op),
             (None, Some(op)) => {
@@ -244,4 +182,117 @@ pub async fn construct_world_model<R: Reasoner>(
         unverified_steps: wm.unverified_steps.clone(),
     });
     Ok(wm)
+}
+
+/// One demonstrated transition: step `step` leads from `prev` to `next`.
+struct Transition<'a> {
+    step: usize,
+    prev: &'a State,
+    next: &'a State,
+}
+
+/// What inducing every transition's operator shares: the demonstration, the settings, the
+/// objects an operator may name and the number of attempts per transition.
+struct Induction<'a> {
+    demo: &'a Demonstration,
+    config: &'a AdaptConfig,
+    demo_objects: Vec<Symbol>,
+    tries: usize,
+}
+
+impl Induction<'_> {
+    /// Asks for the operator of `transition` until one passes or the tries run out. Returns
+    /// the accepted operator, if any, and the last one that parsed (the fallback for an
+    /// unverified step).
+    async fn induce<R: Reasoner>(
+        &self,
+        reasoner: &mut R,
+        transition: &Transition<'_>,
+        trace: &mut Trace,
+    ) -> Result<(Option<Operator>, Option<Operator>), AdaptError> {
+        let Transition { step, prev, next } = *transition;
+        let mut feedback: Vec<Feedback> = Vec::new();
+        let mut last_parsed: Option<Operator> = None;
+        let mut accepted = None;
+        for attempt in 0..self.tries {
+            let request = InductionRequest {
+                step,
+                attempt,
+                previous: prev.clone(),
+                next: next.clone(),
+                diff: prev.diff(next),
+                task: self.demo.task.clone(),
+                feedback: feedback.clone(),
+            };
+            let reply = reasoner.induce_operator(&request).await?;
+            let parsed = parse_induction_reply(&normalize_reply(&reply));
+            let problem = self.problem(parsed.as_ref(), transition);
+            let verdict = match &problem {
+                None => Verdict::Accepted {
+                    checked: self.config.ablation.world_model,
+                },
+                Some(p) => {
+                    let fb = Feedback {
+                        attempt,
+                        reply: reply.clone(),
+                        problem: p.clone(),
+                        message: describe(p),
+                    };
+                    feedback.push(fb.clone());
+                    Verdict::Rejected { feedback: fb }
+                }
+            };
+            let parsed_ok = parsed.ok();
+            if let Some(r) = &parsed_ok {
+                last_parsed = Some(r.operator.clone());
+            }
+            let done = problem.is_none();
+            trace.events.push(TraceEvent::Induction {
+                step,
+                attempt,
+                reply,
+                parsed: parsed_ok.clone(),
+                verdict,
+            });
+            if done {
+                accepted = parsed_ok.map(|r| r.operator);
+                break;
+            }
+        }
+        Ok((accepted, last_parsed))
+    }
+
+    /// Why a reply's operator is rejected for `transition`, or `None` if it passes.
+    fn problem(
+        &self,
+        parsed: Result<&InductionReply, &ParseError>,
+        transition: &Transition<'_>,
+    ) -> Option<Problem> {
+        let demo = self.demo;
+        match parsed {
+            Err(error) => Some(Problem::Unparsable { error: error.clone() }),
+            Ok(r) => {
+                // Names are read before anything is verified, with or without the check.
+                let unknown = unknown_symbols(
+                    &[&r.operator],
+                    &demo.task.vocabulary,
+                    Some(self.demo_objects.as_slice()),
+                );
+                if !unknown.is_empty() {
+                    Some(Problem::UnknownSymbols { unknown })
+                } else if !self.config.ablation.world_model {
+                    None
+                } else {
+                    check_transition(
+                        transition.prev,
+                        transition.next,
+                        &r.operator,
+                        &demo.task.objects,
+                        self.config.transition_check,
+                    )
+                    .err()
+                }
+            }
+        }
+    }
 }

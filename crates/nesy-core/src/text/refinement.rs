@@ -71,57 +71,9 @@ pub fn parse_refinement_reply(text: &str) -> Result<RefinementReply, ParseError>
             None => i += 1,
             Some(Marker::Search) => {
                 first_marker.get_or_insert(i);
-                let search_at = i;
-                let divider = (i + 1..lines.len()).find(|&j| marker(&lines[j]).is_some());
-                let Some(d) = divider.filter(|&d| marker(&lines[d]) == Some(Marker::Divider)) else {
-                    let at = divider.map_or(text.len(), |d| lines[d].content_start());
-                    return Err(ParseError::at(
-                        text,
-                        at,
-                        ParseErrorKind::UnterminatedPatch,
-                        format!(
-                            "a `=======` line ending the SEARCH section opened on line {}",
-                            search_at + 1
-                        ),
-                    ));
-                };
-                let end = (d + 1..lines.len()).find(|&j| marker(&lines[j]).is_some());
-                let Some(r) = end.filter(|&r| marker(&lines[r]) == Some(Marker::Replace)) else {
-                    let at = end.map_or(text.len(), |r| lines[r].content_start());
-                    return Err(ParseError::at(
-                        text,
-                        at,
-                        ParseErrorKind::UnterminatedPatch,
-                        format!(
-                            "a `>>>>>>> REPLACE` line closing the block opened on line {}",
-                            search_at + 1
-                        ),
-                    ));
-                };
-                let search = parse_blocks(text, &lines[search_at + 1..d], true)?;
-                if search.is_empty() {
-                    return Err(ParseError::at(
-                        text,
-                        lines[search_at].content_start(),
-                        ParseErrorKind::EmptySearch,
-                        "at least one action block between `<<<<<<< SEARCH` and `=======`",
-                    ));
-                }
-                let replace_lines = &lines[d + 1..r];
-                let only_none = {
-                    let mut sig = replace_lines.iter().filter(|l| !l.is_blank() && !l.is_fence());
-                    match (sig.next(), sig.next()) {
-                        (Some(l), None) => l.text.trim().eq_ignore_ascii_case("none"),
-                        _ => false,
-                    }
-                };
-                let replace = if only_none {
-                    Vec::new()
-                } else {
-                    parse_blocks(text, replace_lines, true)?
-                };
-                patches.push(Patch { search, replace });
-                patch_lines.push(search_at + 1);
+                let (patch, r) = parse_patch(text, &lines, i)?;
+                patches.push(patch);
+                patch_lines.push(i + 1);
                 i = r + 1;
             }
             Some(m) => {
@@ -147,7 +99,74 @@ pub fn parse_refinement_reply(text: &str) -> Result<RefinementReply, ParseError>
             "a `<<<<<<< SEARCH` / `=======` / `>>>>>>> REPLACE` block",
         ));
     };
-    let rationale = (0..first_marker)
+    Ok(RefinementReply {
+        rationale: rationale(text, &lines, first_marker),
+        patches,
+        patch_lines,
+    })
+}
+
+/// Parses the SEARCH/REPLACE block whose SEARCH marker is line `search_at`; returns the
+/// patch and the index of its REPLACE marker line.
+fn parse_patch(text: &str, lines: &[Line<'_>], search_at: usize) -> Result<(Patch, usize), ParseError> {
+    let divider = (search_at + 1..lines.len()).find(|&j| marker(&lines[j]).is_some());
+    let Some(d) = divider.filter(|&d| marker(&lines[d]) == Some(Marker::Divider)) else {
+        let at = divider.map_or(text.len(), |d| lines[d].content_start());
+        return Err(ParseError::at(
+            text,
+            at,
+            ParseErrorKind::UnterminatedPatch,
+            format!(
+                "a `=======` line ending the SEARCH section opened on line {}",
+                search_at + 1
+            ),
+        ));
+    };
+    let end = (d + 1..lines.len()).find(|&j| marker(&lines[j]).is_some());
+    let Some(r) = end.filter(|&r| marker(&lines[r]) == Some(Marker::Replace)) else {
+        let at = end.map_or(text.len(), |r| lines[r].content_start());
+        return Err(ParseError::at(
+            text,
+            at,
+            ParseErrorKind::UnterminatedPatch,
+            format!(
+                "a `>>>>>>> REPLACE` line closing the block opened on line {}",
+                search_at + 1
+            ),
+        ));
+    };
+    let search = parse_blocks(text, &lines[search_at + 1..d], true)?;
+    if search.is_empty() {
+        return Err(ParseError::at(
+            text,
+            lines[search_at].content_start(),
+            ParseErrorKind::EmptySearch,
+            "at least one action block between `<<<<<<< SEARCH` and `=======`",
+        ));
+    }
+    let replace_lines = &lines[d + 1..r];
+    let replace = if only_none(replace_lines) {
+        Vec::new()
+    } else {
+        parse_blocks(text, replace_lines, true)?
+    };
+    Ok((Patch { search, replace }, r))
+}
+
+/// True if a REPLACE section's only significant line is `None`, which removes the matched
+/// actions.
+fn only_none(replace_lines: &[Line<'_>]) -> bool {
+    let mut sig = replace_lines.iter().filter(|l| !l.is_blank() && !l.is_fence());
+    match (sig.next(), sig.next()) {
+        (Some(l), None) => l.text.trim().eq_ignore_ascii_case("none"),
+        _ => false,
+    }
+}
+
+/// The text under a rationale header before the first marker, up to a patch header if one
+/// comes first.
+fn rationale(text: &str, lines: &[Line<'_>], first_marker: usize) -> Option<String> {
+    (0..first_marker)
         .find_map(|i| header(&lines[i], RATIONALE).map(|at| (i, at)))
         .map(|(i, at)| {
             let end = (i + 1..first_marker)
@@ -161,12 +180,7 @@ pub fn parse_refinement_reply(text: &str) -> Result<RefinementReply, ParseError>
                     .map(|l| l.text.trim()),
             );
             parts.join("\n").trim().to_string()
-        });
-    Ok(RefinementReply {
-        rationale,
-        patches,
-        patch_lines,
-    })
+        })
 }
 
 #[cfg(test)]

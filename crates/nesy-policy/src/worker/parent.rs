@@ -15,6 +15,7 @@ use super::protocol::{RESULT_FD, WorkerMessage, WorkerRequest};
 use crate::episode::EpisodeSpec;
 use crate::limits::Limits;
 use crate::result::{CapturedText, ExecutionResult, Outcome, TimeLimit, WorkerReport};
+use nesy_sim::api::TraceEntry;
 
 /// How to start a worker process.
 #[derive(Clone, Debug)]
@@ -145,33 +146,7 @@ fn run(
         static_checks,
     };
     let (read_end, write_end) = pipe()?;
-    let write_raw = write_end.as_raw_fd();
-    let parent_pid = std::process::id() as libc::pid_t;
-    let mut command = Command::new(&worker.program);
-    command
-        .args(&worker.args)
-        .env_clear()
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    // SAFETY: only async-signal-safe calls between fork and exec.
-    unsafe {
-        command.pre_exec(move || {
-            if libc::dup2(write_raw, RESULT_FD) < 0 {
-                return Err(std::io::Error::last_os_error());
-            }
-            libc::setpgid(0, 0);
-            libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL, 0, 0, 0);
-            if libc::getppid() != parent_pid {
-                libc::_exit(1);
-            }
-            Ok(())
-        });
-    }
-    let mut child = command.spawn().map_err(|source| RunError::Spawn {
-        program: worker.program.clone(),
-        source,
-    })?;
+    let mut child = spawn_worker(worker, &write_end)?;
     drop(write_end);
 
     let stdout = drain_capped(child.stdout.take().expect("piped"));
@@ -201,6 +176,101 @@ fn run(
     });
 
     let kill_at = started + Duration::from_millis(limits.wall_time_ms + limits.kill_grace_ms);
+    let heard = listen(&rx, &mut child, kill_at, limits);
+    let status = wait_until(&mut child, kill_at.max(Instant::now()) + Duration::from_secs(2))?;
+    let _ = writer.join();
+    let _ = reader.join();
+    let raw_output = {
+        let mut text = stdout.join().unwrap_or_default();
+        let err = stderr.join().unwrap_or_default();
+        text.push_capped(&err.text, RAW_OUTPUT_CAP);
+        text.truncated_bytes += err.truncated_bytes;
+        text
+    };
+    let report = WorkerReport {
+        exit_code: status.code(),
+        signal: status.signal(),
+        raw_output,
+        startup_s: heard.startup_s,
+    };
+    if let Some(message) = heard.setup_error {
+        return Err(RunError::Setup(message));
+    }
+    let wall_time_s = started.elapsed().as_secs_f64();
+    if let Some(mut result) = heard.final_result {
+        result.wall_time_s = wall_time_s;
+        result.worker = Some(report);
+        return Ok(result);
+    }
+    let outcome = if heard.killed_by_parent {
+        Outcome::Timeout {
+            limit: if heard.idle_kill {
+                TimeLimit::Idle
+            } else {
+                TimeLimit::ParentKill
+            },
+            error: None,
+        }
+    } else {
+        died(&report)
+    };
+    Ok(ExecutionResult {
+        outcome,
+        trace: heard.trace,
+        stdout: CapturedText::default(),
+        stderr: CapturedText::default(),
+        wall_time_s,
+        subtasks: None,
+        final_state: None,
+        worker: Some(report),
+    })
+}
+
+/// Starts the worker process with the result channel's write end as its fd 3, in its own
+/// process group, killed with its parent.
+fn spawn_worker(worker: &WorkerCommand, write_end: &OwnedFd) -> Result<Child, RunError> {
+    let write_raw = write_end.as_raw_fd();
+    let parent_pid = std::process::id() as libc::pid_t;
+    let mut command = Command::new(&worker.program);
+    command
+        .args(&worker.args)
+        .env_clear()
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    // SAFETY: only async-signal-safe calls between fork and exec.
+    unsafe {
+        command.pre_exec(move || {
+            if libc::dup2(write_raw, RESULT_FD) < 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            libc::setpgid(0, 0);
+            libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL, 0, 0, 0);
+            if libc::getppid() != parent_pid {
+                libc::_exit(1);
+            }
+            Ok(())
+        });
+    }
+    command.spawn().map_err(|source| RunError::Spawn {
+        program: worker.program.clone(),
+        source,
+    })
+}
+
+/// What the worker said on its channel before it finished or was killed.
+struct Heard {
+    trace: Vec<TraceEntry>,
+    startup_s: Option<f64>,
+    final_result: Option<ExecutionResult>,
+    setup_error: Option<String>,
+    killed_by_parent: bool,
+    idle_kill: bool,
+}
+
+/// Collects the worker's messages until its result, its error, the end of the channel, the
+/// wall-clock limit `kill_at`, or the idle limit, killing its process group at a limit.
+fn listen(rx: &mpsc::Receiver<WorkerMessage>, child: &mut Child, kill_at: Instant, limits: &Limits) -> Heard {
     // The watchdog inside the worker stops an idle policy that still runs bytecode; one stuck
     // in C code holds the interpreter lock, so the parent also kills a worker that has sent
     // nothing (no `Ready`, no API call) for the idle limit plus the grace.
@@ -216,7 +286,7 @@ fn run(
         let now = Instant::now();
         let idle_at = last_heard + idle_grace;
         if now >= kill_at || now >= idle_at {
-            kill_group(&mut child);
+            kill_group(child);
             killed_by_parent = true;
             idle_kill = now < kill_at;
             break;
@@ -242,53 +312,14 @@ fn run(
             Err(mpsc::RecvTimeoutError::Disconnected) => break,
         }
     }
-    let status = wait_until(&mut child, kill_at.max(Instant::now()) + Duration::from_secs(2))?;
-    let _ = writer.join();
-    let _ = reader.join();
-    let raw_output = {
-        let mut text = stdout.join().unwrap_or_default();
-        let err = stderr.join().unwrap_or_default();
-        text.push_capped(&err.text, RAW_OUTPUT_CAP);
-        text.truncated_bytes += err.truncated_bytes;
-        text
-    };
-    let report = WorkerReport {
-        exit_code: status.code(),
-        signal: status.signal(),
-        raw_output,
-        startup_s,
-    };
-    if let Some(message) = setup_error {
-        return Err(RunError::Setup(message));
-    }
-    let wall_time_s = started.elapsed().as_secs_f64();
-    if let Some(mut result) = final_result {
-        result.wall_time_s = wall_time_s;
-        result.worker = Some(report);
-        return Ok(result);
-    }
-    let outcome = if killed_by_parent {
-        Outcome::Timeout {
-            limit: if idle_kill {
-                TimeLimit::Idle
-            } else {
-                TimeLimit::ParentKill
-            },
-            error: None,
-        }
-    } else {
-        died(&report)
-    };
-    Ok(ExecutionResult {
-        outcome,
+    Heard {
         trace,
-        stdout: CapturedText::default(),
-        stderr: CapturedText::default(),
-        wall_time_s,
-        subtasks: None,
-        final_state: None,
-        worker: Some(report),
-    })
+        startup_s,
+        final_result,
+        setup_error,
+        killed_by_parent,
+        idle_kill,
+    }
 }
 
 /// Classifies a worker that ended without a result.
