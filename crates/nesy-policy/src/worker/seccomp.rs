@@ -6,81 +6,97 @@
 
 use std::io;
 
-/// Installs the filter on every thread of the process (and sets no-new-privs, which an
-/// unprivileged process needs for that).
+/// BPF opcodes, return values and `seccomp_data` offsets the filter uses.
 #[cfg(target_arch = "x86_64")]
-pub fn install() -> io::Result<()> {
+const LD_W_ABS: u16 = 0x20;
+#[cfg(target_arch = "x86_64")]
+const JEQ_K: u16 = 0x15;
+#[cfg(target_arch = "x86_64")]
+const JSET_K: u16 = 0x45;
+#[cfg(target_arch = "x86_64")]
+const RET_K: u16 = 0x06;
+#[cfg(target_arch = "x86_64")]
+const AUDIT_ARCH_X86_64: u32 = 0xC000_003E;
+#[cfg(target_arch = "x86_64")]
+const RET_ALLOW: u32 = 0x7fff_0000;
+#[cfg(target_arch = "x86_64")]
+const RET_ERRNO: u32 = 0x0005_0000;
+#[cfg(target_arch = "x86_64")]
+const RET_KILL_PROCESS: u32 = 0x8000_0000;
+#[cfg(target_arch = "x86_64")]
+const OFFSET_NR: u32 = 0;
+#[cfg(target_arch = "x86_64")]
+const OFFSET_ARCH: u32 = 4;
+#[cfg(target_arch = "x86_64")]
+const fn offset_arg(i: u32) -> u32 {
+    16 + 8 * i
+}
+
+/// The system calls the worker may never make.
+#[cfg(target_arch = "x86_64")]
+const DENIED: &[i64] = &[
+    libc::SYS_execve,
+    libc::SYS_execveat,
+    libc::SYS_fork,
+    libc::SYS_vfork,
+    libc::SYS_socket,
+    libc::SYS_socketpair,
+    libc::SYS_connect,
+    libc::SYS_bind,
+    libc::SYS_listen,
+    libc::SYS_accept,
+    libc::SYS_accept4,
+    libc::SYS_ptrace,
+    libc::SYS_process_vm_readv,
+    libc::SYS_process_vm_writev,
+    libc::SYS_creat,
+    libc::SYS_openat2,
+    libc::SYS_mkdir,
+    libc::SYS_mkdirat,
+    libc::SYS_rmdir,
+    libc::SYS_unlink,
+    libc::SYS_unlinkat,
+    libc::SYS_rename,
+    libc::SYS_renameat,
+    libc::SYS_renameat2,
+    libc::SYS_link,
+    libc::SYS_linkat,
+    libc::SYS_symlink,
+    libc::SYS_symlinkat,
+    libc::SYS_chmod,
+    libc::SYS_fchmodat,
+    libc::SYS_chown,
+    libc::SYS_lchown,
+    libc::SYS_fchownat,
+    libc::SYS_truncate,
+    libc::SYS_mknod,
+    libc::SYS_mknodat,
+    libc::SYS_mount,
+    libc::SYS_umount2,
+    libc::SYS_chroot,
+    libc::SYS_pivot_root,
+    libc::SYS_unshare,
+    libc::SYS_setns,
+    libc::SYS_bpf,
+    libc::SYS_perf_event_open,
+    libc::SYS_userfaultfd,
+    libc::SYS_io_uring_setup,
+    libc::SYS_keyctl,
+    libc::SYS_add_key,
+    libc::SYS_request_key,
+    libc::SYS_kexec_load,
+    libc::SYS_init_module,
+    libc::SYS_finit_module,
+    libc::SYS_memfd_create,
+];
+
+/// The filter program. Layout: [arch check][nr load][denied...][clone3][clone][open][openat]
+/// [allow][deny][enosys][check clone: 4][check open: 4][check openat: 4] (BPF jumps only go
+/// forward, so each check ends in its own returns).
+#[cfg(target_arch = "x86_64")]
+fn filter_program() -> Vec<libc::sock_filter> {
     use libc::sock_filter;
-
-    const LD_W_ABS: u16 = 0x20;
-    const JEQ_K: u16 = 0x15;
-    const JSET_K: u16 = 0x45;
-    const RET_K: u16 = 0x06;
-    const AUDIT_ARCH_X86_64: u32 = 0xC000_003E;
-    const RET_ALLOW: u32 = 0x7fff_0000;
-    const RET_ERRNO: u32 = 0x0005_0000;
-    const RET_KILL_PROCESS: u32 = 0x8000_0000;
-    const OFFSET_NR: u32 = 0;
-    const OFFSET_ARCH: u32 = 4;
-    const fn offset_arg(i: u32) -> u32 {
-        16 + 8 * i
-    }
-
-    let denied: &[i64] = &[
-        libc::SYS_execve,
-        libc::SYS_execveat,
-        libc::SYS_fork,
-        libc::SYS_vfork,
-        libc::SYS_socket,
-        libc::SYS_socketpair,
-        libc::SYS_connect,
-        libc::SYS_bind,
-        libc::SYS_listen,
-        libc::SYS_accept,
-        libc::SYS_accept4,
-        libc::SYS_ptrace,
-        libc::SYS_process_vm_readv,
-        libc::SYS_process_vm_writev,
-        libc::SYS_creat,
-        libc::SYS_openat2,
-        libc::SYS_mkdir,
-        libc::SYS_mkdirat,
-        libc::SYS_rmdir,
-        libc::SYS_unlink,
-        libc::SYS_unlinkat,
-        libc::SYS_rename,
-        libc::SYS_renameat,
-        libc::SYS_renameat2,
-        libc::SYS_link,
-        libc::SYS_linkat,
-        libc::SYS_symlink,
-        libc::SYS_symlinkat,
-        libc::SYS_chmod,
-        libc::SYS_fchmodat,
-        libc::SYS_chown,
-        libc::SYS_lchown,
-        libc::SYS_fchownat,
-        libc::SYS_truncate,
-        libc::SYS_mknod,
-        libc::SYS_mknodat,
-        libc::SYS_mount,
-        libc::SYS_umount2,
-        libc::SYS_chroot,
-        libc::SYS_pivot_root,
-        libc::SYS_unshare,
-        libc::SYS_setns,
-        libc::SYS_bpf,
-        libc::SYS_perf_event_open,
-        libc::SYS_userfaultfd,
-        libc::SYS_io_uring_setup,
-        libc::SYS_keyctl,
-        libc::SYS_add_key,
-        libc::SYS_request_key,
-        libc::SYS_kexec_load,
-        libc::SYS_init_module,
-        libc::SYS_finit_module,
-        libc::SYS_memfd_create,
-    ];
+    let denied = DENIED;
     let write_flags = (libc::O_WRONLY | libc::O_RDWR | libc::O_CREAT | libc::O_TRUNC | libc::O_APPEND) as u32;
 
     let stmt = |code: u16, k: u32| sock_filter {
@@ -91,9 +107,6 @@ pub fn install() -> io::Result<()> {
     };
     let jump = |code: u16, k: u32, jt: u8, jf: u8| sock_filter { code, jt, jf, k };
 
-    // Layout: [arch check][nr load][denied...][clone3][clone][open][openat][allow]
-    //         [deny][enosys][check clone: 4][check open: 4][check openat: 4]
-    // (BPF jumps only go forward, so each check ends in its own returns.)
     let mut prog: Vec<sock_filter> = vec![
         stmt(LD_W_ABS, OFFSET_ARCH),
         jump(JEQ_K, AUDIT_ARCH_X86_64, 1, 0),
@@ -139,7 +152,14 @@ pub fn install() -> io::Result<()> {
         prog.push(stmt(RET_K, RET_ERRNO | libc::EPERM as u32));
     }
     debug_assert_eq!(prog.len(), check_openat + 4);
+    prog
+}
 
+/// Installs the filter on every thread of the process (and sets no-new-privs, which an
+/// unprivileged process needs for that).
+#[cfg(target_arch = "x86_64")]
+pub fn install() -> io::Result<()> {
+    let mut prog = filter_program();
     // Unprivileged processes may only install filters with no-new-privs set.
     // SAFETY: prctl with integer arguments.
     if unsafe { libc::prctl(libc::PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) } != 0 {
