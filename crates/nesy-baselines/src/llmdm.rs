@@ -137,163 +137,26 @@ enum SolveError {
 /// Runs LLM-DM on `inputs`.
 pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<BaselinePlan, BaselineError> {
     let prompts = BaselinePrompts::builtin()?;
-    let repaired = inputs.fidelity == Fidelity::Repaired;
     let (description, describe) = describe_domain(client, prompts, inputs).await?;
-    let mut stages = vec![describe];
-    let text_stage =
-        |purpose: &'static str, (system, user): (String, String), expected: &'static str| Stage {
-            purpose,
-            system,
-            parts: vec![Part::text(user)],
-            expected,
-            fidelity: inputs.fidelity,
-            client,
-        };
-
-    let prompt = prompts.render(
-        "llmdm.actions",
-        &RecommendVars {
-            domain_description: &description,
-            instruction: &inputs.instruction,
-            objects: bullets(inputs.source_objects.iter().cloned()),
-        },
-    )?;
-    let (actions, record) = text_stage(ACTIONS, prompt, NUMBERED_PLAN)
-        .ask(numbered_plan)
-        .await?;
-    stages.push(record);
-
-    let tier = inputs.vocabulary.render_definitions(inputs.planning_tier());
-    let prompt = prompts.render(
-        "llmdm.predicates",
-        &PredicateVars {
-            domain_description: &description,
-            actions: numbered(&actions),
-            predicates: tier.clone(),
-        },
-    )?;
-    let (proposed, record) = text_stage(
-        PREDICATES,
-        prompt,
-        "List the new predicates, one per line starting with \"- \".",
-    )
-    .ask(|reply| Ok(unordered_list(reply)))
-    .await?;
-    stages.push(record);
-    let mut predicates: Vec<String> = Vec::new();
-    for line in proposed.iter().map(String::as_str).chain(tier.lines()) {
-        // The authors keep the part before the first `:`.
-        let cleaned = line.split(':').next().unwrap_or("").trim().to_string();
-        if !cleaned.is_empty() && !predicates.contains(&cleaned) {
-            predicates.push(cleaned);
-        }
-    }
-
-    let constructions = actions.iter().map(|action| {
-        let prompt = prompts.render(
-            "llmdm.action",
-            &ActionVars {
-                domain_description: &description,
-                predicates: predicates.join("\n"),
-                action,
-            },
-        );
-        async move {
-            text_stage(
-                ACTION,
-                prompt?,
-                "Write \"Action name:\", the \"- \" name, \"Parameters:\", the numbered parameters, then \"Preconditions\" and \"Effects\" once each, each followed by one code block.",
-            )
-            .ask(read_action)
-            .await
-        }
-    });
-    let (models, records): (Vec<ActionModel>, Vec<StageRecord>) =
-        try_join_all(constructions).await?.into_iter().unzip();
-    stages.extend(records);
-
-    let (system, user) = prompts.render(
-        "llmdm.problem",
-        &ProblemVars {
-            domain_description: &description,
-            predicates: format!("{predicates:?}"),
-            instruction: &inputs.instruction,
-            objects: bullets(inputs.target_objects.iter().cloned()),
-            object_state: state_lines(&inputs.target_state),
-        },
-    )?;
-    let mut parts = vec![Part::text(user)];
-    parts.extend(inputs.target_views.parts("scene"));
-    let ((objects, init, goal), record) = Stage {
-        purpose: PROBLEM,
-        system,
-        parts,
-        expected: "Write \"Initial state\" with the (:objects ...) and (:init ...) code blocks, then \"Goal state\" with the (:goal ...) code block.",
-        fidelity: inputs.fidelity,
+    let mut flow = Flow {
         client,
-    }
-    .ask(read_problem)
-    .await?;
-    stages.push(record);
-    let problem =
-        format!("(define (problem llmdm-problem) (:domain llmdm)\n  {objects}\n  {init}\n  {goal})");
-
-    let mut domain = make_domain(&predicates, &models);
-    let mut found = None;
-    let mut rounds = 0;
-    let mut solve_and_refine = true;
-    while solve_and_refine {
-        let context = match solve(&domain, &problem) {
-            Ok(steps) => {
-                found = Some(steps);
-                break;
-            }
-            // A domain or problem that does not parse is reported like a failed plan; the
-            // authors' code raises there instead (a deviation in both modes).
-            Err(SolveError::Plan(context) | SolveError::Parse(context)) => context,
-        };
-        if rounds == inputs.budget {
-            break;
-        }
-        rounds += 1;
-        let prompt = prompts.render(
-            "llmdm.refine",
-            &RefineVars {
-                predicates: predicates.join("\n"),
-                domain: &domain,
-                problem: &problem,
-                failure_context: &context,
-            },
-        )?;
-        let (refined, record) = text_stage(
-            REFINE,
-            prompt,
-            "Write the whole repaired domain in one code block.",
-        )
-        .ask(|reply| first_block(reply).map_err(|e| e.to_string()))
+        inputs,
+        prompts,
+        description,
+        stages: vec![describe],
+    };
+    let actions = flow.propose_actions().await?;
+    let predicates = flow.propose_predicates(&actions).await?;
+    let models = flow.construct_actions(&actions, &predicates).await?;
+    let problem = flow.predict_problem(&predicates).await?;
+    let (found, rounds) = flow
+        .solve_and_refine(make_domain(&predicates, &models), &problem, &predicates)
         .await?;
-        stages.push(record);
-        domain = refined;
-        // The authors do not solve again after the budget's last refinement.
-        solve_and_refine = repaired || rounds < inputs.budget;
-    }
 
     let deviations = crate::Baseline::LlmDm.deviations(inputs.fidelity);
     let steps = match found {
-        Some(ground) => {
-            let prompt = prompts.render(
-                "llmdm.translate",
-                &TranslateVars {
-                    plan: numbered(&ground),
-                },
-            )?;
-            let (steps, record) = text_stage(TRANSLATE, prompt, NUMBERED_PLAN)
-                .ask(numbered_plan)
-                .await?;
-            stages.push(record);
-            steps
-        }
-        None if repaired => {
+        Some(ground) => flow.translate_plan(&ground).await?,
+        None if inputs.fidelity == Fidelity::Repaired => {
             return Err(BaselineError::NoPlan {
                 message: format!("no plan for the model's domain after {rounds} refinement(s) ({PLANNER})"),
             });
@@ -302,11 +165,220 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
     };
     Ok(BaselinePlan {
         steps,
-        stages,
+        stages: flow.stages,
         deviations,
         rounds: Some(rounds),
         instruction: None,
     })
+}
+
+/// One LLM-DM episode in progress: its inputs, the domain description, and the records of
+/// the stages asked so far.
+struct Flow<'a> {
+    client: &'a VlmClient,
+    inputs: &'a BaselineInputs,
+    prompts: &'a BaselinePrompts,
+    description: String,
+    stages: Vec<StageRecord>,
+}
+
+impl<'a> Flow<'a> {
+    /// A text-only stage with the rendered `(system, user)` prompt.
+    fn text_stage(
+        &self,
+        purpose: &'static str,
+        (system, user): (String, String),
+        expected: &'static str,
+    ) -> Stage<'a> {
+        Stage {
+            purpose,
+            system,
+            parts: vec![Part::text(user)],
+            expected,
+            fidelity: self.inputs.fidelity,
+            client: self.client,
+        }
+    }
+
+    /// The actions the task needs, from the demonstration's objects.
+    async fn propose_actions(&mut self) -> Result<Vec<String>, BaselineError> {
+        let prompt = self.prompts.render(
+            "llmdm.actions",
+            &RecommendVars {
+                domain_description: &self.description,
+                instruction: &self.inputs.instruction,
+                objects: bullets(self.inputs.source_objects.iter().cloned()),
+            },
+        )?;
+        let (actions, record) = self
+            .text_stage(ACTIONS, prompt, NUMBERED_PLAN)
+            .ask(numbered_plan)
+            .await?;
+        self.stages.push(record);
+        Ok(actions)
+    }
+
+    /// The predicates: the model's new ones, then the tier's, each kept once.
+    async fn propose_predicates(&mut self, actions: &[String]) -> Result<Vec<String>, BaselineError> {
+        let tier = self
+            .inputs
+            .vocabulary
+            .render_definitions(self.inputs.planning_tier());
+        let prompt = self.prompts.render(
+            "llmdm.predicates",
+            &PredicateVars {
+                domain_description: &self.description,
+                actions: numbered(actions),
+                predicates: tier.clone(),
+            },
+        )?;
+        let (proposed, record) = self
+            .text_stage(
+                PREDICATES,
+                prompt,
+                "List the new predicates, one per line starting with \"- \".",
+            )
+            .ask(|reply| Ok(unordered_list(reply)))
+            .await?;
+        self.stages.push(record);
+        let mut predicates: Vec<String> = Vec::new();
+        for line in proposed.iter().map(String::as_str).chain(tier.lines()) {
+            // The authors keep the part before the first `:`.
+            let cleaned = line.split(':').next().unwrap_or("").trim().to_string();
+            if !cleaned.is_empty() && !predicates.contains(&cleaned) {
+                predicates.push(cleaned);
+            }
+        }
+        Ok(predicates)
+    }
+
+    /// Each action's PDDL model, asked for concurrently.
+    async fn construct_actions(
+        &mut self,
+        actions: &[String],
+        predicates: &[String],
+    ) -> Result<Vec<ActionModel>, BaselineError> {
+        let this = &*self;
+        let constructions = actions.iter().map(|action| {
+            let prompt = this.prompts.render(
+                "llmdm.action",
+                &ActionVars {
+                    domain_description: &this.description,
+                    predicates: predicates.join("\n"),
+                    action,
+                },
+            );
+            async move {
+                this.text_stage(
+                    ACTION,
+                    prompt?,
+                    "Write \"Action name:\", the \"- \" name, \"Parameters:\", the numbered parameters, then \"Preconditions\" and \"Effects\" once each, each followed by one code block.",
+                )
+                .ask(read_action)
+                .await
+            }
+        });
+        let (models, records): (Vec<ActionModel>, Vec<StageRecord>) =
+            try_join_all(constructions).await?.into_iter().unzip();
+        self.stages.extend(records);
+        Ok(models)
+    }
+
+    /// The problem predicted from the target's objects, state and views, as PDDL.
+    async fn predict_problem(&mut self, predicates: &[String]) -> Result<String, BaselineError> {
+        let inputs = self.inputs;
+        let (system, user) = self.prompts.render(
+            "llmdm.problem",
+            &ProblemVars {
+                domain_description: &self.description,
+                predicates: format!("{predicates:?}"),
+                instruction: &inputs.instruction,
+                objects: bullets(inputs.target_objects.iter().cloned()),
+                object_state: state_lines(&inputs.target_state),
+            },
+        )?;
+        let mut parts = vec![Part::text(user)];
+        parts.extend(inputs.target_views.parts("scene"));
+        let ((objects, init, goal), record) = Stage {
+            purpose: PROBLEM,
+            system,
+            parts,
+            expected: "Write \"Initial state\" with the (:objects ...) and (:init ...) code blocks, then \"Goal state\" with the (:goal ...) code block.",
+            fidelity: inputs.fidelity,
+            client: self.client,
+        }
+        .ask(read_problem)
+        .await?;
+        self.stages.push(record);
+        Ok(format!(
+            "(define (problem llmdm-problem) (:domain llmdm)\n  {objects}\n  {init}\n  {goal})"
+        ))
+    }
+
+    /// Solves, and while there is no plan and budget left, asks the model to repair the
+    /// domain from the planner's report. Returns the plan, if one was found, and the rounds
+    /// of refinement made.
+    async fn solve_and_refine(
+        &mut self,
+        mut domain: String,
+        problem: &str,
+        predicates: &[String],
+    ) -> Result<(Option<Vec<String>>, usize), BaselineError> {
+        let inputs = self.inputs;
+        let repaired = inputs.fidelity == Fidelity::Repaired;
+        let mut rounds = 0;
+        let mut solve_again = true;
+        while solve_again {
+            let context = match solve(&domain, problem) {
+                Ok(steps) => return Ok((Some(steps), rounds)),
+                // A domain or problem that does not parse is reported like a failed plan; the
+                // authors' code raises there instead (a deviation in both modes).
+                Err(SolveError::Plan(context) | SolveError::Parse(context)) => context,
+            };
+            if rounds == inputs.budget {
+                break;
+            }
+            rounds += 1;
+            let prompt = self.prompts.render(
+                "llmdm.refine",
+                &RefineVars {
+                    predicates: predicates.join("\n"),
+                    domain: &domain,
+                    problem,
+                    failure_context: &context,
+                },
+            )?;
+            let (refined, record) = self
+                .text_stage(
+                    REFINE,
+                    prompt,
+                    "Write the whole repaired domain in one code block.",
+                )
+                .ask(|reply| first_block(reply).map_err(|e| e.to_string()))
+                .await?;
+            self.stages.push(record);
+            domain = refined;
+            // The authors do not solve again after the budget's last refinement.
+            solve_again = repaired || rounds < inputs.budget;
+        }
+        Ok((None, rounds))
+    }
+
+    /// The grounded plan put into words.
+    async fn translate_plan(&mut self, ground: &[String]) -> Result<Vec<String>, BaselineError> {
+        let prompt = self.prompts.render(
+            "llmdm.translate",
+            &TranslateVars {
+                plan: numbered(ground),
+            },
+        )?;
+        let (steps, record) = self
+            .text_stage(TRANSLATE, prompt, NUMBERED_PLAN)
+            .ask(numbered_plan)
+            .await?;
+        self.stages.push(record);
+        Ok(steps)
+    }
 }
 
 /// Splits `text` once at `marker`: exactly one occurrence, as the authors' `split` needs.

@@ -73,143 +73,235 @@ fn is_surrounding(pred: &str) -> bool {
 /// The schema name and arguments an operator performs, judged from its effects and
 /// preconditions; `None` if they match no schema (e.g. an action without physical effects).
 pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(&'static str, Vec<String>)> {
-    let adds = lits(&op.eff, true);
-    let dels = lits(&op.eff, false);
-    let pre = positive_pre(&op.pre);
-    let known = |o: &String| objects.contains(o);
-    let add1 = |pred: &dyn Fn(&str) -> bool| {
-        adds.iter()
-            .find(|(p, a)| pred(p) && a.len() == 1 && known(&a[0]))
-            .map(|(_, a)| a[0].clone())
+    let ev = Evidence {
+        adds: lits(&op.eff, true),
+        dels: lits(&op.eff, false),
+        pre: positive_pre(&op.pre),
+        objects,
     };
-    let add2 = |name: &str| {
-        adds.iter()
-            .filter(|(p, a)| p == name && a.len() == 2 && a.iter().all(known))
+    // The first rule that recognises the operator decides, so their order is part of the
+    // judgement.
+    if let Some(verdict) = ev
+        .articulation_change()
+        .or_else(|| ev.handle_action())
+        .or_else(|| ev.release_of_item())
+        .or_else(|| ev.grasp_or_approach())
+        .or_else(|| ev.carry_to_place())
+        .or_else(|| ev.lift_off_to_floor())
+    {
+        return verdict;
+    }
+    // Only quantified clearing effects, no relation of its own: the hand only moves (a
+    // retreat, or an approach to a handle, which the grasp that follows makes itself). An
+    // operator with no effects at all says nothing and stays unknown.
+    if ev.adds.is_empty() && ev.dels.is_empty() && !op.eff.is_empty() {
+        return Some(("retreat", Vec::new()));
+    }
+    None
+}
+
+/// A schema name with its arguments, or `None` when the operator matches no schema.
+type Verdict = Option<(&'static str, Vec<String>)>;
+
+/// True if the object is a loose one the robot picks and places.
+fn is_item(o: &str) -> bool {
+    kind_of(o) == Some(Kind::Item)
+}
+
+/// An operator's top-level literals over the scene's objects, which every rule reads.
+/// Each rule returns `Some(verdict)` when it decides, `None` to leave it to the next.
+struct Evidence<'a> {
+    /// Added literals.
+    adds: Vec<Lit>,
+    /// Deleted literals.
+    dels: Vec<Lit>,
+    /// Positive preconditions.
+    pre: Vec<Lit>,
+    /// The scene's object names.
+    objects: &'a [String],
+}
+
+impl Evidence<'_> {
+    /// True if the name is one of the scene's objects.
+    fn known(&self, o: &str) -> bool {
+        self.objects.iter().any(|x| x == o)
+    }
+
+    /// The object of the first added one-argument literal whose predicate passes `pred`.
+    fn add1(&self, pred: &dyn Fn(&str) -> bool) -> Option<String> {
+        self.adds
+            .iter()
+            .find(|(p, a)| pred(p) && a.len() == 1 && self.known(&a[0]))
+            .map(|(_, a)| a[0].clone())
+    }
+
+    /// The argument pairs of every added `name` literal over known objects.
+    fn add2(&self, name: &str) -> Vec<(String, String)> {
+        self.adds
+            .iter()
+            .filter(|(p, a)| p == name && a.len() == 2 && a.iter().all(|o| self.known(o)))
             .map(|(_, a)| (a[0].clone(), a[1].clone()))
             .collect::<Vec<_>>()
-    };
-    // Articulations: a lid or a drawer opened or closed (a swing waypoint may only state
-    // that it is no longer closed, or no longer open).
-    let del1 = |name: &str| {
-        dels.iter()
-            .find(|(p, a)| p == name && a.len() == 1 && known(&a[0]))
+    }
+
+    /// The object of the first deleted one-argument `name` literal.
+    fn del1(&self, name: &str) -> Option<String> {
+        self.dels
+            .iter()
+            .find(|(p, a)| p == name && a.len() == 1 && self.known(&a[0]))
             .map(|(_, a)| a[0].clone())
-    };
-    let changes = [
-        (add1(&|p| p == "Open"), true),
-        (add1(&|p| p == "Closed"), false),
-        (del1("Closed"), true),
-        (del1("Open"), false),
-    ];
-    for (x, opened) in changes {
-        if let Some(x) = x {
-            let schema = match (x.as_str(), opened) {
-                (parts::HINGE_LID, true) => "open-hinge-lid",
-                (parts::HINGE_LID, false) => "close-hinge-lid",
-                (parts::BOTTOM_DRAWER, true) => "open-bottom-drawer",
-                (parts::BOTTOM_DRAWER, false) => "close-bottom-drawer",
-                (parts::TOP_DRAWER, true) => "open-top-drawer",
-                (parts::TOP_DRAWER, false) => "close-top-drawer",
-                _ => continue,
+    }
+
+    /// True if the preconditions state that `x` is held.
+    fn held(&self, x: &str) -> bool {
+        self.pre
+            .iter()
+            .any(|(p, a)| is_holding(p) && a.len() == 1 && a[0] == x)
+    }
+
+    /// Articulations: a lid or a drawer opened or closed (a swing waypoint may only state
+    /// that it is no longer closed, or no longer open).
+    fn articulation_change(&self) -> Option<Verdict> {
+        let changes = [
+            (self.add1(&|p| p == "Open"), true),
+            (self.add1(&|p| p == "Closed"), false),
+            (self.del1("Closed"), true),
+            (self.del1("Open"), false),
+        ];
+        for (x, opened) in changes {
+            if let Some(x) = x {
+                let schema = match (x.as_str(), opened) {
+                    (parts::HINGE_LID, true) => "open-hinge-lid",
+                    (parts::HINGE_LID, false) => "close-hinge-lid",
+                    (parts::BOTTOM_DRAWER, true) => "open-bottom-drawer",
+                    (parts::BOTTOM_DRAWER, false) => "close-bottom-drawer",
+                    (parts::TOP_DRAWER, true) => "open-top-drawer",
+                    (parts::TOP_DRAWER, false) => "close-top-drawer",
+                    _ => continue,
+                };
+                return Some(Some((schema, Vec::new())));
+            }
+        }
+        None
+    }
+
+    /// Handles: approached, grasped, let go.
+    fn handle_action(&self) -> Option<Verdict> {
+        for (handle, part, what) in HANDLES {
+            let on = |v: &[Lit], pred: fn(&str) -> bool| {
+                v.iter()
+                    .any(|(p, a)| pred(p) && a.len() == 1 && (a[0] == handle || a[0] == part))
             };
-            return Some((schema, Vec::new()));
+            let schema = if on(&self.adds, is_holding) {
+                Some(format!("grasp-{what}-handle"))
+            } else if on(&self.dels, is_holding) {
+                Some(format!("release-{what}-handle"))
+            } else if on(&self.adds, is_surrounding) {
+                Some(format!("move-to-{what}-handle"))
+            } else {
+                None
+            };
+            if let Some(name) = schema {
+                return Some(
+                    schemas()
+                        .iter()
+                        .find(|s| s.name == name)
+                        .map(|s| (s.name, Vec::new())),
+                );
+            }
         }
+        None
     }
-    // Handles: approached, grasped, let go.
-    for (handle, part, what) in HANDLES {
-        let on = |v: &[Lit], pred: fn(&str) -> bool| {
-            v.iter()
-                .any(|(p, a)| pred(p) && a.len() == 1 && (a[0] == handle || a[0] == part))
-        };
-        let schema = if on(&adds, is_holding) {
-            Some(format!("grasp-{what}-handle"))
-        } else if on(&dels, is_holding) {
-            Some(format!("release-{what}-handle"))
-        } else if on(&adds, is_surrounding) {
-            Some(format!("move-to-{what}-handle"))
-        } else {
-            None
-        };
-        if let Some(name) = schema {
-            return schemas()
-                .iter()
-                .find(|s| s.name == name)
-                .map(|s| (s.name, Vec::new()));
-        }
-    }
-    let item = |o: &String| kind_of(o) == Some(Kind::Item);
-    // Letting go of a held item: where it comes to rest names the schema.
-    if let Some((_, a)) = dels
-        .iter()
-        .find(|(p, a)| is_holding(p) && a.len() == 1 && item(&a[0]))
-    {
+
+    /// Letting go of a held item: where it comes to rest names the schema (and nowhere
+    /// stated means no schema).
+    fn release_of_item(&self) -> Option<Verdict> {
+        let (_, a) = self
+            .dels
+            .iter()
+            .find(|(p, a)| is_holding(p) && a.len() == 1 && is_item(&a[0]))?;
         let x = a[0].clone();
-        let rest = add2("InsideOf")
+        let Some(rest) = self
+            .add2("InsideOf")
             .into_iter()
-            .chain(add2("OnTopOf"))
+            .chain(self.add2("OnTopOf"))
             .chain(
-                pre.iter()
+                self.pre
+                    .iter()
                     .filter(|(p, a)| (p == "InsideOf" || p == "OverOf") && a.len() == 2)
                     .map(|(_, a)| (a[0].clone(), a[1].clone())),
             )
             .find(|(y, _)| *y == x)
-            .map(|(_, place)| place)?;
-        return match (rest.as_str(), kind_of(&rest)) {
+            .map(|(_, place)| place)
+        else {
+            return Some(None);
+        };
+        Some(match (rest.as_str(), kind_of(&rest)) {
             (parts::HINGE_BODY, _) => Some(("drop-into-hinge-body", vec![x])),
             (parts::BOTTOM_DRAWER, _) => Some(("drop-into-bottom-drawer", vec![x])),
             (_, Some(Kind::Surface)) => Some(("put-down", vec![x, rest])),
             (_, Some(Kind::Box)) => Some(("release-into", vec![x, rest])),
             _ => None,
-        };
+        })
     }
-    if let Some(x) = add1(&|p| is_holding(p)).filter(item) {
-        return Some(("grasp", vec![x]));
+
+    /// An item grasped, or the hand brought around one.
+    fn grasp_or_approach(&self) -> Option<Verdict> {
+        if let Some(x) = self.add1(&|p| is_holding(p)).filter(|x| is_item(x)) {
+            return Some(Some(("grasp", vec![x])));
+        }
+        if let Some(x) = self.add1(&|p| is_surrounding(p)).filter(|x| is_item(x)) {
+            return Some(Some(("move-to-surround", vec![x])));
+        }
+        None
     }
-    if let Some(x) = add1(&|p| is_surrounding(p)).filter(item) {
-        return Some(("move-to-surround", vec![x]));
+
+    /// An item brought over, into or onto a place.
+    fn carry_to_place(&self) -> Option<Verdict> {
+        if let Some((x, place)) = self.add2("OverOf").into_iter().find(|(x, _)| is_item(x)) {
+            return Some(match place.as_str() {
+                parts::HINGE_BODY => Some(("carry-over-hinge-body", vec![x])),
+                parts::BOTTOM_DRAWER => Some(("carry-over-bottom-drawer", vec![x])),
+                _ => None,
+            });
+        }
+        if let Some((x, b)) = self
+            .add2("InsideOf")
+            .into_iter()
+            .find(|(x, b)| is_item(x) && kind_of(b) == Some(Kind::Box))
+        {
+            // Chess pieces reach their boxes by a push across the board; anything held is
+            // carried in.
+            return Some(
+                if b == parts::LEFT_CHESS_BOX || b == parts::RIGHT_CHESS_BOX || !self.held(&x) {
+                    Some(("sweep-into", vec![x, b]))
+                } else {
+                    Some(("carry-into", vec![x, b]))
+                },
+            );
+        }
+        if let Some((x, s)) = self
+            .add2("OnTopOf")
+            .into_iter()
+            .find(|(x, s)| is_item(x) && kind_of(s) == Some(Kind::Surface) && self.held(x))
+        {
+            return Some(Some(("carry-onto", vec![x, s])));
+        }
+        None
     }
-    let held = |x: &String| {
-        pre.iter()
-            .any(|(p, a)| is_holding(p) && a == std::slice::from_ref(x))
-    };
-    if let Some((x, place)) = add2("OverOf").into_iter().find(|(x, _)| item(x)) {
-        return match place.as_str() {
-            parts::HINGE_BODY => Some(("carry-over-hinge-body", vec![x])),
-            parts::BOTTOM_DRAWER => Some(("carry-over-bottom-drawer", vec![x])),
-            _ => None,
-        };
+
+    /// A held item lifted off what it stood on or in, with nowhere new stated: a carry to
+    /// the table (the put-down that follows names the surface it comes to rest on).
+    fn lift_off_to_floor(&self) -> Option<Verdict> {
+        if let Some((_, a)) = self.dels.iter().find(|(p, a)| {
+            matches!(p.as_str(), "OnTopOf" | "InsideOf" | "OverOf")
+                && a.len() == 2
+                && is_item(&a[0])
+                && self.held(&a[0])
+        }) && self.objects.iter().any(|o| o == parts::FLOOR)
+        {
+            return Some(Some(("carry-onto", vec![a[0].clone(), parts::FLOOR.to_owned()])));
+        }
+        None
     }
-    if let Some((x, b)) = add2("InsideOf")
-        .into_iter()
-        .find(|(x, b)| item(x) && kind_of(b) == Some(Kind::Box))
-    {
-        // Chess pieces reach their boxes by a push across the board; anything held is
-        // carried in.
-        return if b == parts::LEFT_CHESS_BOX || b == parts::RIGHT_CHESS_BOX || !held(&x) {
-            Some(("sweep-into", vec![x, b]))
-        } else {
-            Some(("carry-into", vec![x, b]))
-        };
-    }
-    if let Some((x, s)) = add2("OnTopOf")
-        .into_iter()
-        .find(|(x, s)| item(x) && kind_of(s) == Some(Kind::Surface) && held(x))
-    {
-        return Some(("carry-onto", vec![x, s]));
-    }
-    // A held item lifted off what it stood on or in, with nowhere new stated: a carry to
-    // the table (the put-down that follows names the surface it comes to rest on).
-    if let Some((_, a)) = dels.iter().find(|(p, a)| {
-        matches!(p.as_str(), "OnTopOf" | "InsideOf" | "OverOf") && a.len() == 2 && item(&a[0]) && held(&a[0])
-    }) && objects.iter().any(|o| o == parts::FLOOR)
-    {
-        return Some(("carry-onto", vec![a[0].clone(), parts::FLOOR.to_owned()]));
-    }
-    // Only quantified clearing effects, no relation of its own: the hand only moves (a
-    // retreat, or an approach to a handle, which the grasp that follows makes itself). An
-    // operator with no effects at all says nothing and stays unknown.
-    if adds.is_empty() && dels.is_empty() && !op.eff.is_empty() {
-        return Some(("retreat", Vec::new()));
-    }
-    None
 }

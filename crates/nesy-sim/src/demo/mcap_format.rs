@@ -476,10 +476,29 @@ pub fn read_mcap_bytes(bytes: &[u8], path: &Path) -> Result<Demo, DemoError> {
         name: METADATA_NAME.to_owned(),
     })?;
     let (metadata, count) = parse_metadata(&meta_map, path)?;
+    let all_topics = topics();
+    check_channels(&records.channels, &records.schemas, &all_topics, path)?;
+    let mut slots = slot_messages(records.messages, &records.channels, &all_topics, count, path)?;
+    let mut keyframes = Vec::with_capacity(count);
+    for k in 0..count {
+        keyframes.push(take_keyframe(&mut slots, k, count, path)?);
+    }
+    Ok(Demo { metadata, keyframes })
+}
 
-    // Topic → channel id, with schema and encoding checked.
+/// Messages of each topic, indexed by keyframe (a `None` until its message is read).
+type Slots<'a> = HashMap<&'a str, Vec<Option<Stamped>>>;
+
+/// Checks the schema and encoding of every channel a demo topic is on, and that each of
+/// `all_topics` has a channel.
+fn check_channels(
+    channels: &HashMap<u16, (String, u16, String)>,
+    schemas: &HashMap<u16, String>,
+    all_topics: &[String],
+    path: &Path,
+) -> Result<(), DemoError> {
     let mut by_topic: HashMap<&str, u16> = HashMap::new();
-    for (id, (topic, schema_id, encoding)) in &records.channels {
+    for (id, (topic, schema_id, encoding)) in channels {
         by_topic.insert(topic.as_str(), *id);
         let expected_schema = if topic.starts_with("/camera/") {
             Some(IMAGE_SCHEMA_NAME)
@@ -501,7 +520,7 @@ pub fn read_mcap_bytes(bytes: &[u8], path: &Path) -> Result<Demo, DemoError> {
                 format!("{encoding:?}"),
             ));
         }
-        let schema = records.schemas.get(schema_id).map(String::as_str).unwrap_or("");
+        let schema = schemas.get(schema_id).map(String::as_str).unwrap_or("");
         if schema != expected_schema {
             return Err(DemoError::invalid(
                 path,
@@ -511,8 +530,7 @@ pub fn read_mcap_bytes(bytes: &[u8], path: &Path) -> Result<Demo, DemoError> {
             ));
         }
     }
-    let all_topics = topics();
-    for topic in &all_topics {
+    for topic in all_topics {
         if !by_topic.contains_key(topic.as_str()) {
             return Err(DemoError::MissingTopic {
                 path: path.to_owned(),
@@ -521,18 +539,27 @@ pub fn read_mcap_bytes(bytes: &[u8], path: &Path) -> Result<Demo, DemoError> {
             });
         }
     }
+    Ok(())
+}
 
-    // Messages per channel, indexed by keyframe (the message sequence).
-    let topic_of: HashMap<u16, &str> = records
-        .channels
+/// Files each message of a demo topic under its keyframe (the message sequence), rejecting
+/// unknown channels, sequences past `count` and second messages for one keyframe.
+fn slot_messages<'a>(
+    messages: Vec<(MessageHeader, Vec<u8>)>,
+    channels: &HashMap<u16, (String, u16, String)>,
+    all_topics: &'a [String],
+    count: usize,
+    path: &Path,
+) -> Result<Slots<'a>, DemoError> {
+    let topic_of: HashMap<u16, &str> = channels
         .iter()
         .map(|(id, (topic, _, _))| (*id, topic.as_str()))
         .collect();
-    let mut slots: HashMap<&str, Vec<Option<Stamped>>> = all_topics
+    let mut slots: Slots<'a> = all_topics
         .iter()
         .map(|t| (t.as_str(), vec![None; count]))
         .collect();
-    for (header, data) in records.messages {
+    for (header, data) in messages {
         let Some(topic) = topic_of.get(&header.channel_id).copied() else {
             return Err(DemoError::invalid(
                 path,
@@ -563,46 +590,47 @@ pub fn read_mcap_bytes(bytes: &[u8], path: &Path) -> Result<Demo, DemoError> {
         }
         slot[k] = Some((header.log_time, data));
     }
+    Ok(slots)
+}
 
-    let mut keyframes = Vec::with_capacity(count);
-    for k in 0..count {
-        let mut take = |topic: &str| slots.get_mut(topic).and_then(|s| s[k].take());
-        let missing = |topic: &str| {
-            DemoError::invalid(
-                path,
-                format!("{topic} keyframe {k}"),
-                format!("one message for each of the {count} keyframes"),
-                "no message",
-            )
+/// Decodes keyframe `k` of `count` from its messages, taking them out of `slots`: state,
+/// action and each camera's raw and (optional) marked image.
+fn take_keyframe(slots: &mut Slots<'_>, k: usize, count: usize, path: &Path) -> Result<Keyframe, DemoError> {
+    let mut take = |topic: &str| slots.get_mut(topic).and_then(|s| s[k].take());
+    let missing = |topic: &str| {
+        DemoError::invalid(
+            path,
+            format!("{topic} keyframe {k}"),
+            format!("one message for each of the {count} keyframes"),
+            "no message",
+        )
+    };
+    let (log_time, state_bytes) = take(STATE_TOPIC).ok_or_else(|| missing(STATE_TOPIC))?;
+    let state: StateMessage =
+        DemoError::parse_json(path, &format!("{STATE_TOPIC} keyframe {k}"), &state_bytes)?;
+    check_keyframe_field(path, STATE_TOPIC, k, state.keyframe)?;
+    let (_, action_bytes) = take(ACTION_TOPIC).ok_or_else(|| missing(ACTION_TOPIC))?;
+    let action: ActionMessage =
+        DemoError::parse_json(path, &format!("{ACTION_TOPIC} keyframe {k}"), &action_bytes)?;
+    check_keyframe_field(path, ACTION_TOPIC, k, action.keyframe)?;
+    let views = KeyframeViews::from_fn(|camera| {
+        let raw_topic = image_topic(camera, false);
+        let (_, raw) = take(&raw_topic).ok_or_else(|| missing(&raw_topic))?;
+        let raw = decode_image(path, &raw_topic, k, &raw)?;
+        let marked_topic = image_topic(camera, true);
+        let marked = match take(&marked_topic) {
+            Some((_, bytes)) => Some(decode_image(path, &marked_topic, k, &bytes)?),
+            None => None,
         };
-        let (log_time, state_bytes) = take(STATE_TOPIC).ok_or_else(|| missing(STATE_TOPIC))?;
-        let state: StateMessage =
-            DemoError::parse_json(path, &format!("{STATE_TOPIC} keyframe {k}"), &state_bytes)?;
-        check_keyframe_field(path, STATE_TOPIC, k, state.keyframe)?;
-        let (_, action_bytes) = take(ACTION_TOPIC).ok_or_else(|| missing(ACTION_TOPIC))?;
-        let action: ActionMessage =
-            DemoError::parse_json(path, &format!("{ACTION_TOPIC} keyframe {k}"), &action_bytes)?;
-        check_keyframe_field(path, ACTION_TOPIC, k, action.keyframe)?;
-        let views = KeyframeViews::from_fn(|camera| {
-            let raw_topic = image_topic(camera, false);
-            let (_, raw) = take(&raw_topic).ok_or_else(|| missing(&raw_topic))?;
-            let raw = decode_image(path, &raw_topic, k, &raw)?;
-            let marked_topic = image_topic(camera, true);
-            let marked = match take(&marked_topic) {
-                Some((_, bytes)) => Some(decode_image(path, &marked_topic, k, &bytes)?),
-                None => None,
-            };
-            Ok(CameraImages { raw, marked })
-        })?;
-        keyframes.push(Keyframe {
-            index: k,
-            time: log_time as f64 / 1e9,
-            views,
-            state: state.atoms,
-            action: action.entry,
-        });
-    }
-    Ok(Demo { metadata, keyframes })
+        Ok(CameraImages { raw, marked })
+    })?;
+    Ok(Keyframe {
+        index: k,
+        time: log_time as f64 / 1e9,
+        views,
+        state: state.atoms,
+        action: action.entry,
+    })
 }
 
 fn check_keyframe_field(path: &Path, topic: &str, k: usize, found: usize) -> Result<(), DemoError> {

@@ -147,23 +147,54 @@ fn open_closed(q: f64, lo: f64, hi: f64) -> Option<&'static str> {
 /// Applies the observer's rules to a snapshot.
 pub fn observe_snapshot(s: &Snapshot) -> State {
     let mut atoms: Vec<Atom> = Vec::new();
-    let finger = s.embodiment == Embodiment::Finger;
-    let (open_p, closed_p, holding_p, surround_p) = if finger {
-        (
-            "GripperOpen",
-            "GripperClosed",
-            "GripperHolding",
-            "GripperSurrounding",
-        )
-    } else {
-        (
-            "VacuumInactive",
-            "VacuumActive",
-            "VacuumAttached",
-            "VacuumAligned",
-        )
-    };
-    atoms.push(Atom::new(if s.closed { closed_p } else { open_p }, &[]));
+    let preds = EffectorPredicates::of(s.embodiment);
+    push_effector_and_joints(s, &preds, &mut atoms);
+    push_holding(s, &preds, &mut atoms);
+    let inside = push_inside_of(s, &mut atoms);
+    let on_top = push_on_top_of(s, &inside, &mut atoms);
+    push_drawer_over_handle(s, &mut atoms);
+    push_over_of(s, &inside, &on_top, &mut atoms);
+    State::from_atoms(atoms)
+}
+
+/// The end effector's four state predicates, whose names depend on the embodiment.
+struct EffectorPredicates {
+    open: &'static str,
+    closed: &'static str,
+    holding: &'static str,
+    surrounding: &'static str,
+}
+
+impl EffectorPredicates {
+    /// The finger gripper's names or the suction cup's.
+    fn of(embodiment: Embodiment) -> Self {
+        if embodiment == Embodiment::Finger {
+            EffectorPredicates {
+                open: "GripperOpen",
+                closed: "GripperClosed",
+                holding: "GripperHolding",
+                surrounding: "GripperSurrounding",
+            }
+        } else {
+            EffectorPredicates {
+                open: "VacuumInactive",
+                closed: "VacuumActive",
+                holding: "VacuumAttached",
+                surrounding: "VacuumAligned",
+            }
+        }
+    }
+}
+
+/// True if both objects belong to one articulated asset (pairs within an asset are dropped).
+fn same_group(a: &ObjectView, b: &ObjectView) -> bool {
+    a.group.is_some() && a.group == b.group
+}
+
+/// Adds the effector's open/closed atom, its embodiment (when the scene asks for it) and
+/// every joint's `Open`/`Closed`.
+fn push_effector_and_joints(s: &Snapshot, preds: &EffectorPredicates, atoms: &mut Vec<Atom>) {
+    atoms.push(Atom::new(if s.closed { preds.closed } else { preds.open }, &[]));
     if s.embodiment_in_state {
         atoms.push(Atom::new(s.embodiment.state_predicate(), &[]));
     }
@@ -174,7 +205,12 @@ pub fn observe_snapshot(s: &Snapshot) -> State {
             atoms.push(Atom::new(p, &[&o.name]));
         }
     }
-    // Holding: the welded object or the grasped handle, while closed.
+}
+
+/// Adds holding (the welded object or the grasped handle, while closed) or, with the
+/// effector open and nothing welded, surrounding (the first object by name in the grasp
+/// region, leaving out the table, handles and articulated bodies).
+fn push_holding(s: &Snapshot, preds: &EffectorPredicates, atoms: &mut Vec<Atom>) {
     if s.closed {
         let mut held: Vec<&str> = s
             .held
@@ -184,7 +220,7 @@ pub fn observe_snapshot(s: &Snapshot) -> State {
             .collect();
         held.sort_unstable();
         if let Some(first) = held.first() {
-            atoms.push(Atom::new(holding_p, &[first]));
+            atoms.push(Atom::new(preds.holding, &[first]));
         }
     } else if s.held.is_none() {
         let mut around: Vec<&str> = s
@@ -199,11 +235,14 @@ pub fn observe_snapshot(s: &Snapshot) -> State {
             .collect();
         around.sort_unstable();
         if let Some(first) = around.first() {
-            atoms.push(Atom::new(surround_p, &[first]));
+            atoms.push(Atom::new(preds.surrounding, &[first]));
         }
     }
-    let same_group = |a: &ObjectView, b: &ObjectView| a.group.is_some() && a.group == b.group;
-    // InsideOf: the smallest container whose padded box holds the object.
+}
+
+/// Adds `InsideOf` for each object and the smallest container whose padded box holds it;
+/// returns that container's index per object, which the later rules consult.
+fn push_inside_of(s: &Snapshot, atoms: &mut Vec<Atom>) -> Vec<Option<usize>> {
     let mut inside: Vec<Option<usize>> = vec![None; s.objects.len()];
     for (i, a) in s.objects.iter().enumerate() {
         let mut best: Option<(f64, usize)> = None;
@@ -224,8 +263,13 @@ pub fn observe_snapshot(s: &Snapshot) -> State {
             atoms.push(Atom::new("InsideOf", &[&a.name, &s.objects[j].name]));
         }
     }
+    inside
+}
+
+/// Adds `OnTopOf` for each object not inside another and the highest supporting surface(s)
+/// it rests on; returns whether each object rests on something.
+fn push_on_top_of(s: &Snapshot, inside: &[Option<usize>], atoms: &mut Vec<Atom>) -> Vec<bool> {
     let is_inside_pair = |i: usize, j: usize| inside[i] == Some(j) || inside[j] == Some(i);
-    // OnTopOf: resting on the highest supporting surface(s).
     let mut on_top = vec![false; s.objects.len()];
     for (i, a) in s.objects.iter().enumerate() {
         if inside[i].is_some() {
@@ -253,7 +297,12 @@ pub fn observe_snapshot(s: &Snapshot) -> State {
             }
         }
     }
-    // Special rule: an open top drawer lies over the bottom drawer's handle.
+    on_top
+}
+
+/// Special rule: an open top drawer lies over the bottom drawer's handle (they belong to
+/// one asset, so the general rule never pairs them).
+fn push_drawer_over_handle(s: &Snapshot, atoms: &mut Vec<Atom>) {
     if let (Some(top), Some(handle)) = (
         s.objects.iter().find(|o| o.name == parts::TOP_DRAWER),
         s.objects.iter().find(|o| o.name == parts::BOTTOM_DRAWER_HANDLE),
@@ -264,7 +313,11 @@ pub fn observe_snapshot(s: &Snapshot) -> State {
             &[parts::TOP_DRAWER, parts::BOTTOM_DRAWER_HANDLE],
         ));
     }
-    // OverOf: the held object above the nearest thing below it.
+}
+
+/// Adds `OverOf` for the held object, when it is neither inside nor on anything, and the
+/// nearest thing below it.
+fn push_over_of(s: &Snapshot, inside: &[Option<usize>], on_top: &[bool], atoms: &mut Vec<Atom>) {
     if let Some(held) = &s.held
         && let Some(w) = s.objects.iter().position(|o| &o.name == held)
         && inside[w].is_none()
@@ -289,7 +342,6 @@ pub fn observe_snapshot(s: &Snapshot) -> State {
             atoms.push(Atom::new("OverOf", &[held, o]));
         }
     }
-    State::from_atoms(atoms)
 }
 
 #[cfg(test)]

@@ -134,143 +134,14 @@ impl RobotModel {
     /// prismatic joints (and their mimics) become the gripper.
     pub fn from_urdf_str(urdf: &str, tool_link: &str) -> Result<Self, ModelError> {
         let robot = urdf_rs::read_from_string(urdf).map_err(|e| ModelError::Parse(e.to_string()))?;
-        let invalid = |message: String| ModelError::Invalid {
-            robot: robot.name.clone(),
-            message,
-        };
-        let children: std::collections::HashSet<&str> =
-            robot.joints.iter().map(|j| j.child.link.as_str()).collect();
-        let roots: Vec<&urdf_rs::Link> = robot
-            .links
-            .iter()
-            .filter(|l| !children.contains(l.name.as_str()))
-            .collect();
-        let [root] = roots.as_slice() else {
-            return Err(invalid(format!(
-                "expected exactly one root link, found {}",
-                roots.len()
-            )));
-        };
-        let mut links = vec![LinkModel {
-            name: root.name.clone(),
-            parent: None,
-            joint_name: String::new(),
-            kind: JointKind::Fixed,
-            origin: Iso::identity(),
-            axis: Vector3::z(),
-            limits: (0.0, 0.0),
-            source: JointSource::None,
-            collisions: collisions_of(root).map_err(&invalid)?,
-            mass: root.inertial.mass.value,
-        }];
-        let mut arm_limits = Vec::new();
-        let mut gripper_limits = None;
-        let mut driving_finger: Option<String> = None;
+        let mut tree = TreeBuilder::rooted(&robot)?;
         // Breadth-first over joints in file order keeps the dof order deterministic.
         let mut frontier = 0;
-        while frontier < links.len() {
-            let parent_name = links[frontier].name.clone();
-            for joint in robot.joints.iter().filter(|j| j.parent.link == parent_name) {
-                let link = robot
-                    .links
-                    .iter()
-                    .find(|l| l.name == joint.child.link)
-                    .ok_or_else(|| {
-                        invalid(format!(
-                            "joint {} names missing link {}",
-                            joint.name, joint.child.link
-                        ))
-                    })?;
-                let axis = Vector3::from(joint.axis.xyz.0);
-                let axis = if axis.norm() > 0.0 {
-                    axis.normalize()
-                } else {
-                    Vector3::z()
-                };
-                let limits = (joint.limit.lower, joint.limit.upper);
-                let (kind, source) = match joint.joint_type {
-                    urdf_rs::JointType::Fixed => (JointKind::Fixed, JointSource::None),
-                    urdf_rs::JointType::Revolute => {
-                        arm_limits.push(limits);
-                        (JointKind::Revolute, JointSource::Arm(arm_limits.len() - 1))
-                    }
-                    urdf_rs::JointType::Prismatic => {
-                        let source = match &joint.mimic {
-                            Some(m) => {
-                                if driving_finger.as_deref() != Some(m.joint.as_str()) {
-                                    return Err(invalid(format!(
-                                        "joint {} mimics {}, which is not the driving finger",
-                                        joint.name, m.joint
-                                    )));
-                                }
-                                JointSource::Gripper {
-                                    multiplier: m.multiplier.unwrap_or(1.0),
-                                    offset: m.offset.unwrap_or(0.0),
-                                }
-                            }
-                            None => {
-                                if driving_finger.is_some() {
-                                    return Err(invalid("more than one unmimicked prismatic joint".into()));
-                                }
-                                driving_finger = Some(joint.name.clone());
-                                gripper_limits = Some(limits);
-                                JointSource::Gripper {
-                                    multiplier: 1.0,
-                                    offset: 0.0,
-                                }
-                            }
-                        };
-                        (JointKind::Prismatic, source)
-                    }
-                    ref other => {
-                        return Err(invalid(format!(
-                            "joint {} has unsupported type {other:?}",
-                            joint.name
-                        )));
-                    }
-                };
-                links.push(LinkModel {
-                    name: link.name.clone(),
-                    parent: Some(frontier),
-                    joint_name: joint.name.clone(),
-                    kind,
-                    origin: pose_to_iso(&joint.origin),
-                    axis,
-                    limits,
-                    source,
-                    collisions: collisions_of(link).map_err(&invalid)?,
-                    mass: link.inertial.mass.value,
-                });
-            }
+        while frontier < tree.links.len() {
+            tree.attach_children(frontier)?;
             frontier += 1;
         }
-        let tool = links
-            .iter()
-            .position(|l| l.name == tool_link)
-            .ok_or_else(|| invalid(format!("no link named {tool_link}")))?;
-        let mut chain = vec![tool];
-        while let Some(p) = links[*chain.last().unwrap_or(&0)].parent {
-            chain.push(p);
-        }
-        chain.reverse();
-        let arm_in_chain = chain
-            .iter()
-            .filter(|&&i| matches!(links[i].source, JointSource::Arm(_)))
-            .count();
-        if arm_in_chain != arm_limits.len() || arm_limits.is_empty() {
-            return Err(invalid(format!(
-                "the tool chain holds {arm_in_chain} of {} revolute joints",
-                arm_limits.len()
-            )));
-        }
-        Ok(RobotModel {
-            name: robot.name.clone(),
-            links,
-            arm_limits,
-            gripper_limits,
-            tool_link: tool,
-            chain,
-        })
+        tree.into_model(tool_link)
     }
 
     /// Number of arm degrees of freedom.
@@ -377,6 +248,191 @@ impl RobotModel {
         q.iter()
             .zip(&self.arm_limits)
             .all(|(v, &(lo, hi))| *v >= lo - 1e-9 && *v <= hi + 1e-9)
+    }
+}
+
+/// The tree as [`RobotModel::from_urdf_str`] grows it from the root, with the arm and
+/// gripper limits found so far.
+struct TreeBuilder<'a> {
+    /// The parsed URDF.
+    robot: &'a urdf_rs::Robot,
+    /// Links added so far, parents before children.
+    links: Vec<LinkModel>,
+    /// Limits of the revolute joints added so far, in dof order.
+    arm_limits: Vec<(f64, f64)>,
+    /// Limits of the driving finger, once found.
+    gripper_limits: Option<(f64, f64)>,
+    /// The unmimicked prismatic joint, which every other prismatic joint must mimic.
+    driving_finger: Option<String>,
+}
+
+impl<'a> TreeBuilder<'a> {
+    /// An error naming the robot.
+    fn invalid(&self, message: String) -> ModelError {
+        ModelError::Invalid {
+            robot: self.robot.name.clone(),
+            message,
+        }
+    }
+
+    /// A tree holding only the root: the one link that is nobody's child.
+    fn rooted(robot: &'a urdf_rs::Robot) -> Result<Self, ModelError> {
+        let mut tree = TreeBuilder {
+            robot,
+            links: Vec::new(),
+            arm_limits: Vec::new(),
+            gripper_limits: None,
+            driving_finger: None,
+        };
+        let children: std::collections::HashSet<&str> =
+            robot.joints.iter().map(|j| j.child.link.as_str()).collect();
+        let roots: Vec<&urdf_rs::Link> = robot
+            .links
+            .iter()
+            .filter(|l| !children.contains(l.name.as_str()))
+            .collect();
+        let [root] = roots.as_slice() else {
+            return Err(tree.invalid(format!("expected exactly one root link, found {}", roots.len())));
+        };
+        let collisions = collisions_of(root).map_err(|m| tree.invalid(m))?;
+        tree.links.push(LinkModel {
+            name: root.name.clone(),
+            parent: None,
+            joint_name: String::new(),
+            kind: JointKind::Fixed,
+            origin: Iso::identity(),
+            axis: Vector3::z(),
+            limits: (0.0, 0.0),
+            source: JointSource::None,
+            collisions,
+            mass: root.inertial.mass.value,
+        });
+        Ok(tree)
+    }
+
+    /// Appends the links hanging off link `parent`, in the file order of their joints.
+    fn attach_children(&mut self, parent: usize) -> Result<(), ModelError> {
+        let robot = self.robot;
+        let parent_name = self.links[parent].name.clone();
+        for joint in robot.joints.iter().filter(|j| j.parent.link == parent_name) {
+            let link = robot
+                .links
+                .iter()
+                .find(|l| l.name == joint.child.link)
+                .ok_or_else(|| {
+                    self.invalid(format!(
+                        "joint {} names missing link {}",
+                        joint.name, joint.child.link
+                    ))
+                })?;
+            let axis = Vector3::from(joint.axis.xyz.0);
+            let axis = if axis.norm() > 0.0 {
+                axis.normalize()
+            } else {
+                Vector3::z()
+            };
+            let limits = (joint.limit.lower, joint.limit.upper);
+            let (kind, source) = self.joint_drive(joint, limits)?;
+            let collisions = collisions_of(link).map_err(|m| self.invalid(m))?;
+            self.links.push(LinkModel {
+                name: link.name.clone(),
+                parent: Some(parent),
+                joint_name: joint.name.clone(),
+                kind,
+                origin: pose_to_iso(&joint.origin),
+                axis,
+                limits,
+                source,
+                collisions,
+                mass: link.inertial.mass.value,
+            });
+        }
+        Ok(())
+    }
+
+    /// The joint's kind and what drives it: a revolute joint becomes the next arm dof, a
+    /// prismatic one a finger.
+    fn joint_drive(
+        &mut self,
+        joint: &urdf_rs::Joint,
+        limits: (f64, f64),
+    ) -> Result<(JointKind, JointSource), ModelError> {
+        match joint.joint_type {
+            urdf_rs::JointType::Fixed => Ok((JointKind::Fixed, JointSource::None)),
+            urdf_rs::JointType::Revolute => {
+                self.arm_limits.push(limits);
+                Ok((JointKind::Revolute, JointSource::Arm(self.arm_limits.len() - 1)))
+            }
+            urdf_rs::JointType::Prismatic => Ok((JointKind::Prismatic, self.finger_source(joint, limits)?)),
+            ref other => Err(self.invalid(format!("joint {} has unsupported type {other:?}", joint.name))),
+        }
+    }
+
+    /// A prismatic joint's source: the first unmimicked one is the driving finger and sets
+    /// the gripper's limits; the others must mimic it.
+    fn finger_source(
+        &mut self,
+        joint: &urdf_rs::Joint,
+        limits: (f64, f64),
+    ) -> Result<JointSource, ModelError> {
+        match &joint.mimic {
+            Some(m) => {
+                if self.driving_finger.as_deref() != Some(m.joint.as_str()) {
+                    return Err(self.invalid(format!(
+                        "joint {} mimics {}, which is not the driving finger",
+                        joint.name, m.joint
+                    )));
+                }
+                Ok(JointSource::Gripper {
+                    multiplier: m.multiplier.unwrap_or(1.0),
+                    offset: m.offset.unwrap_or(0.0),
+                })
+            }
+            None => {
+                if self.driving_finger.is_some() {
+                    return Err(self.invalid("more than one unmimicked prismatic joint".into()));
+                }
+                self.driving_finger = Some(joint.name.clone());
+                self.gripper_limits = Some(limits);
+                Ok(JointSource::Gripper {
+                    multiplier: 1.0,
+                    offset: 0.0,
+                })
+            }
+        }
+    }
+
+    /// The finished model: finds the tool link and its chain from the root, which must
+    /// hold every arm dof.
+    fn into_model(self, tool_link: &str) -> Result<RobotModel, ModelError> {
+        let links = &self.links;
+        let tool = links
+            .iter()
+            .position(|l| l.name == tool_link)
+            .ok_or_else(|| self.invalid(format!("no link named {tool_link}")))?;
+        let mut chain = vec![tool];
+        while let Some(p) = links[*chain.last().unwrap_or(&0)].parent {
+            chain.push(p);
+        }
+        chain.reverse();
+        let arm_in_chain = chain
+            .iter()
+            .filter(|&&i| matches!(links[i].source, JointSource::Arm(_)))
+            .count();
+        if arm_in_chain != self.arm_limits.len() || self.arm_limits.is_empty() {
+            return Err(self.invalid(format!(
+                "the tool chain holds {arm_in_chain} of {} revolute joints",
+                self.arm_limits.len()
+            )));
+        }
+        Ok(RobotModel {
+            name: self.robot.name.clone(),
+            links: self.links,
+            arm_limits: self.arm_limits,
+            gripper_limits: self.gripper_limits,
+            tool_link: tool,
+            chain,
+        })
     }
 }
 

@@ -348,6 +348,19 @@ impl SceneSpec {
     /// fixed part names, articulation names and ranges, goal references. (Interpenetration
     /// needs geometry and is checked when the world is built.)
     pub fn validate(&self) -> Result<(), SceneError> {
+        self.validate_header()?;
+        let reserved = [parts::FLOOR, parts::GRIPPER, parts::VACUUM_GRIPPER];
+        let mut seen: HashSet<String> = reserved.iter().map(|s| s.to_string()).collect();
+        for (i, o) in self.objects.iter().enumerate() {
+            validate_object_names(i, o, &mut seen)?;
+            validate_object_numbers(i, o)?;
+        }
+        self.validate_articulations(&seen)?;
+        self.validate_goals(&seen, &reserved)
+    }
+
+    /// Checks the format version and the object count.
+    fn validate_header(&self) -> Result<(), SceneError> {
         if self.schema_version != SCENE_SCHEMA_VERSION {
             return Err(SceneError::invalid(
                 "schema_version",
@@ -362,82 +375,12 @@ impl SceneSpec {
                 format!("{} objects", self.objects.len()),
             ));
         }
-        let reserved = [parts::FLOOR, parts::GRIPPER, parts::VACUUM_GRIPPER];
-        let mut seen: HashSet<String> = reserved.iter().map(|s| s.to_string()).collect();
-        for (i, o) in self.objects.iter().enumerate() {
-            let at = |field: &str| format!("objects[{i}].{field}");
-            if o.name.is_empty() || o.name.chars().any(|c| !(c.is_ascii_alphanumeric() || c == '_')) {
-                return Err(SceneError::invalid(
-                    at("name"),
-                    "a non-empty name of [A-Za-z0-9_]",
-                    format!("{:?}", o.name),
-                ));
-            }
-            if let Some(required) = o.kind.required_name()
-                && o.name != required
-            {
-                return Err(SceneError::invalid(
-                    at("name"),
-                    format!("\"{required}\" (the parts of a {:?} have fixed names)", o.kind),
-                    format!("{:?}", o.name),
-                ));
-            }
-            for part in part_names(o) {
-                if !seen.insert(part.clone()) {
-                    return Err(SceneError::invalid(
-                        at("name"),
-                        "a name not used by another object",
-                        format!("duplicate {part:?}"),
-                    ));
-                }
-            }
-            for (k, v) in o.pose.position.iter().enumerate() {
-                let (lo, hi) = SCENE_POSITION_BOUNDS[k];
-                if !(v.is_finite() && (lo..=hi).contains(v)) {
-                    return Err(SceneError::invalid(
-                        at(&format!("pose.position[{k}]")),
-                        format!("a position in metres from {lo} to {hi} (the table and the space around it)"),
-                        v.to_string(),
-                    ));
-                }
-            }
-            if !o.pose.yaw.is_finite() {
-                return Err(SceneError::invalid(
-                    at("pose.yaw"),
-                    "a finite number",
-                    o.pose.yaw.to_string(),
-                ));
-            }
-            if let Some(size) = o.size {
-                if matches!(o.kind, ObjectKind::HingeBox | ObjectKind::DrawerCabinet) {
-                    return Err(SceneError::invalid(
-                        at("size"),
-                        "no size override (articulated assets have fixed geometry)",
-                        format!("{size:?}"),
-                    ));
-                }
-                for (k, v) in size.iter().enumerate() {
-                    if !(v.is_finite() && (MIN_OBJECT_SIZE..=2.0).contains(v)) {
-                        return Err(SceneError::invalid(
-                            at(&format!("size[{k}]")),
-                            format!("a size in metres from {MIN_OBJECT_SIZE} to 2"),
-                            v.to_string(),
-                        ));
-                    }
-                }
-            }
-            if let Some(ColourSpec::Rgb(c)) = o.colour {
-                for (k, v) in c.iter().enumerate() {
-                    if !(v.is_finite() && (0.0..=1.0).contains(v)) {
-                        return Err(SceneError::invalid(
-                            at(&format!("colour[{k}]")),
-                            "a value in 0..1",
-                            v.to_string(),
-                        ));
-                    }
-                }
-            }
-        }
+        Ok(())
+    }
+
+    /// Checks that each articulation names a known joint of a part in the scene (`seen`
+    /// holds every part name) and lies within that joint's limits.
+    fn validate_articulations(&self, seen: &HashSet<String>) -> Result<(), SceneError> {
         for (part, q) in &self.articulations {
             let at = format!("articulations.{part}");
             let Some((lo, hi)) = parts::Joint::from_name(part).map(parts::Joint::limits) else {
@@ -462,6 +405,12 @@ impl SceneSpec {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// Checks that every goal moves something and names only scene objects (`seen` holds
+    /// every part name, `reserved` the names no goal may use).
+    fn validate_goals(&self, seen: &HashSet<String>, reserved: &[&str]) -> Result<(), SceneError> {
         for (g, goal) in self.goals.iter().enumerate() {
             let (field, moved) = match goal {
                 SubtaskGoal::Sweep { placements } => ("placements", placements.len()),
@@ -489,6 +438,91 @@ impl SceneSpec {
         }
         Ok(())
     }
+}
+
+/// Checks object `i`'s name (its characters, the fixed name of an articulated kind) and
+/// records its part names in `seen`, rejecting any already taken.
+fn validate_object_names(i: usize, o: &ObjectSpec, seen: &mut HashSet<String>) -> Result<(), SceneError> {
+    let at = |field: &str| format!("objects[{i}].{field}");
+    if o.name.is_empty() || o.name.chars().any(|c| !(c.is_ascii_alphanumeric() || c == '_')) {
+        return Err(SceneError::invalid(
+            at("name"),
+            "a non-empty name of [A-Za-z0-9_]",
+            format!("{:?}", o.name),
+        ));
+    }
+    if let Some(required) = o.kind.required_name()
+        && o.name != required
+    {
+        return Err(SceneError::invalid(
+            at("name"),
+            format!("\"{required}\" (the parts of a {:?} have fixed names)", o.kind),
+            format!("{:?}", o.name),
+        ));
+    }
+    for part in part_names(o) {
+        if !seen.insert(part.clone()) {
+            return Err(SceneError::invalid(
+                at("name"),
+                "a name not used by another object",
+                format!("duplicate {part:?}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks object `i`'s numbers: position within the bounds, finite yaw, size override
+/// (only on kinds that allow one) and RGB colour.
+fn validate_object_numbers(i: usize, o: &ObjectSpec) -> Result<(), SceneError> {
+    let at = |field: &str| format!("objects[{i}].{field}");
+    for (k, v) in o.pose.position.iter().enumerate() {
+        let (lo, hi) = SCENE_POSITION_BOUNDS[k];
+        if !(v.is_finite() && (lo..=hi).contains(v)) {
+            return Err(SceneError::invalid(
+                at(&format!("pose.position[{k}]")),
+                format!("a position in metres from {lo} to {hi} (the table and the space around it)"),
+                v.to_string(),
+            ));
+        }
+    }
+    if !o.pose.yaw.is_finite() {
+        return Err(SceneError::invalid(
+            at("pose.yaw"),
+            "a finite number",
+            o.pose.yaw.to_string(),
+        ));
+    }
+    if let Some(size) = o.size {
+        if matches!(o.kind, ObjectKind::HingeBox | ObjectKind::DrawerCabinet) {
+            return Err(SceneError::invalid(
+                at("size"),
+                "no size override (articulated assets have fixed geometry)",
+                format!("{size:?}"),
+            ));
+        }
+        for (k, v) in size.iter().enumerate() {
+            if !(v.is_finite() && (MIN_OBJECT_SIZE..=2.0).contains(v)) {
+                return Err(SceneError::invalid(
+                    at(&format!("size[{k}]")),
+                    format!("a size in metres from {MIN_OBJECT_SIZE} to 2"),
+                    v.to_string(),
+                ));
+            }
+        }
+    }
+    if let Some(ColourSpec::Rgb(c)) = o.colour {
+        for (k, v) in c.iter().enumerate() {
+            if !(v.is_finite() && (0.0..=1.0).contains(v)) {
+                return Err(SceneError::invalid(
+                    at(&format!("colour[{k}]")),
+                    "a value in 0..1",
+                    v.to_string(),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Most objects a scene may hold (the benchmark's largest has 16, with 26 parts).
