@@ -180,8 +180,11 @@ fn check_configurations(
     Ok(())
 }
 
+/// The configuration and the HTTP transport every unit shares, for a live responder.
+type LiveTransport = (VlmConfig, Arc<dyn Transport>);
+
 /// The HTTP transport every unit shares, for a live responder.
-fn live_transport(responder: &ResponderSetup) -> Result<Option<(VlmConfig, Arc<dyn Transport>)>, BenchError> {
+fn live_transport(responder: &ResponderSetup) -> Result<Option<LiveTransport>, BenchError> {
     Ok(match responder {
         ResponderSetup::Live(overrides) => {
             let c = VlmConfig::resolve(overrides, &ProcessEnv)
