@@ -137,6 +137,80 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
     keep(record);
 
     // M2: ground and verify, up to the budget.
+    let looped = ground_and_verify(&stage, &mut keep, prompts, inputs, &description, &parsed).await?;
+    let (queue, rounds, verified) = (looped.queue, looped.rounds, looped.verified);
+
+    // M3: three visual sub-questions and their answers.
+    let prompt = prompts.render(
+        "morevqa.vqa_api",
+        &QueueVars {
+            event_queue: numbered(&queue),
+        },
+    )?;
+    let (questions, record) = stage(VQA_API, prompt, true, "Write three lines of the form vqa(\"…\").")
+        .ask(non_empty)
+        .await?;
+    keep(record);
+    let prompt = prompts.render("morevqa.vqa", &VqaVars { vqa: &questions })?;
+    let (answers, record) = stage(VQA, prompt, true, "Answer every question, one line each.")
+        .ask(non_empty)
+        .await?;
+    keep(record);
+
+    // The plan.
+    let prompt = prompts.render(
+        "morevqa.plan",
+        &PlanVars {
+            predicates: inputs.vocabulary.render_definitions(Tier::EndEffector),
+            target_object_state: state_lines(&inputs.target_state),
+            target_objects: bullets(inputs.target_objects.iter().cloned()),
+            vqa_answer: &answers,
+            event_queue: numbered(&queue),
+        },
+    )?;
+    let (steps, record) = stage(PLAN, prompt, true, NUMBERED_PLAN)
+        .ask(numbered_plan)
+        .await?;
+    keep(record);
+
+    let mut deviations = crate::Baseline::MoReVqa.deviations(inputs.fidelity);
+    deviations.push(format!(
+        "the verification loop ran {rounds} of its {} rounds{}",
+        inputs.budget,
+        if verified {
+            " and verified"
+        } else {
+            " without verifying"
+        }
+    ));
+    Ok(BaselinePlan {
+        steps,
+        stages,
+        deviations,
+        rounds: Some(rounds),
+        instruction: Some(parsed.question),
+    })
+}
+
+/// What the grounding and verification loop (M2) ends with: the event queue, the rounds it
+/// ran, and whether the last check verified the queue.
+struct Grounded {
+    queue: Vec<String>,
+    rounds: usize,
+    verified: bool,
+}
+
+/// M2: the event queue grounded in the target's objects and checked, until a check verifies
+/// it or the budget is spent; in repaired mode each round is told why the last check failed.
+async fn ground_and_verify<'a>(
+    stage: &impl Fn(&'static str, (String, String), bool, &'static str) -> Stage<'a>,
+    keep: &mut impl FnMut(StageRecord),
+    prompts: &BaselinePrompts,
+    inputs: &BaselineInputs,
+    description: &str,
+    parsed: &Parsed,
+) -> Result<Grounded, BaselineError> {
+    let tolerant = inputs.fidelity == Fidelity::Repaired;
     let mut queue = parsed.events.clone();
     let mut reason: Option<String> = None;
     let mut rounds = 0;
@@ -146,7 +220,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
         let (system, mut user) = prompts.render(
             "morevqa.ground",
             &GroundVars {
-                domain_description: &description,
+                domain_description: description,
                 target_objects: bullets(inputs.target_objects.iter().cloned()),
                 event_queue: numbered(&queue),
                 event_object: bullets(parsed.objects.iter().cloned()),
@@ -210,56 +284,10 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
         }
         reason = Some(why);
     }
-
-    // M3: three visual sub-questions and their answers.
-    let prompt = prompts.render(
-        "morevqa.vqa_api",
-        &QueueVars {
-            event_queue: numbered(&queue),
-        },
-    )?;
-    let (questions, record) = stage(VQA_API, prompt, true, "Write three lines of the form vqa(\"…\").")
-        .ask(non_empty)
-        .await?;
-    keep(record);
-    let prompt = prompts.render("morevqa.vqa", &VqaVars { vqa: &questions })?;
-    let (answers, record) = stage(VQA, prompt, true, "Answer every question, one line each.")
-        .ask(non_empty)
-        .await?;
-    keep(record);
-
-    // The plan.
-    let prompt = prompts.render(
-        "morevqa.plan",
-        &PlanVars {
-            predicates: inputs.vocabulary.render_definitions(Tier::EndEffector),
-            target_object_state: state_lines(&inputs.target_state),
-            target_objects: bullets(inputs.target_objects.iter().cloned()),
-            vqa_answer: &answers,
-            event_queue: numbered(&queue),
-        },
-    )?;
-    let (steps, record) = stage(PLAN, prompt, true, NUMBERED_PLAN)
-        .ask(numbered_plan)
-        .await?;
-    keep(record);
-
-    let mut deviations = crate::Baseline::MoReVqa.deviations(inputs.fidelity);
-    deviations.push(format!(
-        "the verification loop ran {rounds} of its {} rounds{}",
-        inputs.budget,
-        if verified {
-            " and verified"
-        } else {
-            " without verifying"
-        }
-    ));
-    Ok(BaselinePlan {
-        steps,
-        stages,
-        deviations,
-        rounds: Some(rounds),
-        instruction: Some(parsed.question),
+    Ok(Grounded {
+        queue,
+        rounds,
+        verified,
     })
 }
 
