@@ -4,7 +4,7 @@
 //!
 //! Running the same command again resumes: units with a final record are skipped, units
 //! whose last record is retryable (transport errors, interruptions) or that have none run
-//! again. Demos come from the [`DemoCache`]; each scenario's demo and target scene are
+//! again. Demos come from the [`DemoCache`](crate::demos::DemoCache); each scenario's demo and target scene are
 //! loaded once per process and shared by the variants that run on it.
 //!
 //! Concurrency: `jobs` units run at once; the CPU-bound stages (recording, building and
