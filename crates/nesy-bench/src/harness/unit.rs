@@ -21,7 +21,7 @@ use nesy_vlm::{CassetteFile, RunUsage};
 use nesy_vlm::{CassetteMode, CassetteOptions, CassetteTransport, Transport, VlmClient, VlmConfig};
 
 use crate::meter::{CallCounts, Metered};
-use crate::methods::{self, Method, MethodFailure, Specification, Specified, UnitInputs};
+use crate::methods::{self, FailureKind, Method, Specification, Specified, UnitInputs};
 use crate::status::UnitStatus;
 use crate::unit::Unit;
 use crate::unit_record::{Agreement, Effort, Scores, SpecSummary, SubtaskScore, UnitRecord};
@@ -259,16 +259,25 @@ pub(super) async fn make_code(
                     || inputs.setting.source_embodiment != inputs.setting.target_embodiment,
             };
             let source = reasoner.generate_code(&request).await.map_err(|e| {
-                let failure = MethodFailure::from_reasoner(e.reasoner_kind(), e.to_string());
-                let status = if failure.status == UnitStatus::MethodError {
-                    UnitStatus::CodegenFailed
-                } else {
-                    failure.status
+                let status = match FailureKind::of_reasoner(e.reasoner_kind()) {
+                    // No usable program is the code tail's failure, not the method's.
+                    FailureKind::Method => UnitStatus::CodegenFailed,
+                    kind => status_of(kind),
                 };
-                (status, failure.message)
+                (status, e.to_string())
             })?;
             Ok((source.code, started.elapsed().as_secs_f64(), 0.0))
         }
+    }
+}
+
+/// The unit status a method's failure of `kind` gives its unit.
+fn status_of(kind: FailureKind) -> UnitStatus {
+    match kind {
+        FailureKind::Unresolved => UnitStatus::Unresolved,
+        FailureKind::Method => UnitStatus::MethodError,
+        FailureKind::Refused => UnitStatus::RequestRefused,
+        FailureKind::Transport => UnitStatus::TransportError,
     }
 }
 
@@ -276,8 +285,7 @@ pub(super) fn synth_status(e: &SynthError) -> (UnitStatus, String) {
     match e {
         SynthError::NoProgram { message, .. } => (UnitStatus::CodegenFailed, message.clone()),
         SynthError::Call { message, failure } => {
-            let f = MethodFailure::from_reasoner(*failure, message.clone());
-            (f.status, f.message)
+            (status_of(FailureKind::of_reasoner(*failure)), message.clone())
         }
     }
 }
@@ -536,7 +544,7 @@ pub(super) async fn specify_and_code(
                 iterations: Some(iterations),
                 budget: Some(budget),
             });
-            return Err((f.status, f.message, summary));
+            return Err((status_of(f.kind), f.message, summary));
         }
     };
     let summary = SpecSummary {

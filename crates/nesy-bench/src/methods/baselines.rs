@@ -18,11 +18,10 @@ use nesy_sim::demo::CameraName;
 use nesy_vlm::{Image, VlmClient};
 
 use super::{
-    Classes, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified, UnitInputs,
-    check_keys,
+    Classes, FailureKind, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified,
+    UnitInputs, check_keys,
 };
 use crate::error::BenchError;
-use crate::status::UnitStatus;
 use crate::variant::Variant;
 
 /// A baseline as a harness method.
@@ -149,7 +148,7 @@ impl Method for BaselineMethod {
     ) -> BoxFuture<'a, Result<Specified, MethodFailure>> {
         async move {
             let fidelity = BaselineMethod::fidelity(&inputs.variant)
-                .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?;
+                .map_err(|e| MethodFailure::new(FailureKind::Method, e.to_string()))?;
             let baseline_inputs = baseline_inputs(inputs, fidelity)?;
             let started = Instant::now();
             let plan = self
@@ -196,7 +195,7 @@ fn specified(plan: BaselinePlan, budget: usize, vlm_s: f64) -> Specified {
 /// The unit's failure for a baseline error; an unreadable reply is kept in the message.
 fn baseline_failure(error: BaselineError) -> MethodFailure {
     if error.is_unresolved() {
-        return MethodFailure::new(UnitStatus::Unresolved, error.to_string());
+        return MethodFailure::new(FailureKind::Unresolved, error.to_string());
     }
     let mut message = error.to_string();
     if let Some(reply) = error.reply() {
@@ -209,7 +208,7 @@ fn baseline_failure(error: BaselineError) -> MethodFailure {
 /// What the baselines see of a unit: the demonstration's ground-truth states and six views
 /// per keyframe, and the target's.
 fn baseline_inputs(inputs: &UnitInputs, fidelity: Fidelity) -> Result<BaselineInputs, MethodFailure> {
-    let fail = |message: String| MethodFailure::new(UnitStatus::MethodError, message);
+    let fail = |message: String| MethodFailure::new(FailureKind::Method, message);
     let demo = &inputs.demo.demo;
     let mut keyframes = Vec::with_capacity(demo.keyframes.len());
     for k in &demo.keyframes {

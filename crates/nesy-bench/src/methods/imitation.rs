@@ -16,11 +16,10 @@ use nesy_reasoner::VlmReasoner;
 use nesy_vlm::VlmClient;
 
 use super::{
-    Classes, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified, UnitInputs,
-    check_keys,
+    Classes, FailureKind, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified,
+    UnitInputs, check_keys,
 };
 use crate::error::BenchError;
-use crate::status::UnitStatus;
 use crate::variant::Variant;
 
 /// The imitation control.
@@ -31,7 +30,7 @@ pub struct Imitation;
 /// induction from `demo`'s recorded calls, used by the controls.
 pub(crate) fn ground_truth_client(demo: &DemoInput) -> Result<VlmClient, MethodFailure> {
     let transport = vlm::oracle_transport("", 0, demo.recorded_calls())
-        .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?;
+        .map_err(|e| MethodFailure::new(FailureKind::Method, e.to_string()))?;
     Ok(VlmClient::with_transport(&vlm::oracle_config(), transport))
 }
 
@@ -67,7 +66,7 @@ impl Method for Imitation {
             let client = ground_truth_client(&inputs.demo)?;
             let setting = &inputs.setting;
             let mut reasoner = VlmReasoner::new(client)
-                .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?
+                .map_err(|e| MethodFailure::new(FailureKind::Method, e.to_string()))?
                 .with_keyframes(inputs.keyframes.clone())
                 .with_embodiments(setting.source_embodiment, setting.target_embodiment);
             let vocabulary = Vocabulary::new();
@@ -81,7 +80,7 @@ impl Method for Imitation {
                 &NoProgress,
             )
             .await
-            .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?;
+            .map_err(|e| MethodFailure::new(FailureKind::Method, e.to_string()))?;
             let (demonstration, target) =
                 adaptation_inputs(&inputs.demo, &inputs.target, setting, &states, &vocabulary);
             let started = std::time::Instant::now();
@@ -89,7 +88,7 @@ impl Method for Imitation {
             let world =
                 construct_world_model(&mut reasoner, &demonstration, &AdaptConfig::default(), &mut trace)
                     .await
-                    .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?;
+                    .map_err(|e| MethodFailure::new(FailureKind::Method, e.to_string()))?;
             // Whether the demonstrated procedure happens to hold in the target, as a note.
             let report = verify_procedure(&target.init, &world.procedure, Some(&world.goal));
             let holds = identify(&report, &world.procedure).is_none();

@@ -25,7 +25,6 @@ use nesy_vlm::VlmClient;
 use serde::Serialize;
 
 use crate::error::BenchError;
-use crate::status::UnitStatus;
 use crate::variant::Variant;
 
 pub use baselines::BaselineMethod;
@@ -174,11 +173,39 @@ pub struct Specified {
     pub notes: Vec<String>,
 }
 
+/// What kind of failure kept a method from a specification. The harness turns it into the
+/// unit's status; the methods know nothing of how units are recorded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FailureKind {
+    /// The adaptation (or the plan search) ran out without a verified specification.
+    Unresolved,
+    /// The method could not produce one: a reply it cannot read, a parse or planner failure
+    /// that ends it, a defect of its own request.
+    Method,
+    /// The endpoint refused a request as built.
+    Refused,
+    /// A model call did not complete (network, rate limit, server error, a missing
+    /// recording).
+    Transport,
+}
+
+impl FailureKind {
+    /// The kind of a reasoner failure of `kind`.
+    pub fn of_reasoner(kind: nesy_core::adapt::ReasonerErrorKind) -> FailureKind {
+        use nesy_core::adapt::ReasonerErrorKind as K;
+        match kind {
+            K::Transport | K::Replay => FailureKind::Transport,
+            K::Refused => FailureKind::Refused,
+            K::Reply | K::Request | K::Exhausted => FailureKind::Method,
+        }
+    }
+}
+
 /// Why a method produced no specification.
 #[derive(Debug, Clone)]
 pub struct MethodFailure {
-    /// The unit's status.
-    pub status: UnitStatus,
+    /// What kind of failure it is.
+    pub kind: FailureKind,
     /// What happened.
     pub message: String,
     /// The adaptation trace, when there is one (an unresolved NeSyCR run).
@@ -188,25 +215,19 @@ pub struct MethodFailure {
 }
 
 impl MethodFailure {
-    /// A failure with a status and a message.
-    pub fn new(status: UnitStatus, message: impl Into<String>) -> MethodFailure {
+    /// A failure of a kind, with a message.
+    pub fn new(kind: FailureKind, message: impl Into<String>) -> MethodFailure {
         MethodFailure {
-            status,
+            kind,
             message: message.into(),
             adaptation: None,
             iterations: None,
         }
     }
 
-    /// The status a reasoner failure of `kind` gives the unit.
+    /// The failure a reasoner failure of `kind` is.
     pub fn from_reasoner(kind: nesy_core::adapt::ReasonerErrorKind, message: String) -> MethodFailure {
-        use nesy_core::adapt::ReasonerErrorKind as K;
-        let status = match kind {
-            K::Transport | K::Replay => UnitStatus::TransportError,
-            K::Refused => UnitStatus::RequestRefused,
-            K::Reply | K::Request | K::Exhausted => UnitStatus::MethodError,
-        };
-        MethodFailure::new(status, message)
+        MethodFailure::new(FailureKind::of_reasoner(kind), message)
     }
 }
 

@@ -15,11 +15,10 @@ use nesy_reasoner::VlmReasoner;
 use nesy_vlm::VlmClient;
 
 use super::{
-    Classes, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified, UnitInputs,
-    check_keys, switch,
+    Classes, FailureKind, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified,
+    UnitInputs, check_keys, switch,
 };
 use crate::error::BenchError;
-use crate::status::UnitStatus;
 use crate::variant::Variant;
 
 /// What an unresolved adaptation turns into.
@@ -177,7 +176,7 @@ impl NeSyCr {
 fn pipeline_failure(e: PipelineError) -> MethodFailure {
     match e.reasoner_kind() {
         Some(kind) => MethodFailure::from_reasoner(kind, e.to_string()),
-        None => MethodFailure::new(UnitStatus::MethodError, e.to_string()),
+        None => MethodFailure::new(FailureKind::Method, e.to_string()),
     }
 }
 
@@ -220,12 +219,10 @@ impl Method for NeSyCr {
         async move {
             let settings = self
                 .settings(&inputs.variant)
-                .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?;
+                .map_err(|e| MethodFailure::new(FailureKind::Method, e.to_string()))?;
             let setting = &inputs.setting;
             let reasoner = VlmReasoner::new(client.clone())
-                .map_err(|e| {
-                    MethodFailure::new(UnitStatus::MethodError, format!("loading nesy's prompts: {e}"))
-                })?
+                .map_err(|e| MethodFailure::new(FailureKind::Method, format!("loading nesy's prompts: {e}")))?
                 .with_keyframes(inputs.keyframes.clone())
                 .with_embodiments(setting.source_embodiment, setting.target_embodiment);
             let vocabulary = Vocabulary::new();
@@ -276,7 +273,7 @@ impl Method for NeSyCr {
                 } => match settings.on_unresolved {
                     OnUnresolved::Fail => {
                         return Err(MethodFailure {
-                            status: UnitStatus::Unresolved,
+                            kind: FailureKind::Unresolved,
                             message: format!(
                                 "no verified procedure within the budget of {budget} refinement round(s)"
                             ),

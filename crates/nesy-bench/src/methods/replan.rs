@@ -14,11 +14,10 @@ use nesy_sim::domain::{WorldDomain, plan_to_goal};
 use nesy_vlm::VlmClient;
 
 use super::{
-    Classes, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified, UnitInputs,
-    check_keys,
+    Classes, FailureKind, Method, MethodFailure, MethodInfo, OfflineMeaning, Role, Specification, Specified,
+    UnitInputs, check_keys,
 };
 use crate::error::BenchError;
-use crate::status::UnitStatus;
 use crate::variant::Variant;
 
 /// The replanning control.
@@ -79,8 +78,8 @@ impl Method for Replan {
         _client: &'a VlmClient,
     ) -> BoxFuture<'a, Result<Specified, MethodFailure>> {
         async move {
-            let world = WorldDomain::builtin()
-                .map_err(|e| MethodFailure::new(UnitStatus::MethodError, e.to_string()))?;
+            let world =
+                WorldDomain::builtin().map_err(|e| MethodFailure::new(FailureKind::Method, e.to_string()))?;
             let goal = target_goal(inputs);
             let objects: Vec<Symbol> = inputs.target.objects.iter().map(|o| Symbol::new(o)).collect();
             let started = std::time::Instant::now();
@@ -92,7 +91,7 @@ impl Method for Replan {
                 &objects,
                 &planner_config(),
             )
-            .map_err(|e| MethodFailure::new(UnitStatus::Unresolved, format!("no plan: {e}")))?;
+            .map_err(|e| MethodFailure::new(FailureKind::Unresolved, format!("no plan: {e}")))?;
             let symbolic = started.elapsed().as_secs_f64();
             Ok(Specified {
                 spec: Specification::Procedure {
