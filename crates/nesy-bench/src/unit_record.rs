@@ -7,6 +7,8 @@ use nesy_core::benchmark::{Complexity, Factor};
 use nesy_core::metrics::{EpisodeResult, SubtaskResult};
 use serde::{Deserialize, Serialize};
 
+use nesy_pipeline::TimeBreakdown;
+
 use crate::status::UnitStatus;
 use crate::unit::UnitKey;
 
@@ -106,18 +108,10 @@ pub struct Effort {
     pub tokens: u64,
     /// Cost in US dollars at the configured price table (0 offline).
     pub cost_usd: f64,
-    /// Seconds in model calls.
-    pub vlm_s: f64,
-    /// Seconds of symbolic work (verification, identification, patching, planning).
-    pub symbolic_s: f64,
-    /// The part of `symbolic_s` building the world model.
-    pub symbolic_world_model_s: f64,
-    /// Seconds in the template compiler.
-    pub codegen_template_s: f64,
-    /// Seconds in the simulator (target scene and execution).
-    pub sim_s: f64,
-    /// Wall seconds of the whole unit.
-    pub wall_s: f64,
+    /// Where the unit's time went: the pipeline's own breakdown (model, symbolic, template
+    /// compiler, simulator, demo loading), with the unit's wall time as `total_s`.
+    #[serde(flatten)]
+    pub time: TimeBreakdown,
 }
 
 /// One finished unit.

@@ -9,12 +9,14 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use nesy_core::adapt::{InductionRequest, PatchRequest, Reasoner, ReasonerError};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::progress::Progress;
 
-/// Seconds spent per kind of work in one run.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+/// Seconds spent per kind of work in one run: one `nesy adapt` run, or one benchmark unit
+/// (whose rows carry it). A field a run did not measure is 0.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct TimeBreakdown {
     /// Reading the demo.
     pub load_s: f64,
@@ -37,7 +39,8 @@ pub struct TimeBreakdown {
     /// Wall time of `nesy_core::adapt::run`: its VLM and symbolic parts plus progress
     /// reporting.
     pub adapt_wall_s: f64,
-    /// The whole run.
+    /// The whole run (a benchmark unit's wall time, once recorded as `wall_s`).
+    #[serde(alias = "wall_s")]
     pub total_s: f64,
 }
 

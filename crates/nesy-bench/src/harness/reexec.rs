@@ -39,9 +39,9 @@ pub(super) fn reexecuted(source: &Path, unit: &Unit) -> Result<(String, PhaseA),
                 PhaseA {
                     spec: old.spec.clone(),
                     states: old.states,
-                    vlm_s: old.effort.vlm_s,
-                    symbolic_s: (old.effort.symbolic_s, old.effort.symbolic_world_model_s),
-                    template_s: old.effort.codegen_template_s,
+                    vlm_s: old.effort.time.vlm_s,
+                    symbolic_s: (old.effort.time.symbolic_s, old.effort.time.symbolic_world_model_s),
+                    template_s: old.effort.time.codegen_template_s,
                 },
             ))
         }

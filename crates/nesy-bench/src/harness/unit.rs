@@ -328,41 +328,42 @@ pub(super) async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
             } else {
                 status
             };
-            effort.wall_s = started.elapsed().as_secs_f64();
+            effort.time.total_s = started.elapsed().as_secs_f64();
             let mut r = failed_record(shared, unit, status, message, effort);
             r.spec = summary;
             return r;
         }
     };
-    effort.vlm_s = record_base.vlm_s;
-    effort.symbolic_s = record_base.symbolic_s.0;
-    effort.symbolic_world_model_s = record_base.symbolic_s.1;
-    effort.codegen_template_s = record_base.template_s;
+    effort.time.vlm_s = record_base.vlm_s;
+    effort.time.symbolic_s = record_base.symbolic_s.0;
+    effort.time.symbolic_world_model_s = record_base.symbolic_s.1;
+    effort.time.symbolic_adaptation_s = (record_base.symbolic_s.0 - record_base.symbolic_s.1).max(0.0);
+    effort.time.codegen_template_s = record_base.template_s;
 
     // Phase B: execution in the sandboxed simulator.
     let executed = execute_code(shared, &inputs, &dir, code).await;
-    effort.sim_s = inputs.target.sim_time.as_secs_f64();
+    effort.time.sim_s = inputs.target.sim_time.as_secs_f64();
     let report = match executed {
         Ok(r) => r,
         Err(e) => {
-            effort.wall_s = started.elapsed().as_secs_f64();
+            effort.time.total_s = started.elapsed().as_secs_f64();
             let mut r = failed_record(shared, unit, UnitStatus::ExecutionFailed, e, effort);
             r.spec = record_base.spec.take();
             return r;
         }
     };
-    effort.sim_s += report.result.wall_time_s;
+    effort.time.sim_s += report.result.wall_time_s;
     if let Err(e) = dir.write_json(output::EXECUTION_FILE, &report) {
         // The episode's evidence could not be kept: the unit runs again on resume rather
         // than be scored without it.
-        effort.wall_s = started.elapsed().as_secs_f64();
+        effort.time.total_s = started.elapsed().as_secs_f64();
         let message =
             format!("the execution record could not be written ({e}); the unit runs again on resume");
         return failed_record(shared, unit, UnitStatus::Interrupted, message, effort);
     }
     let scores = scores_of(&report, unit);
     let (status, error) = execution_verdict(&report);
-    effort.wall_s = started.elapsed().as_secs_f64();
+    effort.time.total_s = started.elapsed().as_secs_f64();
     let mut r = base_record(shared, unit, status, error, scores, effort);
     r.spec = record_base.spec.take();
     r.states = record_base.states;

@@ -84,10 +84,10 @@ pub(super) fn units_csv(records: &[&UnitRecord]) -> String {
             s.latched_gc,
             e.calls,
             e.images,
-            e.vlm_s,
-            e.symbolic_s,
-            e.sim_s,
-            e.wall_s,
+            e.time.vlm_s,
+            e.time.symbolic_s,
+            e.time.sim_s,
+            e.time.total_s,
             csv_field(r.error.as_deref().unwrap_or(""))
         );
     }

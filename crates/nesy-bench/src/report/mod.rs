@@ -74,8 +74,8 @@ impl Aggregate {
         if s.sr == 1.0 {
             self.pd_success.push(s.pd);
         }
-        self.vlm_s.push(r.effort.vlm_s);
-        self.symbolic_s.push(r.effort.symbolic_s);
+        self.vlm_s.push(r.effort.time.vlm_s);
+        self.symbolic_s.push(r.effort.time.symbolic_s);
         self.calls.push(r.effort.calls as f64);
     }
 

@@ -422,7 +422,7 @@ fn line(r: &UnitRecord) -> String {
         s.pd,
         r.effort.calls,
         r.effort.cost_usd,
-        r.effort.wall_s
+        r.effort.time.total_s
     );
     if let Some(e) = &r.error {
         text.push_str(" — ");
