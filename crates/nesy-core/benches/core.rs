@@ -60,7 +60,7 @@ fn bench(c: &mut Criterion) {
 
     // A high-complexity scene of the benchmark over nesy's world domain, with and without
     // preferred operators (the peer: one open list).
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let root = nesy_testkit::workspace_root();
     let world = nesy_core::pddl::parse_domain(
         &std::fs::read_to_string(root.join("assets/pddl/nesy-world.pddl")).unwrap(),
     )

@@ -331,7 +331,7 @@ mod tests {
     use nesy_core::Atom;
 
     fn fixture() -> Demo {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/demos/adapt-realstyle");
+        let dir = nesy_testkit::workspace_root().join("fixtures/demos/adapt-realstyle");
         DemoInput::load(&dir).expect("the fixture is a valid demo").demo
     }
 

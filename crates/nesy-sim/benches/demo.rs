@@ -4,7 +4,7 @@
 
 use std::hint::black_box;
 use std::io::Cursor;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nesy_sim::demo::mcap_format;
@@ -24,8 +24,7 @@ fn benches(c: &mut Criterion) {
             black_box(objects)
         })
     });
-    let path =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/demos/composite_medium/demo.mcap");
+    let path = nesy_testkit::workspace_root().join("fixtures/demos/composite_medium/demo.mcap");
     let bytes = std::fs::read(&path).unwrap();
     let demo = mcap_format::read_mcap_bytes(&bytes, Path::new("demo.mcap")).unwrap();
     group.bench_function("read_mcap_composite_medium", |b| {

@@ -2,7 +2,6 @@
 //! three 384² views, and the observer on a 26-part scene.
 
 use std::hint::black_box;
-use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nesy_sim::api::{Direction, RobotApi};
@@ -12,8 +11,8 @@ use nesy_sim::scene::SceneSpec;
 use nesy_sim::world::Sim;
 
 fn scene(name: &str) -> SceneSpec {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/scenes")
+    let path = nesy_testkit::workspace_root()
+        .join("fixtures/scenes")
         .join(format!("{name}.json"));
     SceneSpec::from_file(&path).unwrap()
 }

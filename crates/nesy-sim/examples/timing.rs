@@ -2,7 +2,6 @@
 //! work (CPU time is what one uncontended core would take):
 //! `cargo run --release -p nesy-sim --example timing`.
 
-use std::path::PathBuf;
 use std::time::Instant;
 
 use nesy_sim::api::{Direction, RobotApi};
@@ -22,8 +21,8 @@ fn cpu_seconds() -> f64 {
 }
 
 fn scene(name: &str) -> SceneSpec {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/scenes")
+    let path = nesy_testkit::workspace_root()
+        .join("fixtures/scenes")
         .join(format!("{name}.json"));
     SceneSpec::from_file(&path).expect("fixture scene")
 }

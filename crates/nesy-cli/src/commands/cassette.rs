@@ -204,7 +204,7 @@ mod tests {
     use super::*;
 
     fn smoke() -> PathBuf {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/cassettes/vlm-smoke.json")
+        nesy_testkit::workspace_root().join("fixtures/cassettes/vlm-smoke.json")
     }
 
     #[test]

@@ -69,9 +69,7 @@ mod tests {
     use super::*;
 
     fn fixture(name: &str) -> PathBuf {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("../../fixtures/scenes")
-            .join(name)
+        nesy_testkit::workspace_root().join("fixtures/scenes").join(name)
     }
 
     #[test]

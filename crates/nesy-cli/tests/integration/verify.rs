@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn fixtures() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/pddl")
+    nesy_testkit::workspace_root().join("fixtures/pddl")
 }
 
 fn nesy(args: &[&str]) -> Output {

@@ -8,7 +8,7 @@
 #![allow(dead_code)]
 
 use std::collections::VecDeque;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use nesy_core::State;
@@ -129,7 +129,7 @@ impl Reasoner for ScriptedReasoner {
 pub(super) fn corpus_dir() -> PathBuf {
     match std::env::var_os("NESY_ADAPT_CORPUS") {
         Some(dir) => PathBuf::from(dir),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/adapt_corpus"),
+        None => nesy_testkit::workspace_root().join("tests/adapt_corpus"),
     }
 }
 

@@ -1,7 +1,7 @@
 //! The model-response corpus under `fixtures/responses/`: every file parses to its expected
 //! value or fails with its expected typed error (see `expected.json` there).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use nesy_core::text::{ParseError, ParseErrorKind};
 use nesy_core::text::{parse_induction_reply, parse_procedure, parse_refinement_reply, parse_state_list};
@@ -9,7 +9,7 @@ use nesy_core::{PatchError, apply_patch};
 use serde_json::Value;
 
 fn dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/responses")
+    nesy_testkit::workspace_root().join("fixtures/responses")
 }
 
 fn strings(v: &Value) -> Vec<String> {

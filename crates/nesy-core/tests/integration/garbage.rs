@@ -12,7 +12,7 @@ use nesy_core::text::{
 use proptest::prelude::*;
 
 fn fixture(path: &str) -> String {
-    std::fs::read_to_string(format!("{}/../../fixtures/{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()
+    std::fs::read_to_string(nesy_testkit::workspace_root().join("fixtures").join(path)).unwrap()
 }
 
 fn check_position(text: &str, e: &ParseError) {
@@ -55,9 +55,7 @@ fn every_prefix_of_real_inputs() {
         fixture("pddl/blocksworld/sussman.valid.plan"),
         fixture("responses/procedure-hinge.txt"),
     ];
-    for entry in
-        std::fs::read_dir(format!("{}/../../fixtures/responses", env!("CARGO_MANIFEST_DIR"))).unwrap()
-    {
+    for entry in std::fs::read_dir(nesy_testkit::workspace_root().join("fixtures/responses")).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "txt") {
             inputs.push(std::fs::read_to_string(path).unwrap());

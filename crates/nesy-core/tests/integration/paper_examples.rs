@@ -12,10 +12,9 @@ fn atom(s: &str) -> Atom {
 /// is closed; the violated precondition is `(not (Closed hinge_lid))`.
 #[test]
 fn orange_hinge_lid_identification() {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../fixtures/responses/procedure-hinge.txt"
-    ))
+    let text = std::fs::read_to_string(
+        nesy_testkit::workspace_root().join("fixtures/responses/procedure-hinge.txt"),
+    )
     .unwrap();
     let procedure = parse_procedure(&text).unwrap();
     let counterfactual = parse_state_list(

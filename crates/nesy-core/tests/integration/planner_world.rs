@@ -5,14 +5,14 @@
 //! preferred operators the same searches expand tens of thousands of states on the
 //! plateaus that closed lids and drawers make.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use nesy_core::pddl::{parse_domain, parse_problem};
 use nesy_core::planner::{PlannerConfig, plan};
 use nesy_core::verify_procedure_in;
 
 fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    nesy_testkit::workspace_root()
 }
 
 #[test]

@@ -10,7 +10,7 @@ use std::process::Command;
 
 /// The workspace root, where the scripts live.
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+    nesy_testkit::workspace_root()
 }
 
 /// The interpreter the build embeds: `PYO3_PYTHON` (which `.cargo/config.toml` points at

@@ -8,7 +8,7 @@ use nesy_core::Embodiment;
 use nesy_policy::{EpisodeFactory, EpisodeSpec, Limits, Outcome, SimEpisodes, run_in_process};
 
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+    nesy_testkit::workspace_root()
 }
 
 fn run_example(policy: &str, scene: &str, embodiment: Embodiment, expected: &[&str]) {

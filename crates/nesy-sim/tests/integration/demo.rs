@@ -452,7 +452,7 @@ const FIXTURE_IMAGE_SIZE: u32 = 256;
 #[test]
 #[ignore = "rewrites fixtures/demos (about a minute)"]
 fn record_fixture_demos() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/demos");
+    let root = nesy_testkit::workspace_root().join("fixtures/demos");
     for (name, source, target) in fixture_tasks() {
         let source_scene = source.generate().unwrap().scene;
         let target_scene = target.generate().unwrap().scene;
@@ -487,7 +487,7 @@ fn record_fixture_demos() {
 /// The committed fixture demos read, carry their target scene, and match their tasks.
 #[test]
 fn fixture_demos_read_and_match_their_tasks() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/demos");
+    let root = nesy_testkit::workspace_root().join("fixtures/demos");
     for (name, source, target) in fixture_tasks() {
         let dir = root.join(name);
         let demo = nesy_sim::demo::read(&dir).unwrap_or_else(|e| panic!("{name}: {e}"));

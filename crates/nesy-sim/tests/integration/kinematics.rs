@@ -34,8 +34,7 @@ fn fk_matches_published_check_poses() {
 
 #[test]
 fn fk_matches_dh_reference_on_50_configurations() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/fk/panda_flange_reference.json");
+    let path = nesy_testkit::workspace_root().join("fixtures/fk/panda_flange_reference.json");
     let text = std::fs::read_to_string(path).unwrap();
     let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
     let samples = doc["samples"].as_array().unwrap();

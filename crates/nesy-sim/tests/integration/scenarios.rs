@@ -10,7 +10,7 @@ use nesy_core::benchmark::{Complexity, Factor};
 use nesy_sim::tasks::scenario::{self, CountTable, Side};
 
 fn repo(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(path)
+    nesy_testkit::workspace_root().join(path)
 }
 
 fn updating() -> bool {

@@ -3,7 +3,7 @@
 
 #[test]
 fn committed_scene_schema_is_current() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/schema/scene.schema.json");
+    let path = nesy_testkit::workspace_root().join("assets/schema/scene.schema.json");
     let generated = nesy_sim::scene::json_schema();
     if std::env::var_os("NESY_UPDATE_SCHEMA").is_some() {
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
@@ -19,7 +19,7 @@ fn committed_scene_schema_is_current() {
 
 #[test]
 fn fixture_scenes_round_trip_through_the_types() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenes");
+    let dir = nesy_testkit::workspace_root().join("fixtures/scenes");
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
         let spec = nesy_sim::scene::SceneSpec::from_file(&path).unwrap();

@@ -441,7 +441,7 @@ fn opening_modes_that_record_without_a_live_transport_fails_clearly() {
 /// success body. None of them may be opened, block or pass.
 #[test]
 fn verify_refuses_paths_pipes_credentials_and_empty_successes() {
-    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/cassettes");
+    let fixtures = nesy_testkit::workspace_root().join("fixtures/cassettes");
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("hostile.json");
     let mut file: serde_json::Value =

@@ -11,7 +11,7 @@ use nesy_sim::scene::SceneSpec;
 
 /// The workspace root.
 pub(crate) fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    nesy_testkit::workspace_root()
 }
 
 /// A scratch directory; kept under `$NESY_TEST_KEEP/<random>` when that variable is set

@@ -8,8 +8,8 @@ use nesy_sim::world::Sim;
 
 /// Path of a scene fixture.
 pub(crate) fn scene_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/scenes")
+    nesy_testkit::workspace_root()
+        .join("fixtures/scenes")
         .join(format!("{name}.json"))
 }
 
