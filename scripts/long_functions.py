@@ -6,6 +6,8 @@ closes its body (strings, characters and comments are skipped when braces are co
 `#[cfg(test)]` modules are left out.
 
     scripts/long_functions.py [--top N] [--over LINES]
+
+Test functions in files of their own (a `tests.rs` module) are counted too; read them out.
 """
 import argparse
 import re
