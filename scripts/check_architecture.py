@@ -16,6 +16,7 @@ Exit status 1 with one line per broken rule, naming the crate, the rule and what
 
     scripts/check_architecture.py
 """
+import functools
 import re
 import subprocess
 import sys
@@ -83,8 +84,10 @@ def cargo(*args):
     return out.stdout
 
 
+@functools.lru_cache(maxsize=None)
 def linked(crate):
-    """Every package `crate` links in a normal build (itself included)."""
+    """Every package `crate` links in a normal build (itself included); asked of cargo once per
+    crate, since several rules read the same crate's graph."""
     text = cargo("tree", "-p", crate, "-e", "normal", "--prefix", "none", "--format", "{p}")
     names = set()
     for line in text.splitlines():
