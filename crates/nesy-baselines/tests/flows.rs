@@ -2,8 +2,7 @@
 //! stage is called with the inputs the authors give it, the plan comes out of the last
 //! reply, and a reply without its answer is a typed failure (authors) or re-asked (repaired).
 
-use std::collections::{BTreeMap, VecDeque};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use nesy_baselines::{
     BaselineError, BaselineInputs, Fidelity, Keyframe, SixViews, critic, demo2code, gpt4v, llmdm, morevqa,
@@ -12,80 +11,9 @@ use nesy_baselines::{
 use nesy_core::State;
 use nesy_core::Vocabulary;
 use nesy_reasoner::Views;
-use nesy_vlm::{
-    BackendKind, BoxFuture, Image, Origin, Transport, TransportError, VlmClient, VlmConfig, VlmError,
-    WireRequest, WireResponse,
-};
-use serde_json::{Value, json};
-
-/// The prefix that makes [`Scripted`] answer with `finish_reason: length`.
-const TRUNCATED: &str = "<length>";
-
-/// Answers each purpose from its own queue and keeps every request.
-#[derive(Debug, Default)]
-struct Scripted {
-    replies: Mutex<BTreeMap<String, VecDeque<String>>>,
-    seen: Mutex<Vec<WireRequest>>,
-}
-
-impl Scripted {
-    fn with(replies: &[(&str, &[&str])]) -> Arc<Self> {
-        Arc::new(Scripted {
-            replies: Mutex::new(
-                replies
-                    .iter()
-                    .map(|(p, texts)| (p.to_string(), texts.iter().map(|t| t.to_string()).collect()))
-                    .collect(),
-            ),
-            seen: Mutex::default(),
-        })
-    }
-
-    fn requests(&self, purpose: &str) -> Vec<WireRequest> {
-        let seen = self.seen.lock().unwrap();
-        seen.iter()
-            .filter(|r| r.purpose.as_deref() == Some(purpose))
-            .cloned()
-            .collect()
-    }
-}
-
-impl Transport for Scripted {
-    fn send<'a>(&'a self, request: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
-        Box::pin(async move {
-            self.seen.lock().unwrap().push(request.clone());
-            let purpose = request.purpose.clone().unwrap_or_default();
-            let reply = self
-                .replies
-                .lock()
-                .unwrap()
-                .get_mut(&purpose)
-                .and_then(VecDeque::pop_front)
-                .ok_or_else(|| TransportError::Failed {
-                    message: format!("no reply left for {purpose:?}"),
-                    retryable: false,
-                })?;
-            let (text, finish) = match reply.strip_prefix(TRUNCATED) {
-                Some(partial) => (partial.to_string(), "length"),
-                None => (reply, "stop"),
-            };
-            let body = json!({
-                "id": "chatcmpl-scripted", "model": "scripted",
-                "choices": [{"index": 0, "message": {"role": "assistant", "content": text}, "finish_reason": finish}],
-                "usage": {"prompt_tokens": 10, "completion_tokens": 5}
-            });
-            Ok(WireResponse::new(
-                200,
-                serde_json::to_vec(&body).unwrap(),
-                Origin::Offline,
-            ))
-        })
-    }
-
-    fn label(&self) -> String {
-        "scripted".into()
-    }
-}
+use nesy_testkit::{Scripted, TRUNCATED};
+use nesy_vlm::{BackendKind, Image, VlmClient, VlmConfig, VlmError, WireRequest};
+use serde_json::Value;
 
 fn client(transport: Arc<Scripted>, max_images: Option<usize>) -> VlmClient {
     let mut config = VlmConfig::new(BackendKind::OpenAi, "gpt-5");
@@ -675,11 +603,7 @@ fn morevqa_grounds_and_verifies_until_verified_then_asks_and_plans() {
         "{error}"
     );
     let transport = morevqa_script(&[GROUNDED, GROUNDED], &[NOT_VERIFIED, VERIFIED]);
-    transport
-        .replies
-        .lock()
-        .unwrap()
-        .insert(morevqa::PARSE.into(), [fenced_events.to_string()].into());
+    transport.set(morevqa::PARSE, &[fenced_events]);
     let plan = pollster::block_on(morevqa::run(
         &client(transport.clone(), None),
         &inputs(Fidelity::Repaired),

@@ -13,15 +13,16 @@
 //! assert!(nesy_testkit::workspace_root().join("Cargo.toml").is_file());
 //! ```
 
+use std::collections::{BTreeMap, VecDeque};
 use std::path::PathBuf;
 #[cfg(feature = "policy-worker")]
 use std::process::ExitCode;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use nesy_vlm::{
-    BackendKind, BoxFuture, RetryPolicy, Timeouts, Transport, TransportError, VlmConfig, WireRequest,
+    BackendKind, BoxFuture, Origin, RetryPolicy, Timeouts, Transport, TransportError, VlmConfig, WireRequest,
     WireResponse,
 };
 use serde_json::{Value, json};
@@ -181,4 +182,91 @@ pub fn run_tests_or_worker(tests: &[NamedTest]) -> ExitCode {
 #[cfg(feature = "policy-worker")]
 pub fn own_worker() -> nesy_policy::WorkerCommand {
     nesy_policy::WorkerCommand::current_exe().expect("the running test binary")
+}
+
+/// The prefix that makes [`Scripted`] answer with `finish_reason: length`, cut off after the
+/// text that follows it.
+pub const TRUNCATED: &str = "<length>";
+/// The reply that makes [`Scripted`] answer with a null `content`.
+pub const NULL_CONTENT: &str = "<null>";
+
+/// A transport that answers each request purpose from its own queue of scripted replies and
+/// keeps every request it was sent, for tests of call flows (the reasoner's, the baselines').
+/// A purpose whose queue is empty fails, not retryable.
+#[derive(Debug, Default)]
+pub struct Scripted {
+    replies: Mutex<BTreeMap<String, VecDeque<String>>>,
+    seen: Mutex<Vec<WireRequest>>,
+}
+
+impl Scripted {
+    /// A script: for each purpose, its replies in order.
+    pub fn with(replies: &[(&str, &[&str])]) -> Arc<Self> {
+        let map = replies
+            .iter()
+            .map(|(purpose, texts)| (purpose.to_string(), texts.iter().map(|t| t.to_string()).collect()))
+            .collect();
+        Arc::new(Scripted {
+            replies: Mutex::new(map),
+            seen: Mutex::default(),
+        })
+    }
+
+    /// Replaces the queue of `purpose` with `replies`.
+    pub fn set(&self, purpose: &str, replies: &[&str]) {
+        let queue = replies.iter().map(|t| t.to_string()).collect();
+        self.replies.lock().unwrap().insert(purpose.to_owned(), queue);
+    }
+
+    /// The requests of `purpose` sent so far, in order.
+    pub fn requests(&self, purpose: &str) -> Vec<WireRequest> {
+        self.seen
+            .lock()
+            .unwrap()
+            .iter()
+            .filter(|r| r.purpose.as_deref() == Some(purpose))
+            .cloned()
+            .collect()
+    }
+}
+
+impl Transport for Scripted {
+    fn send<'a>(&'a self, request: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
+        Box::pin(async move {
+            self.seen.lock().unwrap().push(request.clone());
+            let purpose = request.purpose.clone().unwrap_or_default();
+            let reply = self
+                .replies
+                .lock()
+                .unwrap()
+                .get_mut(&purpose)
+                .and_then(VecDeque::pop_front)
+                .ok_or_else(|| TransportError::Failed {
+                    message: format!("script has no reply left for purpose {purpose:?}"),
+                    retryable: false,
+                })?;
+            let body = match reply.strip_prefix(TRUNCATED) {
+                Some(partial) => {
+                    let mut body = completion(partial);
+                    body["choices"][0]["finish_reason"] = "length".into();
+                    body
+                }
+                None if reply == NULL_CONTENT => {
+                    let mut body = completion("");
+                    body["choices"][0]["message"]["content"] = Value::Null;
+                    body
+                }
+                None => completion(&reply),
+            };
+            Ok(WireResponse::new(
+                200,
+                serde_json::to_vec(&body).unwrap(),
+                Origin::Offline,
+            ))
+        })
+    }
+
+    fn label(&self) -> String {
+        "scripted".into()
+    }
 }

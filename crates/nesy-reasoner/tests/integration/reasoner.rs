@@ -4,8 +4,7 @@
 //! matches nothing and is then fixed; then code generation and state translation on the
 //! same client, with per-purpose accounting and typed task contexts.
 
-use std::collections::{BTreeMap, VecDeque};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use crate::scenario;
 use nesy_core::Embodiment;
@@ -16,86 +15,8 @@ use nesy_reasoner::codegen::{CodeGenerationRequest, CodegenError};
 use nesy_reasoner::translate::TranslationProblem;
 use nesy_reasoner::translate::{StateTranslationRequest, TranslateError};
 use nesy_reasoner::{Views, VlmReasoner, VlmTask};
-use nesy_vlm::{
-    BackendKind, BoxFuture, Image, Origin, Transport, TransportError, VlmClient, WireRequest, WireResponse,
-};
-
-/// The prefix that makes [`Scripted`] answer with `finish_reason: length`.
-const TRUNCATED: &str = "<length>";
-/// The reply that makes [`Scripted`] answer with a null `content`.
-const NULL_CONTENT: &str = "<null>";
-
-/// Answers each purpose from its own queue of replies and keeps every request.
-#[derive(Debug, Default)]
-struct Scripted {
-    replies: Mutex<BTreeMap<String, VecDeque<String>>>,
-    seen: Mutex<Vec<WireRequest>>,
-}
-
-impl Scripted {
-    fn with(replies: &[(&str, &[&str])]) -> Arc<Self> {
-        let map = replies
-            .iter()
-            .map(|(purpose, texts)| (purpose.to_string(), texts.iter().map(|t| t.to_string()).collect()))
-            .collect();
-        Arc::new(Scripted {
-            replies: Mutex::new(map),
-            seen: Mutex::default(),
-        })
-    }
-
-    fn requests(&self, purpose: &str) -> Vec<WireRequest> {
-        self.seen
-            .lock()
-            .unwrap()
-            .iter()
-            .filter(|r| r.purpose.as_deref() == Some(purpose))
-            .cloned()
-            .collect()
-    }
-}
-
-impl Transport for Scripted {
-    fn send<'a>(&'a self, request: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
-        Box::pin(async move {
-            self.seen.lock().unwrap().push(request.clone());
-            let purpose = request.purpose.clone().unwrap_or_default();
-            let reply = self
-                .replies
-                .lock()
-                .unwrap()
-                .get_mut(&purpose)
-                .and_then(VecDeque::pop_front)
-                .ok_or_else(|| TransportError::Failed {
-                    message: format!("script has no reply left for purpose {purpose:?}"),
-                    retryable: false,
-                })?;
-            // A reply written "<length>TEXT" comes back cut off at the token cap.
-            let body = match reply.strip_prefix(TRUNCATED) {
-                Some(partial) => {
-                    let mut body = nesy_testkit::completion(partial);
-                    body["choices"][0]["finish_reason"] = "length".into();
-                    body
-                }
-                None if reply == NULL_CONTENT => {
-                    let mut body = nesy_testkit::completion("");
-                    body["choices"][0]["message"]["content"] = serde_json::Value::Null;
-                    body
-                }
-                None => nesy_testkit::completion(&reply),
-            };
-            Ok(WireResponse::new(
-                200,
-                serde_json::to_vec(&body).unwrap(),
-                Origin::Offline,
-            ))
-        })
-    }
-
-    fn label(&self) -> String {
-        "scripted".into()
-    }
-}
+use nesy_testkit::{NULL_CONTENT, Scripted, TRUNCATED};
+use nesy_vlm::{BackendKind, Image, VlmClient, WireRequest};
 
 fn client(transport: Arc<Scripted>) -> VlmClient {
     let config = nesy_testkit::mock_config(BackendKind::OpenAi, "gpt-5", "http://127.0.0.1:9");
