@@ -9,6 +9,8 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use tracing_subscriber::layer::SubscriberExt as _;
+use tracing_subscriber::util::SubscriberInitExt as _;
 
 /// `println!` that returns the write error instead of panicking, so that a closed pipe
 /// (`nesy … | head`) ends the command quietly (see [`run`]).
@@ -69,12 +71,31 @@ pub(crate) const EXIT_BAD_INPUT: u8 = 2;
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     tracing_subscriber::fmt()
-        .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
         .with_writer(std::io::stderr)
         // Colour codes only for a terminal, not in logs captured to a file.
         .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
+        .finish()
+        .with(log_filter(std::env::var("RUST_LOG").ok().as_deref()))
         .init();
     run(cli)
+}
+
+/// Which events are logged: `RUST_LOG`'s `target=level` directives (for example
+/// `warn,nesy_vlm=debug`), or errors only when it is unset. A value that cannot be read is
+/// reported once and leaves errors only, so a typo never silences a run's errors.
+fn log_filter(directives: Option<&str>) -> tracing_subscriber::filter::Targets {
+    use tracing_subscriber::filter::{LevelFilter, Targets};
+    let errors_only = || Targets::new().with_default(LevelFilter::ERROR);
+    match directives.map(str::trim).filter(|d| !d.is_empty()) {
+        None => errors_only(),
+        Some(directives) => directives.parse::<Targets>().unwrap_or_else(|err| {
+            eprintln!(
+                "warning: RUST_LOG={directives:?} was ignored ({err}); expected comma-separated \
+                 `level` or `target=level` directives, e.g. `warn,nesy_vlm=debug`"
+            );
+            errors_only()
+        }),
+    }
 }
 
 /// Runs a parsed command line and maps errors to exit code 2 with their full context.
@@ -135,6 +156,20 @@ fn is_broken_pipe(err: &anyhow::Error) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn log_filter_reads_targets_and_falls_back_to_errors() {
+        use tracing::Level;
+        let filter = log_filter(Some("warn,nesy_vlm=debug"));
+        assert!(filter.would_enable("nesy_vlm::client", &Level::DEBUG));
+        assert!(filter.would_enable("nesy_core", &Level::WARN));
+        assert!(!filter.would_enable("nesy_core", &Level::INFO));
+        for unset in [None, Some(""), Some("nesy=loud")] {
+            let filter = log_filter(unset);
+            assert!(filter.would_enable("nesy_core", &Level::ERROR), "{unset:?}");
+            assert!(!filter.would_enable("nesy_core", &Level::WARN), "{unset:?}");
+        }
+    }
 
     #[test]
     fn a_cause_already_in_the_message_is_not_repeated() {
