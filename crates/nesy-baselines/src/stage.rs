@@ -30,10 +30,10 @@ pub struct StageRecord {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum StageProblem {
     /// The reply stopped at the token cap.
-    #[error("{}", truncation_text(*cap))]
+    #[error("{}", truncation_text(*cutoff))]
     Truncated {
-        /// The request's cap, if it set one.
-        cap: Option<u32>,
+        /// Where the reply was cut.
+        cutoff: nesy_vlm::Cutoff,
     },
     /// The reply's `content` was null.
     #[error("{NULL_CONTENT_TEXT}")]
@@ -49,8 +49,8 @@ pub enum StageProblem {
 }
 
 impl ReplyProblem for StageProblem {
-    fn truncated(cap: Option<u32>) -> Self {
-        StageProblem::Truncated { cap }
+    fn truncated(cutoff: nesy_vlm::Cutoff) -> Self {
+        StageProblem::Truncated { cutoff }
     }
 
     fn null_content() -> Self {

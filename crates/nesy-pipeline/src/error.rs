@@ -68,7 +68,70 @@ pub enum PipelineError {
     },
 }
 
+/// Why a run stopped before it had an outcome of its own (succeeded, unresolved,
+/// codegen_failed, execution_failed), as `failure.json` and the summary name it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopReason {
+    /// The demo, the scene or the settings are at fault.
+    BadInput,
+    /// The model gave no reply the method could use within its budgets (every reply cut
+    /// short, unreadable, or no operator for a transition parsed).
+    NoUsableReply,
+    /// The server refused the request as built (pictures to a text-only model, a prompt
+    /// longer than its context); sending it again cannot help.
+    RequestRefused,
+    /// The server could not be reached or kept failing (network, timeouts, server errors).
+    ModelUnreachable,
+    /// A replayed cassette holds no answer for a request of this run.
+    ReplayMismatch,
+    /// Anything else: a file that could not be written, a policy that could not be run.
+    Internal,
+}
+
+impl StopReason {
+    /// `bad_input`, `no_usable_reply`, ...
+    pub fn as_str(self) -> &'static str {
+        match self {
+            StopReason::BadInput => "bad_input",
+            StopReason::NoUsableReply => "no_usable_reply",
+            StopReason::RequestRefused => "request_refused",
+            StopReason::ModelUnreachable => "model_unreachable",
+            StopReason::ReplayMismatch => "replay_mismatch",
+            StopReason::Internal => "internal",
+        }
+    }
+
+    /// True when the model's side ended the run (its replies, its refusal, its absence):
+    /// an outcome of the episode, not a fault of the input.
+    pub fn is_model_side(self) -> bool {
+        matches!(
+            self,
+            StopReason::NoUsableReply | StopReason::RequestRefused | StopReason::ModelUnreachable
+        )
+    }
+}
+
 impl PipelineError {
+    /// Why the run stopped, for the summary, `failure.json` and the exit code.
+    pub fn stop_reason(&self) -> StopReason {
+        if self.is_bad_input() {
+            return StopReason::BadInput;
+        }
+        match self {
+            PipelineError::Adapt(AdaptError::NoOperator { .. }) => StopReason::NoUsableReply,
+            PipelineError::Adapt(AdaptError::TooShort(_)) => StopReason::BadInput,
+            _ => match self.reasoner_kind() {
+                Some(ReasonerErrorKind::Reply | ReasonerErrorKind::Exhausted) => StopReason::NoUsableReply,
+                Some(ReasonerErrorKind::Refused) => StopReason::RequestRefused,
+                Some(ReasonerErrorKind::Transport) => StopReason::ModelUnreachable,
+                Some(ReasonerErrorKind::Replay) => StopReason::ReplayMismatch,
+                Some(ReasonerErrorKind::Request) => StopReason::BadInput,
+                None => StopReason::Internal,
+            },
+        }
+    }
+
     /// True when the user's input is at fault (a demo, a scene, settings), so a command line
     /// exits with its bad-input code.
     pub fn is_bad_input(&self) -> bool {

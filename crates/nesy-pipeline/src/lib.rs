@@ -67,10 +67,10 @@ use execute::ExecutionReport;
 use states::{StateSource, StatesMode, SymbolicStates};
 use synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest, SynthesizedPolicy};
 
-pub use error::PipelineError;
+pub use error::{PipelineError, StopReason};
 pub use inputs::{DemoInput, DemoKeyframes, TargetInput};
 pub use progress::{LogProgress, NoProgress, Progress};
-pub use setting::{Setting, derive_setting};
+pub use setting::{ImagesMode, Setting, derive_setting};
 pub use timing::TimeBreakdown;
 
 /// Everything a run can be asked to do, besides its inputs and the VLM.
@@ -82,6 +82,8 @@ pub struct AdaptOptions {
     pub codegen: CodegenMode,
     /// Run the policy in the sandbox against the target scene.
     pub execute: bool,
+    /// Whether requests carry the keyframes' pictures.
+    pub images: ImagesMode,
     /// Patch-proposal budget; `None` takes the benchmark's 10/15/20/30 for the scenario.
     pub budget: Option<usize>,
     /// The adaptation loop's settings: induction attempts per transition, the transition
@@ -103,6 +105,7 @@ impl Default for AdaptOptions {
             states: StatesMode::Auto,
             codegen: CodegenMode::Vlm,
             execute: false,
+            images: ImagesMode::Auto,
             budget: None,
             adapt: AdaptConfig::default(),
             limits: Limits::default(),
@@ -319,7 +322,8 @@ pub async fn run(
         sim_s: target.sim_time.as_secs_f64(),
         ..TimeBreakdown::default()
     };
-    let setting = derive_setting(demo, target, options);
+    let mut setting = derive_setting(demo, target, options);
+    setting.images = options.images.sends_images(&client.capabilities().await);
     let reasoner = build_reasoner(client, demo, &setting)?;
 
     progress.stage("symbolic states");
@@ -412,12 +416,16 @@ fn build_reasoner(
     demo: &DemoInput,
     setting: &Setting,
 ) -> Result<VlmReasoner, PipelineError> {
-    let keyframes = Arc::new(DemoKeyframes::from_demo(demo)?);
-    Ok(VlmReasoner::new(client)
-        .map_err(|e| PipelineError::VlmSetup {
-            message: format!("loading nesy's prompts: {e}"),
-        })?
-        .with_keyframes(keyframes)
+    let reasoner = VlmReasoner::new(client).map_err(|e| PipelineError::VlmSetup {
+        message: format!("loading nesy's prompts: {e}"),
+    })?;
+    // Without pictures the prompts carry the states as text alone, as they always do.
+    let reasoner = if setting.images {
+        reasoner.with_keyframes(Arc::new(DemoKeyframes::from_demo(demo)?))
+    } else {
+        reasoner
+    };
+    Ok(reasoner
         .with_embodiments(setting.source_embodiment, setting.target_embodiment)
         .with_program_check(Arc::new(SandboxChecks)))
 }

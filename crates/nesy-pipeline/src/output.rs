@@ -25,7 +25,8 @@ use crate::execute::ExecutionReport;
 use crate::inputs::TargetInput;
 use crate::states::StateSource;
 use crate::synth::{CodegenMode, SynthError};
-use crate::{AdaptRun, PipelineError};
+use crate::{AdaptRun, PipelineError, StopReason};
+use nesy_vlm::RunUsage;
 
 /// `world_model.json`.
 pub const WORLD_MODEL_FILE: &str = "world_model.json";
@@ -52,6 +53,8 @@ pub const FAILURE_FILE: &str = "failure.json";
 pub struct RunFailure<'a> {
     /// Always `failed`.
     pub status: &'static str,
+    /// Why the run stopped (`no_usable_reply`, `request_refused`, ...).
+    pub stopped: StopReason,
     /// The error, with the call that failed (`operator induction for transition 3 (attempt
     /// 2): ...`, `state translation for target/initial: ...`).
     pub error: String,
@@ -59,6 +62,10 @@ pub struct RunFailure<'a> {
     pub failure: Option<ReasonerErrorKind>,
     /// The target scene as given.
     pub target: &'a Path,
+    /// Seconds from the start of the run to the stop.
+    pub elapsed_s: f64,
+    /// The model calls made before the stop: counts, tokens and latency, by purpose.
+    pub calls: &'a RunUsage,
 }
 
 /// A run directory: where one episode's files go, each under its fixed name. Every write
@@ -115,10 +122,13 @@ impl RunDir {
     /// Writes `failure.json` and the target scene for a run that stopped with `error`
     /// before it had an outcome, so no failed run leaves an empty directory. Errors of bad
     /// input (the demo, the scene, the settings) write nothing: they happen before the run.
+    /// `calls` are the model calls made before the stop, `elapsed` the run's time to it.
     pub fn write_failure(
         &self,
         target: &TargetInput,
         error: &PipelineError,
+        calls: &RunUsage,
+        elapsed: std::time::Duration,
     ) -> Result<Option<PathBuf>, PipelineError> {
         if error.is_bad_input() {
             return Ok(None);
@@ -128,9 +138,12 @@ impl RunDir {
             FAILURE_FILE,
             &RunFailure {
                 status: "failed",
+                stopped: error.stop_reason(),
                 error: error.to_string(),
                 failure: error.reasoner_kind(),
                 target: &target.path,
+                elapsed_s: elapsed.as_secs_f64(),
+                calls,
             },
         )?;
         Ok(Some(path))

@@ -5,10 +5,46 @@
 use nesy_core::Embodiment;
 use nesy_core::Tier;
 use nesy_core::benchmark::{Complexity, Factor, iteration_budget, parse_scenario_id};
+use nesy_vlm::ServerCapabilities;
 use serde::Serialize;
 
 use crate::AdaptOptions;
 use crate::inputs::{DemoInput, TargetInput};
+
+/// Whether model requests carry the keyframes' pictures (`--vlm-images`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "snake_case")]
+pub enum ImagesMode {
+    /// Pictures unless the server announces that it takes none (llama.cpp's `/props`).
+    #[default]
+    Auto,
+    /// Always pictures; a server that takes none refuses the request.
+    Always,
+    /// Never pictures: the calls see the states as text only, which needs ground-truth
+    /// states (`--states observed`).
+    Never,
+}
+
+impl ImagesMode {
+    /// Whether requests carry pictures to a server that announced `caps`.
+    ///
+    /// ```
+    /// use nesy_pipeline::ImagesMode;
+    /// use nesy_vlm::ServerCapabilities;
+    /// let text_only = ServerCapabilities { images: Some(false), ..ServerCapabilities::UNKNOWN };
+    /// assert!(!ImagesMode::Auto.sends_images(&text_only));
+    /// assert!(ImagesMode::Auto.sends_images(&ServerCapabilities::UNKNOWN));
+    /// assert!(ImagesMode::Always.sends_images(&text_only));
+    /// ```
+    pub fn sends_images(self, caps: &ServerCapabilities) -> bool {
+        match self {
+            ImagesMode::Auto => !caps.refuses_images(),
+            ImagesMode::Always => true,
+            ImagesMode::Never => false,
+        }
+    }
+}
 
 /// The scenario settings the run derived (factor and complexity decide the budget).
 #[derive(Debug, Clone, Serialize)]
@@ -29,6 +65,11 @@ pub struct Setting {
     pub budget: usize,
     /// Where that budget came from: `flag` or `scenario`.
     pub budget_origin: &'static str,
+    /// `--vlm-images` as given.
+    pub images_mode: ImagesMode,
+    /// Whether the model was shown the keyframes' pictures (the mode, resolved against
+    /// what the server announced).
+    pub images: bool,
 }
 
 /// Tier, embodiment atoms, factor, complexity and budget for a demo and a target.
@@ -70,5 +111,7 @@ pub fn derive_setting(demo: &DemoInput, target: &TargetInput, options: &AdaptOpt
         complexity,
         budget,
         budget_origin,
+        images_mode: options.images,
+        images: options.images != ImagesMode::Never,
     }
 }

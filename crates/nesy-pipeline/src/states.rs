@@ -129,6 +129,18 @@ pub async fn symbolic_states(
         });
     }
 
+    if !setting.images {
+        return Err(PipelineError::States {
+            message: format!(
+                "state translation reads the keyframes' pictures, and this run sends none ({}); use ground-truth states (--states observed)",
+                match setting.images_mode {
+                    crate::ImagesMode::Never => "--vlm-images never",
+                    _ => "the server announced that it takes no image input",
+                }
+            ),
+            kind: Some(nesy_core::adapt::ReasonerErrorKind::Refused),
+        });
+    }
     let started = Instant::now();
     let requests = translation_requests(demo, target, setting, vocabulary, truth.as_deref(), source_atom)?;
     let total = requests.len();

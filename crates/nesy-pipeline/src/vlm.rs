@@ -109,6 +109,13 @@ pub struct VlmSetup {
 pub fn oracle_config() -> VlmConfig {
     let mut config = VlmConfig::new(ORACLE_BACKEND, ORACLE_MODEL);
     config.base_url = "oracle:".into();
+    // One cap for every call, as the responder's recordings were made with: it answers
+    // instantly, so per-purpose caps for slow local servers do not apply.
+    config.defaults.max_output_tokens = Some(nesy_vlm::DEFAULT_CLOUD_OUTPUT_TOKENS);
+    config.defaults.reply_caps = None;
+    // It answers from the task context, so a grammar would change nothing but its
+    // recordings' request bodies.
+    config.defaults.constrain = nesy_vlm::ConstrainMode::Off;
     config
 }
 
@@ -120,20 +127,19 @@ pub fn replay_config(path: &Path, file: &CassetteFile) -> Result<VlmConfig, Pipe
             path.display()
         ))
     })?;
+    if model == ORACLE_MODEL {
+        return Ok(oracle_config());
+    }
     let backend_label = file.meta.backend.clone().unwrap_or_default();
-    // Labels are `openai`, `http openai`, or the oracle's; the last word names the profile.
+    // Labels are `openai` or `http openai`; the last word names the profile.
     let last = backend_label.split_whitespace().last().unwrap_or("");
-    let backend = if model == ORACLE_MODEL {
-        ORACLE_BACKEND
-    } else {
-        last.parse::<BackendKind>().map_err(|e| {
-            setup_error(format!(
-                "{}: at meta.backend: {e}; replay this cassette with NESY_CASSETTE={} NESY_CASSETTE_MODE=none and the settings it was recorded with",
-                path.display(),
-                path.display()
-            ))
-        })?
-    };
+    let backend = last.parse::<BackendKind>().map_err(|e| {
+        setup_error(format!(
+            "{}: at meta.backend: {e}; replay this cassette with NESY_CASSETTE={} NESY_CASSETTE_MODE=none and the settings it was recorded with",
+            path.display(),
+            path.display()
+        ))
+    })?;
     Ok(VlmConfig::new(backend, model))
 }
 

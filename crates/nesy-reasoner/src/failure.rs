@@ -18,7 +18,12 @@ pub fn failure_kind(error: &VlmError) -> ReasonerErrorKind {
     use ReasonerErrorKind as Kind;
     match error {
         VlmError::Config(_) | VlmError::InvalidRequest(_) => Kind::Request,
-        VlmError::TooManyImages { .. } => Kind::Refused,
+        VlmError::TooManyImages { .. } | VlmError::Unsupported { .. } | VlmError::ContextExceeded { .. } => {
+            Kind::Refused
+        }
+        // A server that says it cannot take the request's content (pictures to a text-only
+        // model) refuses it however often it is sent, whatever the status code.
+        VlmError::Http { provider, .. } if provider.missing_capability().is_some() => Kind::Refused,
         VlmError::Transport {
             error: TransportError::Declined(_),
             ..

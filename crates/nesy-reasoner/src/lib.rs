@@ -34,6 +34,7 @@
 //! ```
 
 pub mod codegen;
+pub mod constraints;
 mod context;
 mod failure;
 mod keyframes;

@@ -11,6 +11,7 @@ use nesy_core::adapt::{
 use crate::codegen::{
     self, CheckUnavailable, CodeGenerationRequest, CodegenError, PolicySource, ProgramCheck,
 };
+use crate::constraints::{self, Symbols};
 use crate::context::{Embodiment, InductionContext, PatchContext, VlmTask};
 use crate::keyframes::{KeyframeImages, NoKeyframes};
 use crate::prompts::{PromptError, Prompts};
@@ -128,9 +129,11 @@ impl VlmReasoner {
             request: request.clone(),
             embodiment: self.source,
         });
+        let symbols = Symbols::of_task(&request.task, [&request.previous, &request.next]);
         let mut chat = ChatRequest::new()
             .purpose(context.purpose())
             .task(context.to_task_context())
+            .constraint(constraints::induction_constraint(&symbols))
             .message(Message::system(rendered.system))
             .message(Message::user(parts));
         chat = self.follow_ups(chat, &request.feedback, |f| self.prompts.induction_feedback(f))?;
@@ -146,9 +149,11 @@ impl VlmReasoner {
             request: request.clone(),
             target_embodiment: self.target,
         });
+        let symbols = Symbols::of_task(&request.task, [&request.initial_state, &request.error_state]);
         let mut chat = ChatRequest::new()
             .purpose(context.purpose())
             .task(context.to_task_context())
+            .constraint(constraints::patch_constraint(&symbols, &request.procedure))
             .message(Message::system(rendered.system))
             .message(Message::user_text(rendered.user));
         chat = self.follow_ups(chat, &request.feedback, |f| self.prompts.refinement_feedback(f))?;
@@ -163,7 +168,7 @@ impl VlmReasoner {
     ) -> Result<ChatRequest, PromptError> {
         for f in feedback {
             chat = chat
-                .message(Message::assistant(f.reply.clone()))
+                .message(Message::assistant(reply::quote_for_reask(&f.reply)))
                 .message(Message::user_text(render(f)?));
         }
         Ok(chat)
@@ -193,9 +198,9 @@ impl VlmReasoner {
     }
 
     /// Sends an induction or patch request through the shared [`reply`](nesy_vlm::reply)
-    /// policy: a reply cut off at the token cap or with null content is re-asked here (up
-    /// to [`CALL_ATTEMPTS`] replies), and any text that arrives whole goes to nesy-core,
-    /// which parses it and re-asks within its own budget.
+    /// policy: a reply cut short or with null content is re-asked here (up to
+    /// [`CALL_ATTEMPTS`] replies), and the text that arrives (whole, or the last cut-short
+    /// one) goes to nesy-core, which parses it and re-asks within its own budget.
     async fn send(
         &self,
         what: &str,
@@ -211,18 +216,22 @@ impl VlmReasoner {
             Ok(answer) => Ok(answer.value),
             Err(AskError::Vlm(error)) => Err(reasoner_error(what, &error)),
             Err(AskError::Reader(never)) => match never {},
-            Err(AskError::Exhausted(attempts)) => Err(ReasonerError::new(
-                ReasonerErrorKind::Reply,
-                format!(
-                    "{what}: no usable reply in {} attempt(s): {}",
+            // Every reply was cut short or empty. What the model did say goes to nesy-core
+            // like any other reply: it re-asks one it cannot read within the loop's own
+            // budget, so a few runaway replies cost attempts, not the whole run.
+            Err(AskError::Exhausted(attempts)) => {
+                tracing::warn!(
+                    call = what,
+                    "no whole reply in {} attempt(s) ({}); passing the last one on as it is",
                     attempts.len(),
                     attempts
                         .iter()
                         .map(|a| a.problem.to_string())
                         .collect::<Vec<_>>()
                         .join("; then ")
-                ),
-            )),
+                );
+                Ok(attempts.into_iter().last().map(|a| a.reply).unwrap_or_default())
+            }
         }
     }
 }

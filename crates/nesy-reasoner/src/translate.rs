@@ -12,6 +12,7 @@ use nesy_core::text::{ParseError, normalize_reply, parse_state_list};
 use nesy_core::{Tier, Vocabulary};
 use serde::{Deserialize, Serialize};
 
+use crate::constraints::{self, Symbols};
 use crate::context::{StateTranslationContext, VlmTask};
 use crate::keyframes::Views;
 use crate::prompts::{PromptError, Prompts, StateTranslationPrompt};
@@ -98,10 +99,10 @@ pub enum TranslationProblem {
         symbols: Vec<UnknownSymbol>,
     },
     /// The reply stopped at the token cap.
-    #[error("{}", reply::truncation_text(*cap))]
+    #[error("{}", reply::truncation_text(*cutoff))]
     Truncated {
-        /// The request's cap, if it set one.
-        cap: Option<u32>,
+        /// Where the reply was cut.
+        cutoff: nesy_vlm::Cutoff,
     },
     /// The reply's `content` was null and no `reasoning_content` held text.
     #[error("{}", reply::NULL_CONTENT_TEXT)]
@@ -109,8 +110,8 @@ pub enum TranslationProblem {
 }
 
 impl ReplyProblem for TranslationProblem {
-    fn truncated(cap: Option<u32>) -> Self {
-        TranslationProblem::Truncated { cap }
+    fn truncated(cutoff: nesy_vlm::Cutoff) -> Self {
+        TranslationProblem::Truncated { cutoff }
     }
 
     fn null_content() -> Self {
@@ -196,9 +197,16 @@ pub fn build_request(
     });
     let mut parts = vec![Part::text(rendered.user)];
     parts.extend(request.views.parts("The scene"));
+    let symbols = Symbols::new(
+        &request.vocabulary,
+        request.tier,
+        request.objects.iter().map(String::as_str),
+        [&request.known],
+    );
     let chat = ChatRequest::new()
         .purpose(context.purpose())
         .task(context.to_task_context())
+        .constraint(constraints::translation_constraint(&symbols))
         .message(Message::system(rendered.system))
         .message(Message::user(parts));
     Ok(settings.apply(chat))

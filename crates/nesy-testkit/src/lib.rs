@@ -249,6 +249,13 @@ impl Transport for Scripted {
                 Some(partial) => {
                     let mut body = completion(partial);
                     body["choices"][0]["finish_reason"] = "length".into();
+                    // A reply stopped by its cap has used all of it, as servers report.
+                    let cap = ["max_tokens", "max_completion_tokens"]
+                        .iter()
+                        .find_map(|field| request.body.get(*field).and_then(Value::as_u64));
+                    if let Some(cap) = cap {
+                        body["usage"]["completion_tokens"] = cap.into();
+                    }
                     body
                 }
                 None if reply == NULL_CONTENT => {

@@ -3,20 +3,55 @@
 
 use std::sync::{Arc, Mutex};
 
-use tokio::sync::Semaphore;
+use tokio::sync::{OnceCell, Semaphore};
 use tokio::time::Instant;
 
 use crate::accounting::{CallRecord, PriceTable, RunUsage};
+use crate::capabilities::{ServerCapabilities, estimate_prompt_tokens};
 use crate::cassette::{CassetteMode, CassetteOptions, CassetteTransport};
 use crate::config::{ConfigError, VlmConfig};
 use crate::error::{ProviderError, TransportError, VlmError};
 use crate::profile::{AuthScheme, Profile};
-use crate::request::ChatRequest;
+use crate::request::{ChatRequest, Part};
 use crate::response::{ChatResponse, parse_completion};
 use crate::retry::{RetryPolicy, status_is_retryable};
 use crate::secret::SecretString;
 use crate::transport::Auth;
 use crate::transport::{HttpTransport, Origin, Transport, WireRequest, WireResponse};
+
+/// The smallest reply worth asking for; a prompt leaving less room is refused before it is
+/// sent.
+const MIN_REPLY_TOKENS: u32 = 64;
+
+/// Where re-ask turns start in a conversation: after the system prompt and the task.
+const FIRST_FOLLOW_UP: usize = 2;
+
+/// Whether the conversation holds a rejected reply and its correction after the system
+/// prompt and the task, with at least one later turn, so that leaving them out keeps the
+/// latest exchange.
+fn oldest_follow_up_is_droppable(request: &ChatRequest) -> bool {
+    use crate::request::Role;
+    let roles: Vec<Role> = request.messages.iter().map(|m| m.role).collect();
+    roles.len() > FIRST_FOLLOW_UP + 2
+        && matches!(roles[0], Role::System | Role::Developer)
+        && roles[1] == Role::User
+        && roles[FIRST_FOLLOW_UP] == Role::Assistant
+        && roles[FIRST_FOLLOW_UP + 1] == Role::User
+}
+
+/// [`estimate_prompt_tokens`] of a whole request.
+fn estimate_request_tokens(request: &ChatRequest) -> u32 {
+    let text_bytes: usize = request
+        .messages
+        .iter()
+        .flat_map(|m| &m.parts)
+        .map(|part| match part {
+            Part::Text(text) => text.len(),
+            Part::Image(_) => 0,
+        })
+        .sum();
+    estimate_prompt_tokens(text_bytes, request.messages.len(), request.image_count())
+}
 
 /// An OpenAI-compatible chat client. Cheap to clone; clones share the transport, the
 /// concurrency cap and the run's accounting.
@@ -36,6 +71,8 @@ struct Inner {
     usage: Mutex<RunUsage>,
     /// The configured key, redacted from every provider error by its exact text.
     api_key: Option<SecretString>,
+    /// What the server announced, read before the first call.
+    capabilities: OnceCell<ServerCapabilities>,
 }
 
 impl std::fmt::Debug for VlmClient {
@@ -133,6 +170,7 @@ impl VlmClient {
             &config.timeouts,
             format!("http {}", config.backend),
         )
+        .map(|transport| transport.with_probe(config.backend, config.model.clone()))
         .map_err(|message| {
             ConfigError::Invalid {
                 origin: "base URL".into(),
@@ -156,6 +194,7 @@ impl VlmClient {
                 prices: config.prices.clone(),
                 usage: Mutex::new(RunUsage::default()),
                 api_key: config.api_key.clone(),
+                capabilities: OnceCell::new(),
             }),
         }
     }
@@ -181,6 +220,80 @@ impl VlmClient {
         }
     }
 
+    /// What the server announced it can take (image input, context window), read from the
+    /// transport once and kept for the client's life.
+    pub async fn capabilities(&self) -> ServerCapabilities {
+        self.inner
+            .capabilities
+            .get_or_init(|| self.inner.transport.capabilities())
+            .await
+            .clone()
+    }
+
+    /// The output-token cap a request is sent with ([`Profile::output_cap`]).
+    pub fn effective_cap(&self, request: &ChatRequest) -> Option<u32> {
+        self.inner.profile.output_cap(request)
+    }
+
+    /// The form `request`'s reply takes under this client's backend and constrain mode
+    /// ([`Profile::reply_form`]).
+    pub fn reply_form(&self, request: &ChatRequest) -> crate::constraint::ReplyForm {
+        self.inner.profile.reply_form(request)
+    }
+
+    /// Checks `request` against what the server announced, and sizes its reply to the room
+    /// the context window leaves: pictures never go to a server that takes none, and a
+    /// prompt that would not fit is not sent at all.
+    fn fit_to_server(
+        &self,
+        mut request: ChatRequest,
+        caps: &ServerCapabilities,
+    ) -> Result<ChatRequest, VlmError> {
+        let images = request.image_count();
+        if images > 0 && caps.refuses_images() {
+            return Err(VlmError::Unsupported {
+                capability: "image input".into(),
+                detail: format!(
+                    "{} announces text input only, and this request carries {images} image(s); it was not sent",
+                    caps.source_label()
+                ),
+            });
+        }
+        let Some(context) = caps.context_tokens else {
+            return Ok(request);
+        };
+        // The room a reply needs: its cap, but never more than a quarter of the window, so a
+        // large cap on a small server does not push out the conversation itself.
+        let wanted = self
+            .effective_cap(&request)
+            .unwrap_or(u32::MAX)
+            .min(context / 4)
+            .max(MIN_REPLY_TOKENS);
+        // A conversation of re-asks that outgrows the window loses its oldest rejected
+        // reply and correction first; the task and the latest turns stay.
+        let mut estimated = estimate_request_tokens(&request);
+        let mut dropped = 0;
+        while estimated.saturating_add(wanted) > context && oldest_follow_up_is_droppable(&request) {
+            request.messages.drain(FIRST_FOLLOW_UP..FIRST_FOLLOW_UP + 2);
+            dropped += 1;
+            estimated = estimate_request_tokens(&request);
+        }
+        if dropped > 0 {
+            tracing::info!(
+                purpose = request.purpose.as_deref().unwrap_or("-"),
+                "left out the {dropped} oldest re-ask turn(s) to fit the server's {context}-token context"
+            );
+        }
+        let room = context.saturating_sub(estimated);
+        if room < MIN_REPLY_TOKENS {
+            return Err(VlmError::ContextExceeded { estimated, context });
+        }
+        if self.effective_cap(&request).is_none_or(|cap| cap > room) {
+            request.max_output_tokens = Some(room);
+        }
+        Ok(request)
+    }
+
     /// Sends one chat request: retries transient failures, respects the concurrency cap,
     /// and records usage, latency and attempts whatever the outcome.
     pub async fn chat(&self, request: ChatRequest) -> Result<ChatResponse, VlmError> {
@@ -195,6 +308,9 @@ impl VlmClient {
                 return Err(VlmError::TooManyImages { images, limit });
             }
         }
+        let caps = self.capabilities().await;
+        let request = self.fit_to_server(request, &caps)?;
+        let sent_cap = self.effective_cap(&request);
         let wire = self.wire_request(&request);
         let started = Instant::now();
         let (result, attempts, origin) = self.send_with_retries(&wire).await;
@@ -202,6 +318,21 @@ impl VlmClient {
             Ok(response) => self.read_success(response, attempts, started),
             Err(err) => (Err(err), None),
         };
+        let outcome = outcome.map_err(|error| match error {
+            VlmError::Truncated {
+                partial_text,
+                usage,
+                request_id,
+                ..
+            } => VlmError::Truncated {
+                partial_text,
+                usage,
+                request_id,
+                cap: sent_cap,
+                context: caps.context_tokens,
+            },
+            other => other,
+        });
         let record = CallRecord {
             model: self.inner.profile.model.clone(),
             purpose: request.purpose.clone(),

@@ -11,9 +11,13 @@ use serde::Deserialize;
 
 use crate::accounting::PriceTable;
 use crate::cassette::CassetteMode;
-use crate::profile::{BackendKind, BodyDefaults, Profile, ReasoningMode};
+use crate::constraint::ConstrainMode;
+use crate::profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, ReplyCaps};
 use crate::request::{ImageDetail, ReasoningEffort};
 use crate::retry::RetryPolicy;
+
+/// The output-token cap of every call to a hosted API unless configured otherwise.
+pub const DEFAULT_CLOUD_OUTPUT_TOKENS: u32 = 4096;
 use crate::secret::SecretString;
 
 /// The Azure `api-version` used when none is configured: recent enough for reasoning models
@@ -170,9 +174,18 @@ impl VlmConfig {
             azure_deployment: None,
             azure_api_version: DEFAULT_AZURE_API_VERSION.to_string(),
             reasoning: ReasoningMode::Auto,
-            defaults: BodyDefaults {
-                max_output_tokens: Some(4096),
-                ..BodyDefaults::default()
+            // A cloud model gets one generous cap; a local one a cap per kind of call, since
+            // it generates slowly and a runaway reply would cost minutes.
+            defaults: if backend.is_local() {
+                BodyDefaults {
+                    reply_caps: Some(ReplyCaps::LOCAL),
+                    ..BodyDefaults::default()
+                }
+            } else {
+                BodyDefaults {
+                    max_output_tokens: Some(DEFAULT_CLOUD_OUTPUT_TOKENS),
+                    ..BodyDefaults::default()
+                }
             },
             timeouts: Timeouts::default(),
             retry: RetryPolicy::default(),
@@ -409,6 +422,9 @@ impl Sources<'_> {
             }
             config.defaults.temperature = Some(temperature);
         }
+        if let Some(mode) = self.setting(flags.constrain, "NESY_VLM_CONSTRAIN", file.constrain)? {
+            config.defaults.constrain = mode;
+        }
         if let Some(detail) = self.setting(flags.image_detail, "NESY_VLM_IMAGE_DETAIL", file.image_detail)? {
             config.defaults.image_detail = Some(detail);
         }
@@ -595,6 +611,10 @@ pub struct ConfigOverrides {
     /// Sampling temperature for non-reasoning models [env: NESY_VLM_TEMPERATURE].
     #[cfg_attr(feature = "clap", arg(long = "vlm-temperature", value_name = "T"))]
     pub temperature: Option<f32>,
+    /// Hold replies to each call's grammar where the backend can: auto, off
+    /// [env: NESY_VLM_CONSTRAIN].
+    #[cfg_attr(feature = "clap", arg(long = "vlm-constrain", value_name = "MODE"))]
+    pub constrain: Option<ConstrainMode>,
     /// Image detail: auto, low, high [env: NESY_VLM_IMAGE_DETAIL].
     #[cfg_attr(feature = "clap", arg(long = "vlm-image-detail", value_name = "DETAIL"))]
     pub image_detail: Option<ImageDetail>,
@@ -636,6 +656,7 @@ struct FileConfig {
     max_output_tokens: Option<u32>,
     temperature: Option<f32>,
     image_detail: Option<ImageDetail>,
+    constrain: Option<ConstrainMode>,
     max_concurrency: Option<usize>,
     max_images_per_request: Option<usize>,
     azure: Option<FileAzure>,

@@ -67,18 +67,43 @@ pub enum VlmError {
         /// Request id, if the server sent one.
         request_id: Option<String>,
     },
-    /// The model stopped at the token cap (`finish_reason == "length"`).
+    /// The reply was cut short (`finish_reason == "length"`): at the token cap, or because
+    /// the server's context window filled up first ([`VlmError::cutoff`] tells which).
     #[error(
-        "output truncated at the token cap (finish_reason \"length\"){}",
+        "output cut short (finish_reason \"length\"): {}{}",
+        Cutoff::of(*cap, usage.as_ref(), *context),
         request_id_suffix(request_id)
     )]
     Truncated {
-        /// The text produced before the cap.
+        /// The text produced before the cut.
         partial_text: String,
         /// Token usage, if reported.
         usage: Option<Usage>,
         /// Request id, if the server sent one.
         request_id: Option<String>,
+        /// The output-token cap the request carried (the client fills it in).
+        cap: Option<u32>,
+        /// The context window the server announced, if it did (the client fills it in).
+        context: Option<u32>,
+    },
+    /// The server announced that it cannot take what the request carries (image input to a
+    /// text-only model); the request was not sent.
+    #[error("{capability} is not supported: {detail}")]
+    Unsupported {
+        /// What is missing, e.g. `image input`.
+        capability: String,
+        /// Who said so and what the request carried.
+        detail: String,
+    },
+    /// The prompt alone would fill the server's context window; the request was not sent.
+    #[error(
+        "the prompt needs about {estimated} tokens and the server's context window holds {context} (prompt and reply together); it was not sent"
+    )]
+    ContextExceeded {
+        /// The prompt's estimated size in tokens (an estimate that errs high).
+        estimated: u32,
+        /// The context window the server announced.
+        context: u32,
     },
     /// The model refused (a `refusal` message or `finish_reason == "content_filter"`).
     #[error("model refused{}: {reason}", request_id_suffix(request_id))]
@@ -93,7 +118,76 @@ pub enum VlmError {
     Cassette(#[from] CassetteError),
 }
 
+/// Where a reply that stopped with `finish_reason: length` was cut off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Cutoff {
+    /// At the output-token cap the request carried.
+    TokenCap(u32),
+    /// Before that cap: the server's context window was full after `generated` tokens.
+    ContextWindow {
+        /// Tokens generated before the cut.
+        generated: u32,
+    },
+    /// The request carried no cap and the server did not report its usage.
+    Unstated,
+}
+
+impl Cutoff {
+    /// Tells the cases apart: a reply whose prompt and output together reached the context
+    /// window the server announced stopped because the window was full; otherwise the cap
+    /// the request carried stopped it.
+    ///
+    /// ```
+    /// use nesy_vlm::{Cutoff, Usage};
+    /// let usage = Usage { prompt_tokens: 8000, completion_tokens: 192, ..Usage::default() };
+    /// assert_eq!(Cutoff::of(Some(512), Some(&usage), Some(8192)), Cutoff::ContextWindow { generated: 192 });
+    /// assert_eq!(Cutoff::of(Some(512), Some(&usage), None), Cutoff::TokenCap(512));
+    /// ```
+    pub fn of(cap: Option<u32>, usage: Option<&Usage>, context: Option<u32>) -> Cutoff {
+        // Servers count a few framing tokens differently; a reply this close to the window
+        // ran into it.
+        const SLACK_TOKENS: u64 = 16;
+        if let (Some(usage), Some(context)) = (usage, context)
+            && usage.prompt_tokens + usage.completion_tokens + SLACK_TOKENS >= u64::from(context)
+        {
+            return Cutoff::ContextWindow {
+                generated: u32::try_from(usage.completion_tokens).unwrap_or(u32::MAX),
+            };
+        }
+        match cap {
+            Some(cap) => Cutoff::TokenCap(cap),
+            None => Cutoff::Unstated,
+        }
+    }
+}
+
+impl std::fmt::Display for Cutoff {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Cutoff::TokenCap(cap) => write!(f, "cut off at the token cap ({cap} tokens)"),
+            Cutoff::ContextWindow { generated } => write!(
+                f,
+                "cut off when the server's context window was full ({generated} tokens generated)"
+            ),
+            Cutoff::Unstated => {
+                f.write_str("cut off by the server (no token cap was sent and no usage reported)")
+            }
+        }
+    }
+}
+
 impl VlmError {
+    /// Where a truncated reply was cut off (`None` for every other error).
+    pub fn cutoff(&self) -> Option<Cutoff> {
+        match self {
+            Self::Truncated {
+                cap, usage, context, ..
+            } => Some(Cutoff::of(*cap, usage.as_ref(), *context)),
+            _ => None,
+        }
+    }
+
     /// The HTTP status, for errors that came with one.
     pub fn status(&self) -> Option<u16> {
         match self {
@@ -162,6 +256,26 @@ impl ProviderError {
         error.message = crate::secret::redact_credentials(&error.message);
         error.body = crate::secret::redact_credentials(&error.body);
         error
+    }
+
+    /// The capability the server says it lacks, when its error says so: llama.cpp answers a
+    /// picture sent to a text-only model with HTTP 500 "image input is not supported". Such
+    /// a refusal is not transient and is never retried.
+    ///
+    /// ```
+    /// use nesy_vlm::ProviderError;
+    /// let body = br#"{"error":{"code":500,"message":"image input is not supported - hint: if this is unexpected, you may need to provide the mmproj","type":"server_error"}}"#;
+    /// assert_eq!(ProviderError::from_body(body).missing_capability(), Some("image input"));
+    /// ```
+    pub fn missing_capability(&self) -> Option<&'static str> {
+        let message = self.message.to_ascii_lowercase();
+        let unsupported = ["not supported", "does not support", "unsupported"]
+            .iter()
+            .any(|phrase| message.contains(phrase));
+        let about_images = ["image", "vision", "multimodal"]
+            .iter()
+            .any(|word| message.contains(word));
+        (unsupported && about_images).then_some("image input")
     }
 
     /// This error with every occurrence of `secret` redacted (the configured key, whatever

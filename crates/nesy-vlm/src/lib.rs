@@ -42,9 +42,11 @@
 //! ```
 //!
 mod accounting;
+mod capabilities;
 mod cassette;
 mod client;
 mod config;
+mod constraint;
 mod error;
 mod profile;
 pub mod reply;
@@ -57,6 +59,7 @@ mod timefmt;
 mod transport;
 
 pub use accounting::{CallRecord, ModelPrice, PriceTable, RunUsage, UsageTotals};
+pub use capabilities::ServerCapabilities;
 pub use cassette::tools as cassette_tools;
 pub use cassette::{
     CassetteError, CassetteFile, CassetteMeta, CassetteMiss, CassetteMode, CassetteOptions,
@@ -65,11 +68,12 @@ pub use cassette::{
 };
 pub use client::VlmClient;
 pub use config::{
-    CASSETTE_USAGE_ENV, CassetteSettings, ConfigError, ConfigOverrides, DEFAULT_AZURE_API_VERSION, EnvSource,
-    ProcessEnv, Timeouts, VlmConfig,
+    CASSETTE_USAGE_ENV, CassetteSettings, ConfigError, ConfigOverrides, DEFAULT_AZURE_API_VERSION,
+    DEFAULT_CLOUD_OUTPUT_TOKENS, EnvSource, ProcessEnv, Timeouts, VlmConfig,
 };
-pub use error::{ProviderError, TimeoutPhase, TransportError, VlmError};
-pub use profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, TokenCapField};
+pub use constraint::{ConstrainMode, ReplyConstraint, ReplyForm, gbnf_literal};
+pub use error::{Cutoff, ProviderError, TimeoutPhase, TransportError, VlmError};
+pub use profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, ReplyCaps, TokenCapField};
 pub use request::{ChatRequest, Image, ImageDetail, Message, Part, ReasoningEffort, Role, TaskContext};
 pub use response::{ChatResponse, FinishReason, Usage};
 pub use retry::RetryPolicy;

@@ -8,6 +8,7 @@ use std::str::FromStr;
 use base64::Engine as _;
 use serde_json::{Map, Value, json};
 
+use crate::constraint::{ConstrainMode, ReplyForm, body_fields, form_for};
 use crate::request::{ChatRequest, ImageDetail, Part, ReasoningEffort};
 
 /// The kind of server.
@@ -52,6 +53,12 @@ impl BackendKind {
             Self::Ollama => Some("http://localhost:11434/v1"),
             Self::LlamaCpp => Some("http://localhost:8080/v1"),
         }
+    }
+
+    /// Whether the backend is a server run by the user (vLLM, Ollama, llama.cpp) rather
+    /// than a hosted API.
+    pub fn is_local(self) -> bool {
+        matches!(self, Self::Vllm | Self::Ollama | Self::LlamaCpp)
     }
 
     /// Whether the backend refuses requests without a key.
@@ -139,17 +146,67 @@ pub enum AuthScheme {
     ApiKeyHeader,
 }
 
+/// Output-token caps by what a call is for, applied when neither the request nor the
+/// configuration sets a cap. A local server generates tens of tokens per second, so an
+/// unbounded reply that runs away costs minutes; each cap leaves room for a full answer of
+/// its kind with a short rationale.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReplyCaps {
+    /// Operator induction (`induce`): an action block.
+    pub induce: u32,
+    /// Refinement (`patch`): one SEARCH/REPLACE block of a few actions.
+    pub patch: u32,
+    /// State translation (`translate`): a list of atoms.
+    pub translate: u32,
+    /// Code generation (`codegen`): a whole policy.
+    pub codegen: u32,
+    /// Every other purpose (the baselines' stages).
+    pub other: u32,
+}
+
+impl ReplyCaps {
+    /// The caps used for local backends (vLLM, Ollama, llama.cpp) by default.
+    pub const LOCAL: ReplyCaps = ReplyCaps {
+        induce: 768,
+        patch: 1024,
+        translate: 768,
+        codegen: 2048,
+        other: 1024,
+    };
+
+    /// The cap for a call labelled `purpose`.
+    ///
+    /// ```
+    /// use nesy_vlm::ReplyCaps;
+    /// assert_eq!(ReplyCaps::LOCAL.cap_for(Some("codegen")), 2048);
+    /// assert_eq!(ReplyCaps::LOCAL.cap_for(Some("gpt4v.plan")), 1024);
+    /// ```
+    pub fn cap_for(&self, purpose: Option<&str>) -> u32 {
+        match purpose {
+            Some("induce") => self.induce,
+            Some("patch") => self.patch,
+            Some("translate") => self.translate,
+            Some("codegen") => self.codegen,
+            _ => self.other,
+        }
+    }
+}
+
 /// Per-call defaults that the profile applies when the request does not set them.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct BodyDefaults {
     /// Default output-token cap.
     pub max_output_tokens: Option<u32>,
+    /// Caps by purpose, for calls that set none when `max_output_tokens` is unset too.
+    pub reply_caps: Option<ReplyCaps>,
     /// Default temperature (ignored for reasoning models).
     pub temperature: Option<f32>,
     /// Default reasoning effort (sent only to reasoning models).
     pub reasoning_effort: Option<ReasoningEffort>,
     /// Default image detail.
     pub image_detail: Option<ImageDetail>,
+    /// Whether a request's [`ReplyConstraint`](crate::ReplyConstraint) is sent.
+    pub constrain: ConstrainMode,
 }
 
 /// A resolved backend profile: everything needed to turn a [`ChatRequest`] into a wire body.
@@ -243,6 +300,25 @@ impl Profile {
         }
     }
 
+    /// The output-token cap `request` is sent with: its own, else the configured default,
+    /// else the cap for its purpose.
+    pub fn output_cap(&self, request: &ChatRequest) -> Option<u32> {
+        request
+            .max_output_tokens
+            .or(self.defaults.max_output_tokens)
+            .or_else(|| {
+                self.defaults
+                    .reply_caps
+                    .map(|caps| caps.cap_for(request.purpose.as_deref()))
+            })
+    }
+
+    /// The form `request`'s reply takes: held to its grammar, to its JSON schema, or free,
+    /// by what this backend takes and the configured [`ConstrainMode`].
+    pub fn reply_form(&self, request: &ChatRequest) -> ReplyForm {
+        form_for(self.kind, self.defaults.constrain, request.constraint.as_ref())
+    }
+
     /// Builds the JSON body for a request. Images become base64 data URLs.
     pub fn build_body(&self, request: &ChatRequest) -> Value {
         let mut body = Map::new();
@@ -257,7 +333,7 @@ impl Profile {
             json!({ "role": message.role.as_str(), "content": content })
         });
         body.insert("messages".into(), Value::Array(messages.collect()));
-        if let Some(cap) = request.max_output_tokens.or(self.defaults.max_output_tokens) {
+        if let Some(cap) = self.output_cap(request) {
             body.insert(self.token_cap_field.as_str().into(), Value::from(cap));
         }
         let temperature = request.temperature.or(self.defaults.temperature);
@@ -272,6 +348,11 @@ impl Profile {
             .filter(|_| self.reasoning)
         {
             body.insert("reasoning_effort".into(), Value::from(effort.as_str()));
+        }
+        if let Some(constraint) = &request.constraint {
+            for (key, value) in body_fields(self.kind, self.reply_form(request), constraint) {
+                body.insert(key, value);
+            }
         }
         for (key, value) in &request.extra {
             body.insert(key.clone(), value.clone());

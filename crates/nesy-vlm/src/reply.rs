@@ -11,26 +11,50 @@
 //! proposals, whose replies nesy-core reads and re-asks within its own attempt budget.
 
 use crate::client::VlmClient;
-use crate::error::VlmError;
+use crate::error::{Cutoff, VlmError};
 use crate::request::{ChatRequest, Message};
 
 /// A reason a reply cannot be used, as one call defines it, with the two reasons every call
 /// shares.
 pub trait ReplyProblem: std::fmt::Display + Sized {
-    /// The reply stopped at the token cap of the request (`None`: the backend's default).
-    fn truncated(cap: Option<u32>) -> Self;
+    /// The reply was cut short: at the request's token cap, or when the context filled.
+    fn truncated(cutoff: Cutoff) -> Self;
     /// The reply's `content` was null and no `reasoning_content` held text.
     fn null_content() -> Self;
     /// The message that goes back to the model with the re-ask.
     fn feedback(&self) -> String;
 }
 
-/// The words for a reply cut off at `cap`, shared by every call's problem type.
-pub fn truncation_text(cap: Option<u32>) -> String {
-    format!(
-        "reply was cut off at the token cap ({})",
-        cap.map_or_else(|| "the backend's default".to_string(), |c| format!("{c} tokens"))
-    )
+/// The words for a reply cut short, shared by every call's problem type.
+pub fn truncation_text(cutoff: Cutoff) -> String {
+    format!("reply was {cutoff}")
+}
+
+/// The most characters of a rejected reply that a re-ask quotes back. A runaway reply of
+/// thousands of tokens would otherwise ride along in every later turn and fill a small
+/// server's context; the start of a reply is what the correction is about.
+pub const QUOTE_LIMIT_CHARS: usize = 1500;
+
+/// `reply` as a re-ask quotes it: whole when short, else its first [`QUOTE_LIMIT_CHARS`]
+/// characters and a note of how much was left out.
+///
+/// ```
+/// use nesy_vlm::reply::{QUOTE_LIMIT_CHARS, quote_for_reask};
+/// assert_eq!(quote_for_reask("- (Open drawer)"), "- (Open drawer)");
+/// let long = "x".repeat(QUOTE_LIMIT_CHARS + 10);
+/// assert!(quote_for_reask(&long).ends_with("[10 more characters of this reply are not repeated here]"));
+/// ```
+pub fn quote_for_reask(reply: &str) -> String {
+    match reply.char_indices().nth(QUOTE_LIMIT_CHARS) {
+        None => reply.to_string(),
+        Some((cut, _)) => {
+            let rest = reply[cut..].chars().count();
+            format!(
+                "{}\n[{rest} more characters of this reply are not repeated here]",
+                &reply[..cut]
+            )
+        }
+    }
 }
 
 /// The words for a reply with null content, shared by every call's problem type.
@@ -90,9 +114,16 @@ where
                 let outcome = read(&response.text).map_err(AskError::Reader)?;
                 (response.text, outcome)
             }
-            Err(VlmError::Truncated { partial_text, .. }) => {
-                (partial_text, Err(P::truncated(chat.max_output_tokens)))
-            }
+            Err(VlmError::Truncated {
+                partial_text,
+                usage,
+                cap,
+                context,
+                ..
+            }) => (
+                partial_text,
+                Err(P::truncated(Cutoff::of(cap, usage.as_ref(), context))),
+            ),
             Err(other) => return Err(AskError::Vlm(other)),
         };
         match outcome {
@@ -110,7 +141,7 @@ where
                     "reply not used, re-asking: {problem}"
                 );
                 chat = chat
-                    .message(Message::assistant(reply.clone()))
+                    .message(Message::assistant(quote_for_reask(&reply)))
                     .message(Message::user_text(problem.feedback()));
                 rejected.push(Rejected { reply, problem });
             }
@@ -125,10 +156,10 @@ where
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum CallProblem {
     /// See [`ReplyProblem::truncated`].
-    #[error("{}", truncation_text(*cap))]
+    #[error("{}", truncation_text(*cutoff))]
     Truncated {
-        /// The request's cap, if it set one.
-        cap: Option<u32>,
+        /// Where the reply was cut.
+        cutoff: Cutoff,
     },
     /// See [`ReplyProblem::null_content`].
     #[error("{NULL_CONTENT_TEXT}")]
@@ -136,8 +167,8 @@ pub enum CallProblem {
 }
 
 impl ReplyProblem for CallProblem {
-    fn truncated(cap: Option<u32>) -> Self {
-        CallProblem::Truncated { cap }
+    fn truncated(cutoff: Cutoff) -> Self {
+        CallProblem::Truncated { cutoff }
     }
 
     fn null_content() -> Self {

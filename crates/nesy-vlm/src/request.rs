@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
+use crate::constraint::ReplyConstraint;
 use crate::error::VlmError;
 
 /// Who speaks a message.
@@ -324,6 +325,8 @@ pub struct ChatRequest {
     pub purpose: Option<String>,
     /// Task context for transports that answer offline. Not sent, not hashed.
     pub task: Option<TaskContext>,
+    /// What the reply must look like; sent in the backend's dialect where it has one.
+    pub constraint: Option<ReplyConstraint>,
     /// Further body fields sent as given (e.g. `seed`, `response_format`), applied last.
     pub extra: serde_json::Map<String, serde_json::Value>,
 }
@@ -376,6 +379,12 @@ impl ChatRequest {
     /// Attaches task context for offline transports.
     pub fn task(mut self, task: TaskContext) -> Self {
         self.task = Some(task);
+        self
+    }
+
+    /// Holds the reply to `constraint` where the backend can.
+    pub fn constraint(mut self, constraint: ReplyConstraint) -> Self {
+        self.constraint = Some(constraint);
         self
     }
 

@@ -215,6 +215,8 @@ pub(crate) fn parse_completion(
                 partial_text: text,
                 usage,
                 request_id,
+                cap: None,
+                context: None,
             }),
             FinishReason::ContentFilter => Some(VlmError::Refusal {
                 reason: "the provider's content filter stopped the output".to_string(),

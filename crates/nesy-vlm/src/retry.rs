@@ -37,7 +37,7 @@ impl Default for RetryPolicy {
 
 /// Whether a non-success response may succeed when repeated.
 pub(crate) fn status_is_retryable(response: &WireResponse, provider: &ProviderError) -> bool {
-    if provider.is_insufficient_quota() {
+    if provider.is_insufficient_quota() || provider.missing_capability().is_some() {
         return false;
     }
     match response.header("x-should-retry").map(str::trim) {

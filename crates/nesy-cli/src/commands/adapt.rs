@@ -16,7 +16,8 @@ use nesy_pipeline::states::{StateSource, StatesMode};
 use nesy_pipeline::synth::CodegenMode;
 use nesy_pipeline::vlm::{VlmSetup, VlmSource};
 use nesy_pipeline::{
-    self as pipeline, AdaptOptions, AdaptRun, DemoInput, LogProgress, NoProgress, Progress, TargetInput,
+    self as pipeline, AdaptOptions, AdaptRun, DemoInput, ImagesMode, LogProgress, NoProgress, PipelineError,
+    Progress, TargetInput,
 };
 use nesy_policy::Limits;
 use nesy_vlm::ConfigOverrides;
@@ -44,6 +45,10 @@ pub(crate) struct AdaptArgs {
     /// ground truth when the demo has it (`auto`).
     #[arg(long, value_enum, default_value_t = StatesMode::Auto)]
     pub states: StatesMode,
+    /// Whether model requests carry the keyframes' pictures: `auto` sends them unless the
+    /// server announces text input only; `never` needs `--states observed`.
+    #[arg(long, value_enum, default_value_t = ImagesMode::Auto)]
+    pub vlm_images: ImagesMode,
     /// Code synthesis: the VLM's code-generation prompt, or the deterministic template compiler.
     #[arg(long, value_enum, default_value_t = CodegenMode::Vlm)]
     pub codegen: CodegenMode,
@@ -74,9 +79,44 @@ pub(crate) struct AdaptArgs {
     pub vlm_config: ConfigOverrides,
 }
 
+/// A run that stopped before it had an outcome of its own. The model's side ending it (no
+/// usable reply, a refused request, an unreachable server) is an outcome of the episode:
+/// it is printed, recorded in `failure.json` and exits 1. Anything else is an error (exit
+/// 2); it too leaves its record behind, except bad input, which stops before the run.
+fn stopped(
+    error: &PipelineError,
+    target: &TargetInput,
+    options: &AdaptOptions,
+    calls: &nesy_vlm::RunUsage,
+    elapsed: Duration,
+) -> anyhow::Result<ExitCode> {
+    let reason = error.stop_reason();
+    let recorded =
+        RunDir::create(&options.out_dir).and_then(|dir| dir.write_failure(target, error, calls, elapsed));
+    let record = match recorded {
+        Ok(Some(path)) => format!("; {} records why", path.display()),
+        Ok(None) => String::new(),
+        Err(write_error) => format!("; the failure could not be recorded: {write_error}"),
+    };
+    if reason.is_model_side() {
+        outln!(
+            "nesy adapt: {}\n  reason    {error}\n  calls     {} model call(s) in {:.1} s{record}",
+            reason.as_str().to_uppercase(),
+            calls.total.calls,
+            elapsed.as_secs_f64()
+        )?;
+        return Ok(ExitCode::from(1));
+    }
+    if !record.is_empty() {
+        eprintln!("nesy adapt: the run stopped before an outcome{record}");
+    }
+    Err(anyhow::anyhow!("{error}"))
+}
+
 /// Runs `nesy adapt`: exit 0 when the procedure was adapted, compiled and (with `--execute`)
-/// succeeded; 1 when the adaptation is unresolved, code generation failed or the policy
-/// failed; 2 on bad input.
+/// succeeded; 1 when the adaptation is unresolved, code generation failed, the policy
+/// failed, or the model gave no usable reply, refused the request or could not be reached;
+/// 2 on bad input.
 pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     let options = options(&args)?;
     let setup = VlmSetup {
@@ -101,27 +141,14 @@ pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
         .enable_all()
         .build()
         .context("starting the async runtime")?;
+    let started = std::time::Instant::now();
+    // The clone shares the client's accounting, so the calls made before a stop are known.
+    let calls = client.clone();
     let run = match runtime.block_on(pipeline::run(&demo, &target, client, &options, progress.clone())) {
         Ok(run) => run,
         Err(error) => {
             progress.stage("");
-            // A run that stops before it has an outcome still leaves its record behind (bad
-            // input stops before the run and writes nothing).
-            if !error.is_bad_input() {
-                let recorded =
-                    RunDir::create(&options.out_dir).and_then(|dir| dir.write_failure(&target, &error));
-                match recorded {
-                    Ok(Some(path)) => eprintln!(
-                        "nesy adapt: the run stopped before an outcome; {} records why",
-                        path.display()
-                    ),
-                    Ok(None) => {}
-                    Err(write_error) => {
-                        eprintln!("nesy adapt: the failure could not be recorded: {write_error}")
-                    }
-                }
-            }
-            return Err(error.into());
+            return stopped(&error, &target, &options, &calls.usage(), started.elapsed());
         }
     };
     progress.stage("writing the outputs");
@@ -164,6 +191,7 @@ fn options(args: &AdaptArgs) -> anyhow::Result<AdaptOptions> {
         states: args.states,
         codegen: args.codegen,
         execute: args.execute,
+        images: args.vlm_images,
         budget: args.budget,
         adapt: AdaptConfig {
             induction_tries: args.induction_tries,

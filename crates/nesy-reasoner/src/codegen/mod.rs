@@ -103,10 +103,10 @@ pub enum ProgramProblem {
         error: ExtractError,
     },
     /// The reply stopped at the token cap.
-    #[error("{}", reply::truncation_text(*cap))]
+    #[error("{}", reply::truncation_text(*cutoff))]
     Truncated {
-        /// The request's cap, if it set one.
-        cap: Option<u32>,
+        /// Where the reply was cut.
+        cutoff: nesy_vlm::Cutoff,
     },
     /// The reply's `content` was null and no `reasoning_content` held text.
     #[error("{}", reply::NULL_CONTENT_TEXT)]
@@ -126,8 +126,8 @@ pub enum ProgramProblem {
 }
 
 impl ReplyProblem for ProgramProblem {
-    fn truncated(cap: Option<u32>) -> Self {
-        ProgramProblem::Truncated { cap }
+    fn truncated(cutoff: nesy_vlm::Cutoff) -> Self {
+        ProgramProblem::Truncated { cutoff }
     }
 
     fn null_content() -> Self {

@@ -47,6 +47,10 @@ pub struct CassetteMeta {
     /// The backend label of the recording transport (e.g. `http openai`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub backend: Option<String>,
+    /// What the recorded server announced it can take; a replay sizes its requests by it,
+    /// as the recording did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub server: Option<crate::capabilities::ServerCapabilities>,
 }
 
 /// One recorded call.
@@ -170,6 +174,7 @@ impl CassetteFile {
                 updated_at: now,
                 model,
                 backend,
+                server: None,
             },
             interactions: Vec::new(),
         }

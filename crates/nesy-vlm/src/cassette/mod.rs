@@ -20,6 +20,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use crate::capabilities::ServerCapabilities;
 use crate::error::{TransportError, VlmError};
 use crate::secret::SecretString;
 use crate::transport::{BoxFuture, Origin, Transport, WireRequest, WireResponse};
@@ -201,6 +202,13 @@ struct ReplayState {
     used: Vec<bool>,
 }
 
+/// What the server announced: as the file recorded it, and as this run read it live.
+#[derive(Default)]
+struct Announced {
+    recorded: Option<ServerCapabilities>,
+    probed: Option<ServerCapabilities>,
+}
+
 /// A transport that replays from, and records to, a cassette file.
 pub struct CassetteTransport {
     path: PathBuf,
@@ -212,6 +220,7 @@ pub struct CassetteTransport {
     records: bool,
     recorded: Vec<Recorded>,
     replay: Mutex<ReplayState>,
+    announced: Mutex<Announced>,
     /// Serialises writes within the process (the lock file does so across processes) and
     /// remembers whether `all` mode has discarded the old recording yet.
     writer: Mutex<bool>,
@@ -250,8 +259,10 @@ impl CassetteTransport {
         }
         let mut recorded = Vec::new();
         let mut state = ReplayState::default();
+        let mut announced = Announced::default();
         if existed && replays {
             let file = CassetteFile::load(&path)?;
+            announced.recorded = file.meta.server.clone();
             let mut occurrences: HashMap<String, usize> = HashMap::new();
             for (index, interaction) in file.interactions.into_iter().enumerate() {
                 let key = request_key(&interaction.request.path, &interaction.request.body);
@@ -286,6 +297,7 @@ impl CassetteTransport {
             records,
             recorded,
             replay: Mutex::new(state),
+            announced: Mutex::new(announced),
             writer: Mutex::new(false),
         })
     }
@@ -450,6 +462,13 @@ impl CassetteTransport {
         file.meta.updated_at = interaction.recorded_at.clone();
         file.meta.model = model.or_else(|| self.options.model.clone()).or(file.meta.model);
         file.meta.backend = backend.or(file.meta.backend);
+        let probed = self
+            .announced
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+            .probed
+            .clone();
+        file.meta.server = probed.or(file.meta.server);
         file.interactions.push(interaction);
         write_atomically(&self.path, file.to_pretty_json(&self.options.redact).as_bytes())
     }
@@ -497,6 +516,31 @@ impl Transport for CassetteTransport {
             ),
             None => format!("cassette {} ({})", self.path.display(), self.mode),
         }
+    }
+
+    fn capabilities(&self) -> BoxFuture<'_, ServerCapabilities> {
+        Box::pin(async move {
+            let recorded = self
+                .announced
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner())
+                .recorded
+                .clone();
+            if let Some(recorded) = recorded.filter(|_| self.replays) {
+                return recorded;
+            }
+            let Some(inner) = self.inner.as_ref().filter(|_| self.records) else {
+                return ServerCapabilities::UNKNOWN;
+            };
+            let live = inner.capabilities().await;
+            if live != ServerCapabilities::UNKNOWN {
+                self.announced
+                    .lock()
+                    .unwrap_or_else(|poisoned| poisoned.into_inner())
+                    .probed = Some(live.clone());
+            }
+            live
+        })
     }
 
     fn finish(&self) -> Result<(), VlmError> {

@@ -6,8 +6,10 @@ use std::sync::Once;
 use reqwest::header::{CONTENT_TYPE, HeaderMap, HeaderValue};
 
 use super::{BoxFuture, Origin, Transport, WireRequest, WireResponse, is_allowed_header};
+use crate::capabilities::ServerCapabilities;
 use crate::config::Timeouts;
 use crate::error::{TimeoutPhase, TransportError};
+use crate::profile::BackendKind;
 use crate::secret::SecretString;
 
 /// How requests authenticate.
@@ -38,6 +40,8 @@ pub struct HttpTransport {
     auth_headers: HeaderMap,
     auth_kind: &'static str,
     label: String,
+    /// Which server's announcement to read, and for which model.
+    probe: Option<(BackendKind, String)>,
 }
 
 impl fmt::Debug for HttpTransport {
@@ -117,6 +121,60 @@ impl HttpTransport {
             auth_headers,
             auth_kind,
             label: label.into(),
+            probe: None,
+        })
+    }
+
+    /// Reads what the server announces before the first call: llama.cpp's `/props` (image
+    /// input, context window) or vLLM's `/models` (context window). Other backends announce
+    /// nothing and are not asked.
+    pub fn with_probe(mut self, backend: BackendKind, model: impl Into<String>) -> Self {
+        self.probe = Some((backend, model.into()));
+        self
+    }
+
+    async fn get_json(&self, url: &str) -> Result<serde_json::Value, String> {
+        let response = self
+            .client
+            .get(url)
+            .headers(self.auth_headers.clone())
+            .send()
+            .await
+            .map_err(|e| classify(e).to_string())?;
+        let status = response.status();
+        if !status.is_success() {
+            return Err(format!("HTTP {}", status.as_u16()));
+        }
+        let bytes = response.bytes().await.map_err(|e| classify(e).to_string())?;
+        serde_json::from_slice(&bytes).map_err(|e| format!("not JSON: {e}"))
+    }
+
+    async fn probe_capabilities(&self) -> ServerCapabilities {
+        let Some((backend, model)) = &self.probe else {
+            return ServerCapabilities::UNKNOWN;
+        };
+        let read = match backend {
+            BackendKind::LlamaCpp => {
+                // `/props` lives at the server's root, beside `/v1`.
+                let root = self.base_url.strip_suffix("/v1").unwrap_or(&self.base_url);
+                let url = format!("{root}/props");
+                self.get_json(&url)
+                    .await
+                    .map(|props| ServerCapabilities::from_llamacpp_props(&props))
+                    .map_err(|e| (url, e))
+            }
+            BackendKind::Vllm => {
+                let url = format!("{}/models", self.base_url);
+                self.get_json(&url)
+                    .await
+                    .map(|list| ServerCapabilities::from_models_list(&list, model))
+                    .map_err(|e| (url, e))
+            }
+            _ => return ServerCapabilities::UNKNOWN,
+        };
+        read.unwrap_or_else(|(url, error)| {
+            tracing::warn!("could not read what the server announces at {url} ({error}); assuming nothing");
+            ServerCapabilities::UNKNOWN
         })
     }
 
@@ -201,5 +259,9 @@ impl Transport for HttpTransport {
 
     fn label(&self) -> String {
         self.label.clone()
+    }
+
+    fn capabilities(&self) -> BoxFuture<'_, ServerCapabilities> {
+        Box::pin(self.probe_capabilities())
     }
 }

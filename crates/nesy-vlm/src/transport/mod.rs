@@ -10,6 +10,7 @@ use std::sync::Arc;
 
 use bytes::Bytes;
 
+use crate::capabilities::ServerCapabilities;
 use crate::error::{TransportError, VlmError};
 use crate::request::TaskContext;
 
@@ -143,6 +144,12 @@ pub trait Transport: Send + Sync + fmt::Debug {
     fn finish(&self) -> Result<(), VlmError> {
         Ok(())
     }
+
+    /// What the server behind this transport announces it can take. The client asks once,
+    /// before its first call. The default announces nothing.
+    fn capabilities(&self) -> BoxFuture<'_, ServerCapabilities> {
+        Box::pin(async { ServerCapabilities::UNKNOWN })
+    }
 }
 
 impl<T: Transport + ?Sized> Transport for Arc<T> {
@@ -154,5 +161,8 @@ impl<T: Transport + ?Sized> Transport for Arc<T> {
     }
     fn finish(&self) -> Result<(), VlmError> {
         (**self).finish()
+    }
+    fn capabilities(&self) -> BoxFuture<'_, ServerCapabilities> {
+        (**self).capabilities()
     }
 }

@@ -27,8 +27,16 @@ fn simple_request() -> ChatRequest {
         .purpose("describe")
 }
 
+/// The one POST the server received (a local backend's client also reads what the server
+/// announces, with a GET, before its first call).
 async fn only_request(server: &MockServer) -> (Value, wiremock::Request) {
-    let requests = server.received_requests().await.expect("recording is on");
+    let requests: Vec<wiremock::Request> = server
+        .received_requests()
+        .await
+        .expect("recording is on")
+        .into_iter()
+        .filter(|r| r.method == wiremock::http::Method::POST)
+        .collect();
     assert_eq!(requests.len(), 1, "exactly one request expected");
     let request = requests.into_iter().next().unwrap();
     (serde_json::from_slice(&request.body).expect("JSON body"), request)
