@@ -55,11 +55,23 @@ usage() {
   exit "${1:-0}"
 }
 
+# The build tools, installed from the system's packages where that is possible (Debian and
+# Ubuntu, as root or with sudo), else named.
 need_tools() {
   local missing=()
   for tool in "$@"; do command -v "$tool" >/dev/null 2>&1 || missing+=("$tool"); done
   [ ${#missing[@]} -eq 0 ] && return 0
-  die "missing ${missing[*]}; on Debian or Ubuntu: apt-get install cmake g++ make curl python3-pip"
+  if command -v apt-get >/dev/null 2>&1 && { [ "$(id -u)" -eq 0 ] || command -v sudo >/dev/null 2>&1; }; then
+    say "installing cmake, g++ and make from the system's packages (missing: ${missing[*]})"
+    local run=()
+    [ "$(id -u)" -eq 0 ] || run=(sudo)
+    "${run[@]}" apt-get update -qq >&2 &&
+      DEBIAN_FRONTEND=noninteractive "${run[@]}" apt-get install -y -qq --no-install-recommends \
+        cmake g++ make curl ca-certificates >&2 ||
+      die "could not install cmake, g++ and make with apt-get"
+    return 0
+  fi
+  die "missing ${missing[*]}; install cmake, a C++ compiler, make and curl, then run this again"
 }
 
 sha256_of() { sha256sum "$1" | cut -d' ' -f1; }

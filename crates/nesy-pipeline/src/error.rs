@@ -157,3 +157,49 @@ impl PipelineError {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nesy_core::adapt::ReasonerError;
+
+    fn reasoner(kind: ReasonerErrorKind) -> PipelineError {
+        PipelineError::Adapt(AdaptError::Reasoner(ReasonerError::new(kind, "x")))
+    }
+
+    #[test]
+    fn stops_on_the_model_side_are_outcomes_and_the_rest_errors() {
+        use StopReason as S;
+        let cases = [
+            (reasoner(ReasonerErrorKind::Reply), S::NoUsableReply),
+            (reasoner(ReasonerErrorKind::Exhausted), S::NoUsableReply),
+            (reasoner(ReasonerErrorKind::Refused), S::RequestRefused),
+            (reasoner(ReasonerErrorKind::Transport), S::ModelUnreachable),
+            (reasoner(ReasonerErrorKind::Replay), S::ReplayMismatch),
+            (reasoner(ReasonerErrorKind::Request), S::BadInput),
+            (
+                PipelineError::Adapt(AdaptError::NoOperator { step: 1, attempts: 5 }),
+                S::NoUsableReply,
+            ),
+            (
+                PipelineError::States {
+                    message: "no pictures".into(),
+                    kind: Some(ReasonerErrorKind::Refused),
+                },
+                S::RequestRefused,
+            ),
+            (PipelineError::VlmSetup { message: "x".into() }, S::BadInput),
+            (PipelineError::Finish { message: "x".into() }, S::Internal),
+        ];
+        for (error, expected) in cases {
+            assert_eq!(error.stop_reason(), expected, "{error}");
+            assert_eq!(
+                expected.is_model_side(),
+                matches!(
+                    expected,
+                    S::NoUsableReply | S::RequestRefused | S::ModelUnreachable
+                )
+            );
+        }
+    }
+}

@@ -219,3 +219,113 @@ pub fn translation_constraint(symbols: &Symbols) -> ReplyConstraint {
         json_schema: None,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nesy_core::text::{
+        normalize_reply, parse_induction_reply, parse_procedure, parse_refinement_reply, parse_state_list,
+    };
+
+    fn symbols() -> Symbols {
+        Symbols {
+            predicates: vec![
+                ("GripperOpen".into(), 0),
+                ("OnTopOf".into(), 2),
+                ("Open".into(), 1),
+            ],
+            objects: vec!["red_cube".into(), "floor".into()],
+        }
+    }
+
+    const LITERALS: &str = r#"pred0 ::= "GripperOpen"
+pred1 ::= "Open"
+pred2 ::= "OnTopOf"
+obj ::= "red_cube" | "floor"
+arg ::= obj | "?x"
+atom ::= "(" (pred0 | pred1 " " obj | pred2 " " obj " " obj) ")"
+qatom ::= "(" (pred0 | pred1 " " arg | pred2 " " arg " " arg) ")"
+literal ::= atom | "(not " atom ")" | "(forall (?x - thing) " qliteral ")"
+qliteral ::= qatom | "(not " qatom ")"
+"#;
+
+    #[test]
+    fn induction_grammar_is_the_prompt_layout_over_the_symbols() {
+        let expected = format!(
+            r#"root ::= "* Prediction Rationale:\n" reason{{1,4}} "* Predicted Action:\nAction Semantic:\n- " line "\nPrecondition:\n" pre "Effect:\n" eff
+pre ::= "None\n" | ("- " literal "\n"){{1,12}}
+eff ::= ("- " literal "\n"){{1,12}}
+reason ::= "- " line "\n"
+line ::= [^\n]{{1,200}}
+{LITERALS}"#
+        );
+        assert_eq!(induction_constraint(&symbols()).grammar, expected);
+    }
+
+    #[test]
+    fn translation_grammar_lists_atoms_or_none() {
+        let expected = format!("root ::= \"None\\n\" | (\"- \" atom \"\\n\"){{1,48}}\n{LITERALS}");
+        assert_eq!(translation_constraint(&symbols()).grammar, expected);
+    }
+
+    #[test]
+    fn patch_grammar_quotes_runs_of_the_procedure() {
+        let procedure = parse_procedure(
+            "OpenDrawer\n- Preconditions:\n\t(GripperOpen)\n- Effects:\n\t(Open floor)\n\n\
+             PlaceCube\n- Preconditions:\n\tNone\n- Effects:\n\t(OnTopOf red_cube floor)",
+        )
+        .unwrap();
+        let expected = format!(
+            r#"root ::= "* Refinement rationale:\n" reason{{1,4}} "\n* Refinement patch:\n<<<<<<< SEARCH\n" search "=======\n" replace ">>>>>>> REPLACE\n"
+replace ::= "" | block ("\n" block){{0,5}}
+block ::= name "\n- Preconditions:\n" ("\tNone\n" | ("\t" literal "\n"){{1,12}}) "- Effects:\n" ("\t" literal "\n"){{1,12}}
+name ::= [A-Za-z] [A-Za-z0-9_]{{0,79}}
+search ::= (step0) | (step0 "\n" step1) | (step1)
+step0 ::= "OpenDrawer\n- Preconditions:\n\t(GripperOpen)\n- Effects:\n\t(Open floor)\n"
+step1 ::= "PlaceCube\n- Preconditions:\n\tNone\n- Effects:\n\t(OnTopOf red_cube floor)\n"
+reason ::= "- " line "\n"
+line ::= [^\n]{{1,200}}
+{LITERALS}"#
+        );
+        assert_eq!(patch_constraint(&symbols(), &procedure).grammar, expected);
+    }
+
+    /// Replies written the way each grammar allows are read by the parsers the loop uses.
+    #[test]
+    fn replies_the_grammars_allow_parse() {
+        let induction = "* Prediction Rationale:\n- The cube was put down.\n* Predicted Action:\nAction Semantic:\n- place the cube\nPrecondition:\n- (not (OnTopOf red_cube floor))\n- (forall (?x - thing) (not (Open ?x)))\nEffect:\n- (OnTopOf red_cube floor)\n";
+        let parsed = parse_induction_reply(&normalize_reply(induction)).unwrap();
+        assert_eq!(parsed.operator.pre.len(), 2);
+
+        let procedure = parse_procedure(
+            "OpenDrawer\n- Preconditions:\n\t(GripperOpen)\n- Effects:\n\t(Open floor)\n\n\
+             PlaceCube\n- Preconditions:\n\tNone\n- Effects:\n\t(OnTopOf red_cube floor)",
+        )
+        .unwrap();
+        let patch = format!(
+            "* Refinement rationale:\n- Drop the opening.\n\n* Refinement patch:\n<<<<<<< SEARCH\n{}\n\n{}\n=======\n{}\n>>>>>>> REPLACE\n",
+            procedure[0], procedure[1], procedure[1]
+        );
+        let parsed = parse_refinement_reply(&normalize_reply(&patch)).unwrap();
+        assert_eq!(parsed.patches[0].search, procedure);
+        assert_eq!(parsed.patches[0].replace, procedure[1..]);
+
+        let state =
+            parse_state_list(&normalize_reply("- (GripperOpen)\n- (OnTopOf red_cube floor)\n")).unwrap();
+        assert_eq!(state.len(), 2);
+        assert!(parse_state_list(&normalize_reply("None\n")).unwrap().is_empty());
+    }
+
+    #[test]
+    fn symbols_take_objects_from_the_states_once() {
+        let state = parse_state_list("- (OnTopOf red_cube table)").unwrap();
+        let symbols = Symbols::new(&Vocabulary::new(), Tier::Full, ["red_cube"], [&state]);
+        assert_eq!(symbols.objects, ["red_cube", "table"]);
+        assert!(
+            symbols
+                .predicates
+                .iter()
+                .any(|(name, arity)| name == "OnTopOf" && *arity == 2)
+        );
+    }
+}

@@ -8,4 +8,5 @@
 mod cassette;
 mod client;
 mod fixtures;
+mod server_fit;
 mod transport;
