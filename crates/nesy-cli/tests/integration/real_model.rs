@@ -82,9 +82,12 @@ fn run_limited(args: &[String], env: &[(String, String)]) -> (i32, String) {
 /// directory.
 fn comparable(run: &Path, name: &str) -> String {
     let path = run.join(name);
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .replace(&run.display().to_string(), "<run>");
+    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let Ok(text) = String::from_utf8(bytes.clone()) else {
+        // Pictures of the scene: compared byte for byte.
+        return format!("{} bytes, {:x?}", bytes.len(), &bytes[..bytes.len().min(64)]) + &checksum(&bytes);
+    };
+    let text = text.replace(&run.display().to_string(), "<run>");
     if path.extension().is_some_and(|e| e == "json") {
         let mut value: Value = serde_json::from_str(&text).unwrap();
         strip_times(&mut value);
@@ -98,6 +101,14 @@ fn comparable(run: &Path, name: &str) -> String {
             .collect::<Vec<_>>()
             .join("\n")
     }
+}
+
+/// A checksum of `bytes` (FNV-1a), enough to tell two files apart in a test.
+fn checksum(bytes: &[u8]) -> String {
+    let hash = bytes
+        .iter()
+        .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| (h ^ u64::from(*b)).wrapping_mul(0x100_0000_01b3));
+    format!(" fnv {hash:016x}")
 }
 
 fn strip_times(value: &mut Value) {
