@@ -150,7 +150,7 @@ pub fn induction_constraint(symbols: &Symbols) -> ReplyConstraint {
 
 /// The refinement reply: rationale lines, then one SEARCH/REPLACE block whose SEARCH side
 /// quotes consecutive actions of `procedure` exactly as the prompt printed them (at most
-/// [`SEARCH_SPAN`] of them), and whose REPLACE side holds whole action blocks over
+/// eight of them), and whose REPLACE side holds whole action blocks over
 /// `symbols` (or nothing, to delete).
 ///
 /// ```

@@ -105,9 +105,9 @@ fn comparable(run: &Path, name: &str) -> String {
 
 /// A checksum of `bytes` (FNV-1a), enough to tell two files apart in a test.
 fn checksum(bytes: &[u8]) -> String {
-    let hash = bytes
-        .iter()
-        .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| (h ^ u64::from(*b)).wrapping_mul(0x100_0000_01b3));
+    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+        (h ^ u64::from(*b)).wrapping_mul(0x100_0000_01b3)
+    });
     format!(" fnv {hash:016x}")
 }
 
