@@ -129,13 +129,17 @@ impl VlmReasoner {
             request: request.clone(),
             embodiment: self.source,
         });
-        let symbols = Symbols::of_task(&request.task, [&request.previous, &request.next]);
-        let mut chat = ChatRequest::new()
+        let chat = ChatRequest::new()
             .purpose(context.purpose())
             .task(context.to_task_context())
-            .constraint(constraints::induction_constraint(&symbols))
             .message(Message::system(rendered.system))
             .message(Message::user(parts));
+        let mut chat = self.client.constrain(chat, || {
+            constraints::induction_constraint(&Symbols::of_task(
+                &request.task,
+                [&request.previous, &request.next],
+            ))
+        });
         chat = self.follow_ups(chat, &request.feedback, |f| self.prompts.induction_feedback(f))?;
         Ok(self.settings.induce.apply(chat))
     }
@@ -149,13 +153,15 @@ impl VlmReasoner {
             request: request.clone(),
             target_embodiment: self.target,
         });
-        let symbols = Symbols::of_task(&request.task, [&request.initial_state, &request.error_state]);
-        let mut chat = ChatRequest::new()
+        let chat = ChatRequest::new()
             .purpose(context.purpose())
             .task(context.to_task_context())
-            .constraint(constraints::patch_constraint(&symbols, &request.procedure))
             .message(Message::system(rendered.system))
             .message(Message::user_text(rendered.user));
+        let mut chat = self.client.constrain(chat, || {
+            let symbols = Symbols::of_task(&request.task, [&request.initial_state, &request.error_state]);
+            constraints::patch_constraint(&symbols, &request.procedure)
+        });
         chat = self.follow_ups(chat, &request.feedback, |f| self.prompts.refinement_feedback(f))?;
         Ok(self.settings.patch.apply(chat))
     }

@@ -173,7 +173,8 @@ impl TranslateError {
     }
 }
 
-/// Builds the state-translation chat request without sending it.
+/// Builds the state-translation chat request without sending it, and without the reply
+/// constraint that [`translate_state`] attaches when its client sends one.
 pub fn build_request(
     prompts: &Prompts,
     request: &StateTranslationRequest,
@@ -197,16 +198,9 @@ pub fn build_request(
     });
     let mut parts = vec![Part::text(rendered.user)];
     parts.extend(request.views.parts("The scene"));
-    let symbols = Symbols::new(
-        &request.vocabulary,
-        request.tier,
-        request.objects.iter().map(String::as_str),
-        [&request.known],
-    );
     let chat = ChatRequest::new()
         .purpose(context.purpose())
         .task(context.to_task_context())
-        .constraint(constraints::translation_constraint(&symbols))
         .message(Message::system(rendered.system))
         .message(Message::user(parts));
     Ok(settings.apply(chat))
@@ -264,7 +258,11 @@ pub async fn translate_state(
     request: &StateTranslationRequest,
     settings: &CallSettings,
 ) -> Result<TranslatedState, TranslateError> {
-    let chat = build_request(prompts, request, settings)?;
+    let chat = client.constrain(build_request(prompts, request, settings)?, || {
+        let objects = request.objects.iter().map(String::as_str);
+        let symbols = Symbols::new(&request.vocabulary, request.tier, objects, [&request.known]);
+        constraints::translation_constraint(&symbols)
+    });
     let what = format!("state translation for {}", request.view_set);
     let answer = reply::ask_until_usable(client, chat, TRANSLATION_ATTEMPTS, &what, |text| {
         Ok::<_, std::convert::Infallible>(read_translation(text, request))

@@ -53,12 +53,11 @@ impl ServerCapabilities {
                     .and_then(Value::as_array)
                     .map(|list| list.iter().any(|m| m.as_str() == Some("image")))
             });
-        let context = props
-            .pointer("/default_generation_settings/n_ctx")
-            .or_else(|| props.pointer("/n_ctx"))
-            .and_then(Value::as_u64)
-            .and_then(|n| u32::try_from(n).ok())
-            .filter(|&n| n > 0);
+        let context = token_count(
+            props
+                .pointer("/default_generation_settings/n_ctx")
+                .or_else(|| props.pointer("/n_ctx")),
+        );
         ServerCapabilities {
             images: vision,
             context_tokens: context,
@@ -81,11 +80,7 @@ impl ServerCapabilities {
                 .find(|m| m.get("id").and_then(Value::as_str) == Some(model))
                 .or(if list.len() == 1 { list.first() } else { None })
         });
-        let context = entry
-            .and_then(|m| m.get("max_model_len"))
-            .and_then(Value::as_u64)
-            .and_then(|n| u32::try_from(n).ok())
-            .filter(|&n| n > 0);
+        let context = token_count(entry.and_then(|m| m.get("max_model_len")));
         ServerCapabilities {
             images: None,
             context_tokens: context,
@@ -102,6 +97,14 @@ impl ServerCapabilities {
     pub fn source_label(&self) -> &str {
         self.source.as_deref().unwrap_or("the server")
     }
+}
+
+/// A positive token count that fits in `u32`, or `None`.
+fn token_count(value: Option<&Value>) -> Option<u32> {
+    value
+        .and_then(Value::as_u64)
+        .and_then(|n| u32::try_from(n).ok())
+        .filter(|&n| n > 0)
 }
 
 /// The first value of `key` anywhere in `value` (depth first).

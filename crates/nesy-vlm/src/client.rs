@@ -31,12 +31,12 @@ const FIRST_FOLLOW_UP: usize = 2;
 /// latest exchange.
 fn oldest_follow_up_is_droppable(request: &ChatRequest) -> bool {
     use crate::request::Role;
-    let roles: Vec<Role> = request.messages.iter().map(|m| m.role).collect();
-    roles.len() > FIRST_FOLLOW_UP + 2
-        && matches!(roles[0], Role::System | Role::Developer)
-        && roles[1] == Role::User
-        && roles[FIRST_FOLLOW_UP] == Role::Assistant
-        && roles[FIRST_FOLLOW_UP + 1] == Role::User
+    let role = |i: usize| request.messages[i].role;
+    request.messages.len() > FIRST_FOLLOW_UP + 2
+        && matches!(role(0), Role::System | Role::Developer)
+        && role(1) == Role::User
+        && role(FIRST_FOLLOW_UP) == Role::Assistant
+        && role(FIRST_FOLLOW_UP + 1) == Role::User
 }
 
 /// [`estimate_prompt_tokens`] of a whole request.
@@ -235,6 +235,20 @@ impl VlmClient {
         self.inner.profile.output_cap(request)
     }
 
+    /// `chat` with the constraint `build` makes, when this client sends constraints at all
+    /// (`constrain = auto`); under `off` the constraint is not even built, so callers that
+    /// never send one (the offline responder) pay nothing for it.
+    pub fn constrain(
+        &self,
+        chat: ChatRequest,
+        build: impl FnOnce() -> crate::constraint::ReplyConstraint,
+    ) -> ChatRequest {
+        match self.inner.profile.defaults.constrain {
+            crate::constraint::ConstrainMode::Auto => chat.constraint(build()),
+            crate::constraint::ConstrainMode::Off => chat,
+        }
+    }
+
     /// The form `request`'s reply takes under this client's backend and constrain mode
     /// ([`Profile::reply_form`]).
     pub fn reply_form(&self, request: &ChatRequest) -> crate::constraint::ReplyForm {
@@ -318,21 +332,12 @@ impl VlmClient {
             Ok(response) => self.read_success(response, attempts, started),
             Err(err) => (Err(err), None),
         };
-        let outcome = outcome.map_err(|error| match error {
-            VlmError::Truncated {
-                partial_text,
-                usage,
-                request_id,
-                ..
-            } => VlmError::Truncated {
-                partial_text,
-                usage,
-                request_id,
-                cap: sent_cap,
-                context: caps.context_tokens,
-            },
-            other => other,
-        });
+        let mut outcome = outcome;
+        // Only the client knows what the request was sent with; the cut is judged by it.
+        if let Err(VlmError::Truncated { cap, context, .. }) = &mut outcome {
+            *cap = sent_cap;
+            *context = caps.context_tokens;
+        }
         let record = CallRecord {
             model: self.inner.profile.model.clone(),
             purpose: request.purpose.clone(),
