@@ -14,7 +14,9 @@
 # Progress goes to stderr; stdout carries only the `export` lines.
 #
 # Settings (environment): NESY_LOCAL_MODEL_HOME; NESY_LOCAL_MODEL_CTX, the server's context
-# window in tokens (8192); NESY_LOCAL_MODEL_THREADS, generation threads (all cores);
+# window in tokens per request (8192); NESY_LOCAL_MODEL_SLOTS, requests served at once (1;
+# a benchmark with several units in flight uses 2, so that each keeps its prompt prefix
+# cached in its own slot); NESY_LOCAL_MODEL_THREADS, generation threads (all cores);
 # NESY_LOCAL_MODEL_JOBS, parallel compile jobs for the one-time build (all cores).
 set -euo pipefail
 
@@ -35,6 +37,7 @@ INDEX=${NESY_LOCAL_MODEL_INDEX:-https://pypi.org/simple}
 
 HOME_DIR=${NESY_LOCAL_MODEL_HOME:-${XDG_CACHE_HOME:-$HOME/.cache}/nesy/local-model}
 CTX=${NESY_LOCAL_MODEL_CTX:-8192}
+SLOTS=${NESY_LOCAL_MODEL_SLOTS:-1}
 CORES=$(nproc 2>/dev/null || echo 2)
 THREADS=${NESY_LOCAL_MODEL_THREADS:-$CORES}
 JOBS=${NESY_LOCAL_MODEL_JOBS:-$CORES}
@@ -226,10 +229,10 @@ start() {
     return
   fi
   port=${NESY_LOCAL_MODEL_PORT:-$(free_port)}
-  say "starting llama-server on 127.0.0.1:$port (context $CTX tokens, $THREADS thread(s)); log $LOG"
-  # One slot, so the whole context window belongs to the one request nesy sends at a time.
+  say "starting llama-server on 127.0.0.1:$port ($SLOTS slot(s) of $CTX tokens, $THREADS thread(s)); log $LOG"
+  # The server splits its context among the slots, so each slot gets the full window.
   setsid "$SERVER" --model "$MODEL" --alias "$MODEL_ALIAS" --host 127.0.0.1 --port "$port" \
-    --ctx-size "$CTX" --parallel 1 --threads "$THREADS" --jinja \
+    --ctx-size "$((CTX * SLOTS))" --parallel "$SLOTS" --threads "$THREADS" --jinja \
     --chat-template-file "$TEMPLATE" --no-webui --metrics --props \
     >"$LOG" 2>&1 </dev/null &
   pid=$!

@@ -11,7 +11,7 @@
 //! lines never match and the edit is silently not applied; a numbered REPLACE line keeps its
 //! number in the action's text. [`Fidelity::Repaired`] reads both without list numbers.
 
-use nesy_vlm::{Part, VlmClient};
+use nesy_vlm::{Part, ReplyLength, VlmClient};
 use serde::Serialize;
 
 use crate::demo2code::observe_all;
@@ -69,6 +69,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
         parts: vec![Part::text(user)],
         expected: NUMBERED_PLAN,
         fidelity: inputs.fidelity,
+        length: ReplyLength::Open,
         client,
     }
     .ask(numbered_plan)
@@ -89,13 +90,14 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
             },
         )?;
         let mut parts = vec![Part::text(user)];
-        parts.extend(inputs.target_views.parts("scene"));
+        parts.extend(inputs.target_observation.parts("scene"));
         let (feedback, record) = Stage {
             purpose: FEEDBACK,
             system,
             parts,
             expected: "Give your feedback as one line that starts with \"- \"; write \"No issue\" there if the plan works.",
             fidelity: inputs.fidelity,
+            length: ReplyLength::Open,
             client,
         }
         .ask(|reply| {
@@ -124,6 +126,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
             parts: vec![Part::text(user)],
             expected: "Give your diagnosis, then an empty line, then the edits as SEARCH/REPLACE blocks.",
             fidelity: inputs.fidelity,
+            length: ReplyLength::Open,
             client,
         }
         .ask(read_correction)

@@ -4,7 +4,7 @@
 //! images and the predicates, and answers with the numbered plan for the target.
 
 use futures::future::try_join_all;
-use nesy_vlm::VlmClient;
+use nesy_vlm::{ReplyLength, VlmClient};
 use serde::Serialize;
 
 use crate::inputs::{BaselineInputs, Keyframe};
@@ -88,13 +88,15 @@ async fn observe(
         },
     )?;
     let mut parts = vec![nesy_vlm::Part::text(user)];
-    parts.extend(keyframe.views.parts("scene"));
+    parts.extend(keyframe.observation.parts("scene"));
     Stage {
         purpose: OBSERVE,
         system,
         parts,
         expected: "Give the observation as one line that starts with \"- \".",
         fidelity: inputs.fidelity,
+        // One observation line: on a local server a runaway reply stops at the brief cap.
+        length: ReplyLength::Brief,
         client,
     }
     .ask(|reply| {

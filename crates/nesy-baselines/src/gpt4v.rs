@@ -10,7 +10,7 @@
 
 use nesy_core::State;
 use nesy_core::Tier;
-use nesy_vlm::VlmClient;
+use nesy_vlm::{ReplyLength, VlmClient};
 use serde::Serialize;
 
 use crate::inputs::BaselineInputs;
@@ -91,7 +91,7 @@ pub async fn describe_domain(
     )?;
     let mut parts = vec![nesy_vlm::Part::text(user)];
     for (i, keyframe) in inputs.keyframes.iter().enumerate() {
-        parts.extend(keyframe.views.parts(&format!("demo keyframe {}", i + 1)));
+        parts.extend(keyframe.observation.parts(&format!("demo keyframe {}", i + 1)));
     }
     Stage {
         purpose: DESCRIBE,
@@ -99,6 +99,7 @@ pub async fn describe_domain(
         parts,
         expected: "Write the whole description inside one fenced block, with ``` on its own line before and after it.",
         fidelity: inputs.fidelity,
+        length: ReplyLength::Open,
         client,
     }
     .ask(|reply| first_block(reply).map_err(|e| e.to_string()))

@@ -31,13 +31,50 @@ impl SixViews {
     }
 }
 
+/// What a flow is shown of one scene where the authors attach its pictures.
+#[derive(Debug, Clone)]
+pub enum SceneObservation {
+    /// The six images, as the authors attach them.
+    Images(SixViews),
+    /// The scene's ground-truth state written out in place of the images: the setting in
+    /// which every method runs on a text-only model under the same perception.
+    StateText(State),
+}
+
+impl SceneObservation {
+    /// The request parts standing for the scene `scene`: its six captioned images, or one
+    /// text part listing its ground-truth atoms.
+    ///
+    /// ```
+    /// use nesy_baselines::SceneObservation;
+    /// use nesy_core::{Atom, State};
+    /// use nesy_vlm::Part;
+    ///
+    /// let state = State::from_atoms(["(OnTopOf red_cube floor)".parse::<Atom>().unwrap()]);
+    /// let parts = SceneObservation::StateText(state).parts("scene");
+    /// assert_eq!(parts.len(), 1);
+    /// let Part::Text(text) = &parts[0] else { panic!("a text part") };
+    /// assert!(text.starts_with("scene, as its ground-truth state"));
+    /// assert!(text.contains("- (OnTopOf red_cube floor)"));
+    /// ```
+    pub fn parts(&self, scene: &str) -> Vec<Part> {
+        match self {
+            SceneObservation::Images(views) => views.parts(scene),
+            SceneObservation::StateText(state) => vec![Part::text(format!(
+                "{scene}, as its ground-truth state (no pictures in this setting):\n{}",
+                crate::prompts::state_lines(state)
+            ))],
+        }
+    }
+}
+
 /// One keyframe of the demonstration.
 #[derive(Debug, Clone)]
 pub struct Keyframe {
     /// The ground-truth state at the keyframe.
     pub state: State,
-    /// Its six images.
-    pub views: SixViews,
+    /// What the flows see of it in place of pictures, or its six images.
+    pub observation: SceneObservation,
 }
 
 /// How closely a flow follows the authors' code.
@@ -76,8 +113,8 @@ pub struct BaselineInputs {
     pub target_objects: Vec<String>,
     /// The target's ground-truth initial state.
     pub target_state: State,
-    /// The target's six images.
-    pub target_views: SixViews,
+    /// The target scene as the flows see it: its six images, or its state as text.
+    pub target_observation: SceneObservation,
     /// The predicates, for the tier texts.
     pub vocabulary: Vocabulary,
     /// Whether the target's state carries end-effector atoms (the authors' `ee_set`: the

@@ -32,7 +32,7 @@ use std::time::Duration;
 use futures::future::try_join_all;
 use nesy_core::pddl::{parse_domain, parse_problem};
 use nesy_core::planner::{Grounding, Heuristic, PlannerConfig, Search, plan};
-use nesy_vlm::{Part, VlmClient};
+use nesy_vlm::{Part, ReplyLength, VlmClient};
 use serde::Serialize;
 
 use crate::gpt4v::describe_domain;
@@ -196,6 +196,7 @@ impl<'a> Flow<'a> {
             parts: vec![Part::text(user)],
             expected,
             fidelity: self.inputs.fidelity,
+            length: ReplyLength::Open,
             client: self.client,
         }
     }
@@ -298,13 +299,14 @@ impl<'a> Flow<'a> {
             },
         )?;
         let mut parts = vec![Part::text(user)];
-        parts.extend(inputs.target_views.parts("scene"));
+        parts.extend(inputs.target_observation.parts("scene"));
         let ((objects, init, goal), record) = Stage {
             purpose: PROBLEM,
             system,
             parts,
             expected: "Write \"Initial state\" with the (:objects ...) and (:init ...) code blocks, then \"Goal state\" with the (:goal ...) code block.",
             fidelity: inputs.fidelity,
+            length: ReplyLength::Open,
             client: self.client,
         }
         .ask(read_problem)

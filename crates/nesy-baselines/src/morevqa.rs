@@ -15,7 +15,7 @@
 //! and shows the reason.
 
 use nesy_core::Tier;
-use nesy_vlm::{Part, VlmClient};
+use nesy_vlm::{Part, ReplyLength, VlmClient};
 use serde::Serialize;
 
 use crate::gpt4v::describe_domain;
@@ -104,7 +104,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
         |purpose: &'static str, (system, user): (String, String), images: bool, expected: &'static str| {
             let mut parts = vec![Part::text(user)];
             if images {
-                parts.extend(inputs.target_views.parts("scene"));
+                parts.extend(inputs.target_observation.parts("scene"));
             }
             Stage {
                 purpose,
@@ -112,6 +112,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
                 parts,
                 expected,
                 fidelity: inputs.fidelity,
+                length: ReplyLength::Open,
                 client,
             }
         };

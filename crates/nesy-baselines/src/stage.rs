@@ -1,8 +1,11 @@
 //! One stage's call: a system prompt, a user message of text and captioned images, the
 //! stage's reader, and the reply policy of [`crate::Fidelity`].
 
-use nesy_vlm::reply::{self, AskError, CALL_ATTEMPTS, NULL_CONTENT_TEXT, ReplyProblem, truncation_text};
 use nesy_vlm::{ChatRequest, Message, Part, ReasoningEffort, VlmClient};
+use nesy_vlm::{
+    ReplyLength,
+    reply::{self, AskError, CALL_ATTEMPTS, NULL_CONTENT_TEXT, ReplyProblem, truncation_text},
+};
 use serde::Serialize;
 
 use crate::error::BaselineError;
@@ -80,6 +83,8 @@ pub(crate) struct Stage<'a> {
     pub expected: &'static str,
     /// How closely to follow the authors.
     pub fidelity: Fidelity,
+    /// How long the answer is expected to be (its output cap on a local server).
+    pub length: ReplyLength,
     /// The client.
     pub client: &'a VlmClient,
 }
@@ -94,6 +99,7 @@ impl Stage<'_> {
     ) -> Result<(T, StageRecord), BaselineError> {
         let chat = ChatRequest::new()
             .purpose(self.purpose)
+            .reply_length(self.length)
             .reasoning_effort(ReasoningEffort::Low)
             .message(Message::system(self.system))
             .message(Message::user(self.parts));
@@ -162,13 +168,14 @@ pub(crate) async fn target_plan(
     mut earlier: Vec<StageRecord>,
 ) -> Result<crate::BaselinePlan, BaselineError> {
     let mut parts = vec![Part::text(user)];
-    parts.extend(inputs.target_views.parts("scene"));
+    parts.extend(inputs.target_observation.parts("scene"));
     let (steps, record) = Stage {
         purpose,
         system,
         parts,
         expected: NUMBERED_PLAN,
         fidelity: inputs.fidelity,
+        length: ReplyLength::Open,
         client,
     }
     .ask(numbered_plan)

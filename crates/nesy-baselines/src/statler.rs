@@ -16,7 +16,7 @@
 use std::collections::BTreeSet;
 
 use nesy_core::Tier;
-use nesy_vlm::{Part, VlmClient};
+use nesy_vlm::{Part, ReplyLength, VlmClient};
 use serde::Serialize;
 
 use crate::gpt4v::describe_domain;
@@ -73,13 +73,14 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
         },
     )?;
     let mut parts = vec![Part::text(user)];
-    parts.extend(inputs.target_views.parts("scene"));
+    parts.extend(inputs.target_observation.parts("scene"));
     let (predicted, record) = Stage {
         purpose: STATE,
         system,
         parts,
         expected: "List the atoms, one per line starting with \"- \".",
         fidelity: inputs.fidelity,
+        length: ReplyLength::Open,
         client,
     }
     .ask(|reply| Ok(unordered_list(reply)))
@@ -106,13 +107,14 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
             },
         )?;
         let mut parts = vec![Part::text(user)];
-        parts.extend(inputs.target_views.parts("scene"));
+        parts.extend(inputs.target_observation.parts("scene"));
         let ((steps, written, reached), record) = Stage {
             purpose: ACTIONS,
             system,
             parts,
             expected: "Give the next actions as a numbered list and the world state as \"- \" lines.",
             fidelity: inputs.fidelity,
+            length: ReplyLength::Open,
             client,
         }
         .ask(|reply| {

@@ -5,8 +5,8 @@
 use std::sync::Arc;
 
 use nesy_baselines::{
-    BaselineError, BaselineInputs, Fidelity, Keyframe, SixViews, critic, demo2code, gpt4v, llmdm, morevqa,
-    statler,
+    BaselineError, BaselineInputs, Fidelity, Keyframe, SceneObservation, SixViews, critic, demo2code, gpt4v,
+    llmdm, morevqa, statler,
 };
 use nesy_core::State;
 use nesy_core::Vocabulary;
@@ -52,15 +52,15 @@ fn inputs(fidelity: Fidelity) -> BaselineInputs {
         keyframes: vec![
             Keyframe {
                 state: state(&["(GripperOpen)", "(OnTopOf red_cube floor)"]),
-                views: six(1),
+                observation: SceneObservation::Images(six(1)),
             },
             Keyframe {
                 state: state(&["(GripperClosed)", "(GripperHolding red_cube)"]),
-                views: six(10),
+                observation: SceneObservation::Images(six(10)),
             },
             Keyframe {
                 state: state(&["(GripperOpen)", "(InsideOf red_cube box)"]),
-                views: six(20),
+                observation: SceneObservation::Images(six(20)),
             },
         ],
         target_objects: vec![
@@ -74,7 +74,7 @@ fn inputs(fidelity: Fidelity) -> BaselineInputs {
             "(OnTopOf red_cube floor)",
             "(OnTopOf blue_cube red_cube)",
         ]),
-        target_views: six(40),
+        target_observation: SceneObservation::Images(six(40)),
         vocabulary: Vocabulary::new(),
         end_effector_in_state: false,
         budget: 10,
@@ -173,6 +173,41 @@ fn demo2code_observes_every_keyframe_then_plans_for_the_target() {
             .chain(&observe)
             .all(|r| r.body["reasoning_effort"] == "low")
     );
+}
+
+/// The same episode in the text-observation setting: each scene's ground-truth state in place
+/// of its pictures.
+fn state_text_inputs(fidelity: Fidelity) -> BaselineInputs {
+    let mut inputs = inputs(fidelity);
+    for keyframe in &mut inputs.keyframes {
+        keyframe.observation = SceneObservation::StateText(keyframe.state.clone());
+    }
+    inputs.target_observation = SceneObservation::StateText(inputs.target_state.clone());
+    inputs
+}
+
+#[test]
+fn in_the_text_observation_setting_no_request_carries_a_picture() {
+    let transport = Scripted::with(&[(demo2code::OBSERVE, &OBSERVATIONS), (demo2code::ACTIONS, &[PLAN])]);
+    pollster::block_on(demo2code::run(
+        &client(transport.clone(), None),
+        &state_text_inputs(Fidelity::Authors),
+    ))
+    .unwrap();
+    let observe = transport.requests(demo2code::OBSERVE);
+    let actions = transport.requests(demo2code::ACTIONS);
+    assert_eq!((observe.len(), actions.len()), (3, 1));
+    for request in observe.iter().chain(&actions) {
+        assert!(messages(request).iter().all(|m| images(m) == 0));
+    }
+    let user = text_of(&messages(&observe[1])[1]);
+    assert!(
+        user.contains("scene, as its ground-truth state (no pictures in this setting):\n- (GripperClosed)\n- (GripperHolding red_cube)"),
+        "{user}"
+    );
+    let user = text_of(&messages(&actions[0])[1]);
+    assert!(user.contains("scene, as its ground-truth state"), "{user}");
+    assert!(!user.contains("scene front"), "{user}");
 }
 
 #[test]

@@ -149,7 +149,11 @@ pub fn estimate(prepared: &Prepared, cache: &DemoCache) -> CallBudget {
         match n {
             Some(n) => {
                 let budget = nesy_core::benchmark::iteration_budget(unit.factor(), unit.complexity()) as u64;
-                let load = unit_load(unit, n, budget);
+                let mut load = unit_load(unit, n, budget);
+                if !prepared.manifest.settings.observation.is_images() {
+                    // The scenes go as text: the calls stay, the pictures do not.
+                    (load.images_min, load.images_max) = (0, 0);
+                }
                 row.load.add(&load);
                 total.add(&load);
             }

@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
+use nesy_vlm::ConstrainMode;
 use serde::{Deserialize, Serialize};
 
 use crate::error::BenchError;
@@ -37,6 +38,10 @@ pub enum Responder {
         model: String,
         /// The base URL (never a key).
         base_url: String,
+        /// Whether replies were held to their grammars (`--vlm-constrain`); absent means
+        /// `auto`, so earlier manifests keep their hashes.
+        #[serde(default, skip_serializing_if = "ConstrainMode::is_auto")]
+        constrain: ConstrainMode,
     },
 }
 
@@ -55,7 +60,8 @@ impl Responder {
                 backend,
                 model,
                 base_url,
-            } => format!("live model {model} ({backend} at {base_url})"),
+                constrain,
+            } => format!("live model {model} ({backend} at {base_url}, constraints {constrain})"),
         }
     }
 }
@@ -72,6 +78,39 @@ pub struct RunSettings {
     pub policy_wall_ms: u64,
     /// Cap on model calls per unit.
     pub max_calls_per_unit: Option<u64>,
+    /// What the methods see of each scene. Left out of the manifest when it is the
+    /// pictures, so runs made before the setting existed keep their configuration hashes.
+    #[serde(default, skip_serializing_if = "Observation::is_images")]
+    pub observation: Observation,
+}
+
+/// What every method is shown of the demonstration's keyframes and the target scene.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum Observation {
+    /// The rendered views, as the authors attach them.
+    #[default]
+    Images,
+    /// Each scene's ground-truth symbolic state as text in place of its pictures, for every
+    /// method alike: the setting in which all of them run on a text-only model under the same
+    /// perception. NeSyCR reads the ground-truth states (`states=vlm` is refused).
+    StateText,
+}
+
+impl Observation {
+    /// True for the rendered views.
+    pub fn is_images(&self) -> bool {
+        *self == Observation::Images
+    }
+
+    /// `images` or `state-text`, as the option spells it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Observation::Images => "images",
+            Observation::StateText => "state-text",
+        }
+    }
 }
 
 /// One variant of the run.

@@ -2,7 +2,7 @@
 //! record. Its seed is derived from the run seed and its identity by SHA-256, never from a
 //! randomised hasher, so every machine and every shard draws the same numbers.
 
-use nesy_core::benchmark::{Complexity, Factor};
+use nesy_core::benchmark::{Complexity, Factor, FactorGroup};
 use nesy_core::rng::SplitMix64;
 use nesy_sim::tasks::scenario::Scenario;
 use serde::{Deserialize, Serialize};
@@ -65,6 +65,11 @@ pub struct Selection {
     pub sample: Option<usize>,
     /// Seed of the sample.
     pub sample_seed: u64,
+    /// Spread the sample over the table's cells (factor group × complexity): each cell
+    /// present gets an equal share, and the remainder goes to cells drawn with the same seed.
+    /// Left out of the manifest when false, so earlier runs keep their hashes.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub stratify: bool,
 }
 
 impl Selection {
@@ -74,6 +79,7 @@ impl Selection {
             patterns: Vec::new(),
             sample: None,
             sample_seed: 0,
+            stratify: false,
         }
     }
 
@@ -118,17 +124,58 @@ impl Selection {
                 )));
             }
             let mut rng = SplitMix64::new(self.sample_seed);
-            let mut index: Vec<usize> = (0..chosen.len()).collect();
-            for i in 0..k {
-                let j = i + rng.below(index.len() - i);
-                index.swap(i, j);
-            }
-            let mut keep = index[..k].to_vec();
+            let mut keep = if self.stratify {
+                stratified_sample(&chosen, k, &mut rng)?
+            } else {
+                partial_shuffle((0..chosen.len()).collect(), k, &mut rng)
+            };
             keep.sort_unstable();
             chosen = keep.into_iter().map(|i| chosen[i].clone()).collect();
         }
         Ok(chosen)
     }
+}
+
+/// The first `k` of `index` after a seeded partial shuffle.
+fn partial_shuffle(mut index: Vec<usize>, k: usize, rng: &mut SplitMix64) -> Vec<usize> {
+    for i in 0..k {
+        let j = i + rng.below(index.len() - i);
+        index.swap(i, j);
+    }
+    index.truncate(k);
+    index
+}
+
+/// Indices of `k` of `scenarios` spread over the table's cells (factor group × complexity,
+/// in table order): `k / cells` from each, and one more from each of `k % cells` cells drawn
+/// by `rng`. A cell too small for its share is an error rather than a lopsided sample.
+fn stratified_sample(
+    scenarios: &[Scenario],
+    k: usize,
+    rng: &mut SplitMix64,
+) -> Result<Vec<usize>, BenchError> {
+    let mut cells: std::collections::BTreeMap<(FactorGroup, Complexity), Vec<usize>> = Default::default();
+    for (i, s) in scenarios.iter().enumerate() {
+        cells.entry((s.factor.group(), s.complexity)).or_default().push(i);
+    }
+    let cells: Vec<((FactorGroup, Complexity), Vec<usize>)> = cells.into_iter().collect();
+    let mut shares = vec![k / cells.len(); cells.len()];
+    for c in partial_shuffle((0..cells.len()).collect(), k % cells.len(), rng) {
+        shares[c] += 1;
+    }
+    let mut keep = Vec::with_capacity(k);
+    for (((group, complexity), members), share) in cells.into_iter().zip(shares) {
+        if share > members.len() {
+            return Err(BenchError::Usage(format!(
+                "--sample {k} --stratify: the cell {} / {} has {} scenario(s), fewer than its share of {share}",
+                group.title(),
+                complexity.as_str(),
+                members.len()
+            )));
+        }
+        keep.extend(partial_shuffle(members, share, rng));
+    }
+    Ok(keep)
 }
 
 /// A unit with what the harness needs to run it.
@@ -233,6 +280,48 @@ mod tests {
         assert_eq!(
             a.iter().map(|s| &s.id).collect::<Vec<_>>(),
             b.iter().map(|s| &s.id).collect::<Vec<_>>()
+        );
+    }
+
+    #[test]
+    fn a_stratified_sample_covers_every_cell_evenly() {
+        let files = nesy_sim::tasks::scenario::generate_suite();
+        let all = nesy_sim::tasks::scenario::scenarios(&files);
+        let stratified = |k: usize, seed: u64| Selection {
+            sample: Some(k),
+            sample_seed: seed,
+            stratify: true,
+            ..Selection::all()
+        };
+        for seed in 0..5 {
+            let chosen = stratified(12, seed).apply(all.clone()).unwrap();
+            assert_eq!(chosen.len(), 12);
+            let mut per_cell: std::collections::BTreeMap<_, usize> = Default::default();
+            for s in &chosen {
+                *per_cell.entry((s.factor.group(), s.complexity)).or_default() += 1;
+            }
+            // Nine cells: one each, and three of them a second.
+            assert_eq!(per_cell.len(), 9, "seed {seed}: {per_cell:?}");
+            assert_eq!(per_cell.values().filter(|n| **n == 2).count(), 3);
+            let ids = |v: &[Scenario]| v.iter().map(|s| s.id.clone()).collect::<Vec<_>>();
+            assert_eq!(
+                ids(&chosen),
+                ids(&stratified(12, seed).apply(all.clone()).unwrap())
+            );
+        }
+        // Within one cell the draw is the plain sample of that cell.
+        let comb = Selection {
+            patterns: vec!["comb_low".into()],
+            ..stratified(3, 1)
+        };
+        assert_eq!(comb.apply(all.clone()).unwrap().len(), 3);
+        assert!(
+            Selection {
+                patterns: vec!["comb_low".into()],
+                ..stratified(41, 1)
+            }
+            .apply(all)
+            .is_err()
         );
     }
 }

@@ -10,7 +10,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 use nesy_bench::harness::{Quiet, ResponderSetup, RunConfig, RunSummary, StopSignal, final_records};
-use nesy_bench::manifest::RunSettings;
+use nesy_bench::manifest::{Observation, RunSettings};
 use nesy_bench::methods::parse_variants;
 use nesy_bench::report::{ReportOptions, write};
 use nesy_bench::{Selection, UnitStatus};
@@ -42,6 +42,7 @@ fn config(run_dir: &Path, demos: &Path) -> RunConfig {
             image_size: 64,
             policy_wall_ms: 120_000,
             max_calls_per_unit: None,
+            observation: Observation::Images,
         },
         shard: "0/1".parse().unwrap(),
         jobs: 2,

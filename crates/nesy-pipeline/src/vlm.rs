@@ -119,7 +119,8 @@ pub fn oracle_config() -> VlmConfig {
     config
 }
 
-/// The configuration that rebuilds the bodies a cassette recorded: its backend and model.
+/// The configuration that rebuilds the bodies a cassette recorded: its backend and model,
+/// and whether its requests carried their reply constraints.
 pub fn replay_config(path: &Path, file: &CassetteFile) -> Result<VlmConfig, PipelineError> {
     let model = file.meta.model.clone().ok_or_else(|| {
         setup_error(format!(
@@ -140,7 +141,9 @@ pub fn replay_config(path: &Path, file: &CassetteFile) -> Result<VlmConfig, Pipe
             path.display()
         ))
     })?;
-    Ok(VlmConfig::new(backend, model))
+    let mut config = VlmConfig::new(backend, model);
+    config.defaults.constrain = file.meta.constrain;
+    Ok(config)
 }
 
 /// Builds the client for `setup`. The offline responder is given `demo`'s recorded robot
@@ -222,6 +225,7 @@ pub fn build_client(setup: &VlmSetup, demo: &DemoInput) -> Result<VlmClient, Pip
                         model: Some(config.model.clone()),
                         backend: Some(config.backend.as_str().to_owned()),
                         redact: config.api_key.iter().cloned().collect(),
+                        constrain: config.defaults.constrain,
                         ..CassetteOptions::default()
                     },
                 )
@@ -268,4 +272,24 @@ fn client_error(e: nesy_vlm::VlmError) -> PipelineError {
 fn resolve(overrides: &ConfigOverrides) -> Result<VlmConfig, PipelineError> {
     VlmConfig::resolve(overrides, &ProcessEnv)
         .map_err(|e| setup_error(format!("resolving the VLM configuration: {e}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_replay_sends_constraints_as_the_recording_did() {
+        let mut file = CassetteFile::new(Some("gemma3-270m-q4_k_m".into()), Some("http llamacpp".into()));
+        let path = Path::new("c.json");
+        let config = replay_config(path, &file).unwrap();
+        assert_eq!(config.backend, BackendKind::LlamaCpp);
+        assert_eq!(config.defaults.constrain, nesy_vlm::ConstrainMode::Auto);
+        file.meta.constrain = nesy_vlm::ConstrainMode::Off;
+        let config = replay_config(path, &file).unwrap();
+        assert_eq!(config.defaults.constrain, nesy_vlm::ConstrainMode::Off);
+        // The offline responder's recordings keep its own settings.
+        file.meta.model = Some(ORACLE_MODEL.into());
+        assert_eq!(replay_config(path, &file).unwrap(), oracle_config());
+    }
 }

@@ -134,6 +134,7 @@ impl VlmClient {
                     backend: backend_label,
                     redact: config.api_key.iter().cloned().collect(),
                     allow_playback_repeats: false,
+                    constrain: config.defaults.constrain,
                 },
             )?),
             None => live.ok_or_else(|| VlmError::InvalidRequest("no transport configured".into()))?,

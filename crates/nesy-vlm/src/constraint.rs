@@ -46,6 +46,11 @@ pub enum ConstrainMode {
 }
 
 impl ConstrainMode {
+    /// True for [`ConstrainMode::Auto`].
+    pub fn is_auto(&self) -> bool {
+        *self == ConstrainMode::Auto
+    }
+
     /// `auto` or `off`.
     pub fn as_str(self) -> &'static str {
         match self {

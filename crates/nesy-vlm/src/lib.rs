@@ -74,7 +74,9 @@ pub use config::{
 pub use constraint::{ConstrainMode, ReplyConstraint, ReplyForm, gbnf_literal};
 pub use error::{Cutoff, ProviderError, TimeoutPhase, TransportError, VlmError};
 pub use profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, ReplyCaps, TokenCapField};
-pub use request::{ChatRequest, Image, ImageDetail, Message, Part, ReasoningEffort, Role, TaskContext};
+pub use request::{
+    ChatRequest, Image, ImageDetail, Message, Part, ReasoningEffort, ReplyLength, Role, TaskContext,
+};
 pub use response::{ChatResponse, FinishReason, Usage};
 pub use retry::RetryPolicy;
 pub use secret::SecretString;

@@ -9,7 +9,7 @@ use base64::Engine as _;
 use serde_json::{Map, Value, json};
 
 use crate::constraint::{ConstrainMode, ReplyForm, body_fields, form_for};
-use crate::request::{ChatRequest, ImageDetail, Part, ReasoningEffort};
+use crate::request::{ChatRequest, ImageDetail, Part, ReasoningEffort, ReplyLength};
 
 /// The kind of server.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -162,6 +162,9 @@ pub struct ReplyCaps {
     pub codegen: u32,
     /// Every other purpose (the baselines' stages).
     pub other: u32,
+    /// A call of any purpose whose answer is one line, a verdict or a few items
+    /// ([`ReplyLength::Brief`]).
+    pub brief: u32,
 }
 
 impl ReplyCaps {
@@ -172,16 +175,21 @@ impl ReplyCaps {
         translate: 768,
         codegen: 2048,
         other: 1024,
+        brief: 256,
     };
 
-    /// The cap for a call labelled `purpose`.
+    /// The cap for a call labelled `purpose` whose answer has length `length`.
     ///
     /// ```
-    /// use nesy_vlm::ReplyCaps;
-    /// assert_eq!(ReplyCaps::LOCAL.cap_for(Some("codegen")), 2048);
-    /// assert_eq!(ReplyCaps::LOCAL.cap_for(Some("gpt4v.plan")), 1024);
+    /// use nesy_vlm::{ReplyCaps, ReplyLength};
+    /// assert_eq!(ReplyCaps::LOCAL.cap_for(Some("codegen"), ReplyLength::Open), 2048);
+    /// assert_eq!(ReplyCaps::LOCAL.cap_for(Some("gpt4v.plan"), ReplyLength::Open), 1024);
+    /// assert_eq!(ReplyCaps::LOCAL.cap_for(Some("d2c.observe"), ReplyLength::Brief), 256);
     /// ```
-    pub fn cap_for(&self, purpose: Option<&str>) -> u32 {
+    pub fn cap_for(&self, purpose: Option<&str>, length: ReplyLength) -> u32 {
+        if length == ReplyLength::Brief {
+            return self.brief;
+        }
         match purpose {
             Some("induce") => self.induce,
             Some("patch") => self.patch,
@@ -309,7 +317,7 @@ impl Profile {
             .or_else(|| {
                 self.defaults
                     .reply_caps
-                    .map(|caps| caps.cap_for(request.purpose.as_deref()))
+                    .map(|caps| caps.cap_for(request.purpose.as_deref(), request.reply_length))
             })
     }
 

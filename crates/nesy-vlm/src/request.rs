@@ -309,6 +309,18 @@ impl TaskContext {
     }
 }
 
+/// How long a call's answer is expected to be. A local server generates tens of tokens per
+/// second, so a one-line answer gets a smaller cap than an open one
+/// ([`crate::ReplyCaps::brief`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum ReplyLength {
+    /// Whatever the call's kind needs (a plan, a program, an action block).
+    #[default]
+    Open,
+    /// One line, a verdict or a few items.
+    Brief,
+}
+
 /// One chat-completions call, before the backend profile turns it into a wire body.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ChatRequest {
@@ -327,6 +339,9 @@ pub struct ChatRequest {
     pub task: Option<TaskContext>,
     /// What the reply must look like; sent in the backend's dialect where it has one.
     pub constraint: Option<ReplyConstraint>,
+    /// How long the answer is expected to be, which picks its output cap on a local backend
+    /// when neither the request nor the configuration sets one. Not sent.
+    pub reply_length: ReplyLength,
     /// Further body fields sent as given (e.g. `seed`, `response_format`), applied last.
     pub extra: serde_json::Map<String, serde_json::Value>,
 }
@@ -373,6 +388,12 @@ impl ChatRequest {
     /// Labels the call for accounting.
     pub fn purpose(mut self, purpose: impl Into<String>) -> Self {
         self.purpose = Some(purpose.into());
+        self
+    }
+
+    /// Says how long the answer is expected to be.
+    pub fn reply_length(mut self, length: ReplyLength) -> Self {
+        self.reply_length = length;
         self
     }
 

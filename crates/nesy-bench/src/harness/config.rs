@@ -174,6 +174,7 @@ pub fn describe_responder(setup: &ResponderSetup) -> Result<Responder, BenchErro
                 backend: config.backend.as_str().to_owned(),
                 model: config.model.clone(),
                 base_url: config.base_url.clone(),
+                constrain: config.defaults.constrain,
             }
         }
     })

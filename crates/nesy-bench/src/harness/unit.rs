@@ -12,7 +12,7 @@ use nesy_pipeline::execute::ExecutionReport;
 use nesy_pipeline::output::RunDir;
 use nesy_pipeline::states::StateSource;
 use nesy_pipeline::synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest};
-use nesy_pipeline::{AdaptOptions, DemoInput, derive_setting, execute, output, synth, vlm};
+use nesy_pipeline::{AdaptOptions, DemoInput, ImagesMode, derive_setting, execute, output, synth, vlm};
 use nesy_policy::Limits;
 use nesy_reasoner::VlmReasoner;
 use nesy_reasoner::codegen::CodeGenerationRequest;
@@ -20,6 +20,7 @@ use nesy_sim::tasks::scenario::Side;
 use nesy_vlm::{CassetteFile, RunUsage};
 use nesy_vlm::{CassetteMode, CassetteOptions, CassetteTransport, Transport, VlmClient, VlmConfig};
 
+use crate::manifest::Observation;
 use crate::meter::{CallCounts, Metered};
 use crate::methods::{self, FailureKind, Method, Specification, Specified, UnitInputs};
 use crate::status::UnitStatus;
@@ -197,6 +198,7 @@ pub(super) fn record_to(
             model: Some(config.model.clone()),
             backend: Some(config.backend.as_str().to_owned()),
             redact: config.api_key.iter().cloned().collect(),
+            constrain: config.defaults.constrain,
             ..CassetteOptions::default()
         },
     )
@@ -385,7 +387,14 @@ async fn prepare_unit(
         return Err((UnitStatus::DemoUnusable, why));
     }
     let dir = RunDir::create(unit_dir(shared, unit)).map_err(|e| (UnitStatus::MethodError, e.to_string()))?;
-    let setting = derive_setting(&inputs.demo, &inputs.target, &AdaptOptions::default());
+    let options = AdaptOptions {
+        images: match shared.config.settings.observation {
+            Observation::Images => ImagesMode::Auto,
+            Observation::StateText => ImagesMode::Never,
+        },
+        ..AdaptOptions::default()
+    };
+    let setting = derive_setting(&inputs.demo, &inputs.target, &options);
     let unit_inputs = UnitInputs {
         demo: inputs.demo.clone(),
         keyframes: inputs.keyframes.clone(),

@@ -10,7 +10,9 @@ use std::time::Instant;
 
 use futures::FutureExt as _;
 use futures::future::BoxFuture;
-use nesy_baselines::{Baseline, BaselineError, BaselineInputs, BaselinePlan, Fidelity, Keyframe, SixViews};
+use nesy_baselines::{
+    Baseline, BaselineError, BaselineInputs, BaselinePlan, Fidelity, Keyframe, SceneObservation, SixViews,
+};
 use nesy_core::Vocabulary;
 use nesy_pipeline::synth::CodegenMode;
 use nesy_reasoner::Views;
@@ -205,10 +207,12 @@ fn baseline_failure(error: BaselineError) -> MethodFailure {
     MethodFailure::from_reasoner(error.reasoner_kind(), message)
 }
 
-/// What the baselines see of a unit: the demonstration's ground-truth states and six views
-/// per keyframe, and the target's.
+/// What the baselines see of a unit: the demonstration's ground-truth states, and per
+/// keyframe and for the target either the six views or, when the run sends no pictures, the
+/// scene's ground-truth state as text.
 fn baseline_inputs(inputs: &UnitInputs, fidelity: Fidelity) -> Result<BaselineInputs, MethodFailure> {
     let fail = |message: String| MethodFailure::new(FailureKind::Method, message);
+    let pictures = inputs.setting.images;
     let demo = &inputs.demo.demo;
     let mut keyframes = Vec::with_capacity(demo.keyframes.len());
     for k in &demo.keyframes {
@@ -235,18 +239,24 @@ fn baseline_inputs(inputs: &UnitInputs, fidelity: Fidelity) -> Result<BaselineIn
                 back: image(CameraName::Back)?,
             })
         };
-        keyframes.push(Keyframe {
-            state,
-            views: SixViews {
+        let observation = if pictures {
+            SceneObservation::Images(SixViews {
                 raw: view(false)?,
                 marked: view(true)?,
-            },
-        });
+            })
+        } else {
+            SceneObservation::StateText(state.clone())
+        };
+        keyframes.push(Keyframe { state, observation });
     }
     let target = &inputs.target;
-    let target_views = SixViews {
-        raw: target.raw_views().map_err(|e| fail(e.to_string()))?,
-        marked: target.marked_views().map_err(|e| fail(e.to_string()))?,
+    let target_observation = if pictures {
+        SceneObservation::Images(SixViews {
+            raw: target.raw_views().map_err(|e| fail(e.to_string()))?,
+            marked: target.marked_views().map_err(|e| fail(e.to_string()))?,
+        })
+    } else {
+        SceneObservation::StateText(target.observed.clone())
     };
     Ok(BaselineInputs {
         instruction: target.instruction(&inputs.demo),
@@ -254,7 +264,7 @@ fn baseline_inputs(inputs: &UnitInputs, fidelity: Fidelity) -> Result<BaselineIn
         keyframes,
         target_objects: target.objects.clone(),
         target_state: target.observed.clone(),
-        target_views,
+        target_observation,
         vocabulary: Vocabulary::new(),
         end_effector_in_state: inputs.setting.embodiment_in_state
             || inputs.setting.factor == nesy_core::benchmark::Factor::Comb,

@@ -223,8 +223,14 @@ impl Method for NeSyCr {
             let setting = &inputs.setting;
             let reasoner = VlmReasoner::new(client.clone())
                 .map_err(|e| MethodFailure::new(FailureKind::Method, format!("loading nesy's prompts: {e}")))?
-                .with_keyframes(inputs.keyframes.clone())
                 .with_embodiments(setting.source_embodiment, setting.target_embodiment);
+            // Without pictures the induction prompts carry the keyframes' states alone, as
+            // text, which they always include.
+            let reasoner = if setting.images {
+                reasoner.with_keyframes(inputs.keyframes.clone())
+            } else {
+                reasoner
+            };
             let vocabulary = Vocabulary::new();
             let states = states::symbolic_states(
                 &reasoner,

@@ -9,7 +9,7 @@ use nesy_core::metrics::Tally;
 
 use super::csv::stage_use;
 use super::{Aggregate, Tables, is_method, pct};
-use crate::manifest::Manifest;
+use crate::manifest::{Manifest, Observation};
 use crate::methods::{self, OfflineMeaning, Role};
 use crate::status::UnitStatus;
 use crate::unit_record::UnitRecord;
@@ -168,10 +168,24 @@ fn write_provenance(md: &mut String, manifest: &Manifest) {
     if let Some(k) = manifest.selection.sample {
         let _ = writeln!(
             md,
-            "- a sample of {k} scenarios, seed {}",
+            "- a {}sample of {k} scenarios, seed {}",
+            if manifest.selection.stratify {
+                "stratified (factor group × complexity) "
+            } else {
+                ""
+            },
             manifest.selection.sample_seed
         );
     }
+    let _ = writeln!(
+        md,
+        "- observation: {}",
+        match manifest.settings.observation {
+            Observation::Images => "the rendered views (`images`)",
+            Observation::StateText =>
+                "each scene's ground-truth state as text in place of its pictures (`state-text`)",
+        }
+    );
     if let Some(src) = &manifest.reexecutes {
         let _ = writeln!(
             md,

@@ -12,7 +12,7 @@ use anyhow::Context as _;
 use nesy_bench::demos::DemoCache;
 use nesy_bench::harness::{self, Prepared};
 use nesy_bench::harness::{BenchProgress, ResponderSetup, RunConfig, StopSignal};
-use nesy_bench::manifest::{Manifest, RunSettings};
+use nesy_bench::manifest::{Manifest, Observation, RunSettings};
 use nesy_bench::methods::{self, OfflineMeaning, Role};
 use nesy_bench::studies::Study;
 use nesy_bench::{Selection, Shard, UnitRecord, UnitStatus};
@@ -101,6 +101,9 @@ pub(crate) struct RunArgs {
     /// Seed of `--sample`.
     #[arg(long, value_name = "SEED", default_value_t = 0)]
     pub sample_seed: u64,
+    /// Spread `--sample` evenly over the table's cells (factor group × complexity).
+    #[arg(long, requires = "sample")]
+    pub stratify: bool,
     /// Repeats per method and scenario, each with its own seed. Default 1, or 3 with
     /// `--study`.
     #[arg(long, value_name = "N")]
@@ -145,6 +148,11 @@ pub(crate) struct RunArgs {
     /// Wall-clock budget of one policy in seconds.
     #[arg(long, value_name = "SECS", default_value_t = 300.0)]
     pub policy_timeout: f64,
+    /// What every method sees of each scene: `images` (the rendered views) or `state-text`
+    /// (each scene's ground-truth state as text in place of its pictures, for text-only
+    /// models; NeSyCR reads the ground-truth states).
+    #[arg(long, value_enum, default_value_t = Observation::Images)]
+    pub observation: Observation,
     /// Record the offline responder's calls to per-unit cassettes too (live calls always are).
     #[arg(long)]
     pub record_cassettes: bool,
@@ -284,6 +292,7 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
     let mut selection = Selection::parse(scenarios);
     selection.sample = args.sample;
     selection.sample_seed = args.sample_seed;
+    selection.stratify = args.stratify;
     let run_dir = args
         .run
         .clone()
@@ -306,6 +315,7 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
             image_size: nesy_sim::perception::render::VIEW_SIZE,
             policy_wall_ms: (args.policy_timeout * 1000.0) as u64,
             max_calls_per_unit: args.max_calls_per_unit,
+            observation: args.observation,
         },
         shard: args.shard.parse()?,
         jobs: args.jobs.unwrap_or_else(cores).max(1),

@@ -344,11 +344,8 @@ fn records_by_unit(run: &Path) -> BTreeMap<String, Value> {
     out
 }
 
-#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn baselines_run_live_record_and_replay_to_the_same_records() {
-    let scratch = common::scratch();
-    let demos = scratch.path().join("demos");
-    let live = scratch.path().join("live");
+/// A local server answering with [`HandWritten`], and its per-stage request counts.
+async fn hand_written_server() -> (MockServer, Arc<Mutex<BTreeMap<&'static str, usize>>>) {
     let server = MockServer::start().await;
     let responder = HandWritten::default();
     let seen = responder.seen.clone();
@@ -357,6 +354,15 @@ async fn baselines_run_live_record_and_replay_to_the_same_records() {
         .respond_with(responder)
         .mount(&server)
         .await;
+    (server, seen)
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn baselines_run_live_record_and_replay_to_the_same_records() {
+    let scratch = common::scratch();
+    let demos = scratch.path().join("demos");
+    let live = scratch.path().join("live");
+    let (server, seen) = hand_written_server().await;
     let url = format!("{}/v1", server.uri());
     let (live_dir, demos_dir) = (live.clone(), demos.clone());
     tokio::task::spawn_blocking(move || bench(&live_dir, &demos_dir, &url))
@@ -478,6 +484,75 @@ async fn baselines_run_live_record_and_replay_to_the_same_records() {
 /// NeSyCR's calls recorded from the offline responder, the six baselines' from the
 /// hand-written server; both sets of cassettes together replay twice into the same records,
 /// and those are the recorded runs' records.
+/// The text-observation setting: every baseline sees each scene's ground-truth state in place
+/// of its pictures, and NeSyCR's induction carries the keyframes' states alone, so that a
+/// text-only model can answer all of them. No request carries an image; the manifest and the
+/// report name the setting.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn in_the_text_observation_setting_no_method_sends_a_picture() {
+    let scratch = common::scratch();
+    let demos = scratch.path().join("demos");
+    let run = scratch.path().join("text");
+    let (server, seen) = hand_written_server().await;
+    let url = format!("{}/v1", server.uri());
+    let methods = format!("{BASELINES},nesycr");
+    let (run_dir, demos_dir) = (run.clone(), demos.clone());
+    tokio::task::spawn_blocking(move || {
+        bench_with(
+            &run_dir,
+            &demos_dir,
+            &url,
+            &methods,
+            SCENARIO,
+            &["--observation", "state-text"],
+        )
+    })
+    .await
+    .unwrap();
+    let requests = server.received_requests().await.unwrap();
+    let mut induction = 0;
+    for request in &requests {
+        let body: Value = serde_json::from_slice(&request.body).unwrap();
+        let text = body.to_string();
+        assert!(
+            !text.contains("image_url"),
+            "a picture was sent: {}",
+            &text[..text.len().min(400)]
+        );
+        if common::message_text(&body["messages"][0])
+            .starts_with("You work out which robot action was executed")
+        {
+            induction += 1;
+        }
+    }
+    assert!(induction > 0, "NeSyCR's induction was never asked");
+    // Each scene the baselines were shown came as its state.
+    let seen = seen.lock().unwrap().clone();
+    assert!(seen["observe"] >= 6 && seen["describe"] >= 1, "{seen:?}");
+    let described = requests
+        .iter()
+        .map(|r| serde_json::from_slice::<Value>(&r.body).unwrap())
+        .find(|b| common::message_text(&b["messages"][0]).starts_with("You analyse a robot demonstration"))
+        .unwrap();
+    let user = common::message_text(&described["messages"][1]);
+    assert!(
+        user.contains("demo keyframe 1, as its ground-truth state (no pictures in this setting):\n- ("),
+        "{user}"
+    );
+    let records = records(&run);
+    for (method, record) in &records {
+        assert_eq!(record["effort"]["images"], 0, "{method}");
+    }
+    let manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["settings"]["observation"], "state-text");
+    let report = std::fs::read_to_string(run.join("report.md")).unwrap();
+    assert!(
+        report.contains("- observation: each scene's ground-truth state as text"),
+        "{report}"
+    );
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn all_methods_replay_to_identical_records_over_the_fixture_scenarios() {
     const FIXTURES: &str = "obst_low_00_s0,grip_low_02_s0,comb_low_00_s0";

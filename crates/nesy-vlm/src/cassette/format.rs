@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 
 use super::CassetteError;
+use crate::constraint::ConstrainMode;
 use crate::secret::SecretString;
 use crate::transport::{Origin, WireResponse, is_allowed_header};
 
@@ -51,6 +52,10 @@ pub struct CassetteMeta {
     /// as the recording did.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub server: Option<crate::capabilities::ServerCapabilities>,
+    /// Whether the recorded requests carried their reply constraints; a replay sends them
+    /// the same way, so that its bodies match. Absent means `auto`.
+    #[serde(default, skip_serializing_if = "ConstrainMode::is_auto")]
+    pub constrain: ConstrainMode,
 }
 
 /// One recorded call.
@@ -175,6 +180,7 @@ impl CassetteFile {
                 model,
                 backend,
                 server: None,
+                constrain: ConstrainMode::Auto,
             },
             interactions: Vec::new(),
         }

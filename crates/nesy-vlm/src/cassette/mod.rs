@@ -21,6 +21,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::capabilities::ServerCapabilities;
+use crate::constraint::ConstrainMode;
 use crate::error::{TransportError, VlmError};
 use crate::secret::SecretString;
 use crate::transport::{BoxFuture, Origin, Transport, WireRequest, WireResponse};
@@ -185,6 +186,8 @@ pub struct CassetteOptions {
     /// Once every recording of a request has been replayed, replay the last one again
     /// instead of missing (vcrpy's `allow_playback_repeats`; benchmarks use it).
     pub allow_playback_repeats: bool,
+    /// Whether the recording client sends reply constraints, for metadata.
+    pub constrain: ConstrainMode,
 }
 
 struct Recorded {
@@ -469,6 +472,7 @@ impl CassetteTransport {
             .probed
             .clone();
         file.meta.server = probed.or(file.meta.server);
+        file.meta.constrain = self.options.constrain;
         file.interactions.push(interaction);
         write_atomically(&self.path, file.to_pretty_json(&self.options.redact).as_bytes())
     }

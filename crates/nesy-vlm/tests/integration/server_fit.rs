@@ -6,7 +6,7 @@
 
 use nesy_vlm::{
     BackendKind, CassetteMode, CassetteSettings, ChatRequest, ConstrainMode, Image, Message, Part,
-    ReplyConstraint, ReplyForm, VlmClient, VlmError,
+    ReplyConstraint, ReplyForm, ReplyLength, VlmClient, VlmError,
 };
 use serde_json::{Value, json};
 use wiremock::matchers::{method, path};
@@ -151,6 +151,14 @@ async fn a_text_only_llamacpp_server_gets_no_pictures_and_replies_sized_to_its_w
     client.chat(long).await.unwrap();
     let cap = posted_bodies(&server).await[1]["max_tokens"].as_u64().unwrap();
     assert!((400..768).contains(&cap), "{cap}");
+    // ...and a call whose answer is one line gets the brief cap, whatever its purpose.
+    let brief = ChatRequest::new()
+        .purpose("d2c.observe")
+        .reply_length(ReplyLength::Brief)
+        .message(Message::system("Observe."))
+        .message(Message::user_text("The scene."));
+    client.chat(brief).await.unwrap();
+    assert_eq!(posted_bodies(&server).await[2]["max_tokens"], 256);
 }
 
 #[tokio::test]
@@ -258,4 +266,31 @@ async fn a_cassette_keeps_what_the_server_announced_for_its_replay() {
     let client = VlmClient::from_config(&cfg).unwrap();
     assert_eq!(client.capabilities().await.context_tokens, Some(1024));
     client.chat(constrained()).await.unwrap();
+    // The default, sending constraints, is left out of the metadata.
+    assert_eq!(recorded.meta.constrain, ConstrainMode::Auto);
+    assert!(!std::fs::read_to_string(&cassette).unwrap().contains("\"constrain\""));
+}
+
+#[tokio::test]
+async fn a_cassette_recorded_without_constraints_says_so() {
+    let server = props_server(json!({"default_generation_settings": {"n_ctx": 4096}})).await;
+    let dir = tempfile::tempdir().unwrap();
+    let cassette = dir.path().join("c.json");
+    let mut cfg = config(BackendKind::LlamaCpp, "m", &format!("{}/v1", server.uri()));
+    cfg.defaults.constrain = ConstrainMode::Off;
+    cfg.cassette = Some(CassetteSettings {
+        path: cassette.clone(),
+        mode: CassetteMode::All,
+        strict: false,
+        usage_report: None,
+    });
+    VlmClient::from_config(&cfg)
+        .unwrap()
+        .chat(constrained())
+        .await
+        .unwrap();
+    assert!(posted_bodies(&server).await[0].get("grammar").is_none());
+    // A replay reads it back, so that it rebuilds the same unconstrained bodies.
+    let recorded = nesy_vlm::CassetteFile::load(&cassette).unwrap();
+    assert_eq!(recorded.meta.constrain, ConstrainMode::Off);
 }
