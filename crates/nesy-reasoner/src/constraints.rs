@@ -6,12 +6,18 @@
 //!
 //! Every grammar bounds its free text (rationale lines, action names) and its lists, so a
 //! constrained reply cannot run away.
+//!
+//! Backends that hold replies only to JSON (OpenAI's `response_format`, Ollama's `format`)
+//! get the same answer as a JSON schema with the same symbols and bounds; the reply they
+//! send back is written out in the prompt's layout again ([`induction_layout`],
+//! [`patch_layout`], [`translation_layout`]) before the usual parser reads it.
 
 use std::fmt::Write as _;
 
 use nesy_core::adapt::TaskContext;
 use nesy_core::{Operator, State, Tier, Vocabulary};
 use nesy_vlm::{ReplyConstraint, gbnf_literal};
+use serde_json::{Map, Value, json};
 
 /// The most rationale lines a constrained reply may write.
 const RATIONALE_LINES: usize = 4;
@@ -116,6 +122,125 @@ impl Symbols {
     }
 }
 
+impl Symbols {
+    /// A regular expression of one atom whose arguments match `arg`.
+    fn atom_pattern(&self, arg: &str) -> String {
+        let mut arities: Vec<usize> = self.predicates.iter().map(|(_, n)| *n).collect();
+        arities.sort_unstable();
+        arities.dedup();
+        let heads: Vec<String> = arities
+            .iter()
+            .map(|arity| {
+                let names: Vec<String> = self
+                    .predicates
+                    .iter()
+                    .filter(|(_, n)| n == arity)
+                    .map(|(name, _)| regex_escape(name))
+                    .collect();
+                format!("(?:{}){}", names.join("|"), format!(" {arg}").repeat(*arity))
+            })
+            .collect();
+        format!("\\((?:{})\\)", heads.join("|"))
+    }
+
+    /// The regular expressions of an object, a grounded atom and a literal (the grammar's
+    /// `obj`, `atom` and `literal`), each anchored.
+    fn json_patterns(&self) -> (String, String) {
+        let objects: Vec<String> = if self.objects.is_empty() {
+            vec!["floor".into()]
+        } else {
+            self.objects.iter().map(|o| regex_escape(o)).collect()
+        };
+        let obj = format!("(?:{})", objects.join("|"));
+        let atom = self.atom_pattern(&obj);
+        let qatom = self.atom_pattern(&format!("(?:{obj}|\\?x)"));
+        let literal = format!(
+            "^(?:{atom}|\\(not {atom}\\)|\\(forall \\(\\?x - thing\\) (?:{qatom}|\\(not {qatom}\\))\\))$"
+        );
+        (format!("^{atom}$"), literal)
+    }
+}
+
+/// `text` with the characters a regular expression gives meaning to escaped (only those:
+/// ECMAScript, which JSON Schema patterns follow, refuses other escapes under `u`).
+fn regex_escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        if "\\.+*?()|[]{}^$/".contains(c) {
+            out.push('\\');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// A JSON object schema whose every property is required and no other is allowed (what
+/// OpenAI's strict mode asks for).
+fn object_schema(properties: Vec<(&str, Value)>) -> Value {
+    let required: Vec<&str> = properties.iter().map(|(k, _)| *k).collect();
+    let properties: Map<String, Value> = properties.into_iter().map(|(k, v)| (k.to_owned(), v)).collect();
+    json!({"type": "object", "properties": properties, "required": required, "additionalProperties": false})
+}
+
+/// An array of `min` to `max` items of `items`.
+fn array_schema(items: Value, min: usize, max: usize) -> Value {
+    json!({"type": "array", "items": items, "minItems": min, "maxItems": max})
+}
+
+/// A string matching `pattern`.
+fn pattern_schema(pattern: &str) -> Value {
+    json!({"type": "string", "pattern": pattern})
+}
+
+/// A bounded line of free text.
+fn line_schema() -> Value {
+    json!({"type": "string", "minLength": 1, "maxLength": LINE_CHARS})
+}
+
+/// An action block: its name, preconditions (possibly none) and effects.
+fn block_schema(literal: &str) -> Value {
+    object_schema(vec![
+        ("name", pattern_schema("^[A-Za-z][A-Za-z0-9_]{0,79}$")),
+        (
+            "preconditions",
+            array_schema(pattern_schema(literal), 0, LITERALS_PER_SECTION),
+        ),
+        (
+            "effects",
+            array_schema(pattern_schema(literal), 1, LITERALS_PER_SECTION),
+        ),
+    ])
+}
+
+/// The JSON object of a reply, or `None` when it is not one.
+fn json_object(reply: &str) -> Option<Map<String, Value>> {
+    match serde_json::from_str::<Value>(reply.trim()).ok()? {
+        Value::Object(map) => Some(map),
+        _ => None,
+    }
+}
+
+/// The strings of `field` in `object`, each on one line; `None` when it is not a list of
+/// strings.
+fn strings(object: &Map<String, Value>, field: &str) -> Option<Vec<String>> {
+    object
+        .get(field)?
+        .as_array()?
+        .iter()
+        .map(|v| v.as_str().map(|s| s.replace(['\n', '\r'], " ").trim().to_owned()))
+        .collect()
+}
+
+/// `item` lines after `prefix`, or `none` on a line of its own when there is no item.
+fn bullet_lines(out: &mut String, items: &[String], prefix: &str, none: &str) {
+    if items.is_empty() {
+        let _ = writeln!(out, "{none}");
+    }
+    for item in items {
+        let _ = writeln!(out, "{prefix}{item}");
+    }
+}
+
 /// The rationale lines every layout opens with, and a bounded line of free text.
 fn text_rules() -> String {
     format!("reason ::= \"- \" line \"\\n\"\nline ::= [^\\n]{{1,{LINE_CHARS}}}\n",)
@@ -141,11 +266,61 @@ pub fn induction_constraint(symbols: &Symbols) -> ReplyConstraint {
     );
     grammar.push_str(&text_rules());
     grammar.push_str(&symbols.literal_rules());
+    let (_, literal) = symbols.json_patterns();
+    let json_schema = object_schema(vec![
+        ("rationale", array_schema(line_schema(), 1, RATIONALE_LINES)),
+        ("action_semantic", line_schema()),
+        (
+            "preconditions",
+            array_schema(pattern_schema(&literal), 0, LITERALS_PER_SECTION),
+        ),
+        (
+            "effects",
+            array_schema(pattern_schema(&literal), 1, LITERALS_PER_SECTION),
+        ),
+    ]);
     ReplyConstraint {
         name: "induce".into(),
         grammar,
-        json_schema: None,
+        json_schema: Some(json_schema),
     }
+}
+
+/// An induction reply given as JSON under [`induction_constraint`]'s schema, written out in
+/// the prompt's layout; `None` when it is not such an object.
+///
+/// ```
+/// use nesy_reasoner::constraints::induction_layout;
+/// let reply = r#"{"rationale": ["The cube was lifted."], "action_semantic": "pick up the cube",
+///     "preconditions": [], "effects": ["(GripperHolding red_cube)"]}"#;
+/// assert_eq!(
+///     induction_layout(reply).unwrap(),
+///     "* Prediction Rationale:\n- The cube was lifted.\n* Predicted Action:\nAction Semantic:\n- pick up the cube\nPrecondition:\nNone\nEffect:\n- (GripperHolding red_cube)\n"
+/// );
+/// assert!(induction_layout("- (GripperHolding red_cube)").is_none());
+/// ```
+pub fn induction_layout(reply: &str) -> Option<String> {
+    let object = json_object(reply)?;
+    let rationale = strings(&object, "rationale")?;
+    let action = object
+        .get("action_semantic")?
+        .as_str()?
+        .replace(['\n', '\r'], " ");
+    let pre = strings(&object, "preconditions")?;
+    let eff = strings(&object, "effects")?;
+    let mut out = String::from("* Prediction Rationale:\n");
+    for r in &rationale {
+        let _ = writeln!(out, "- {r}");
+    }
+    let _ = write!(
+        out,
+        "* Predicted Action:\nAction Semantic:\n- {}\nPrecondition:\n",
+        action.trim()
+    );
+    bullet_lines(&mut out, &pre, "- ", "None");
+    out.push_str("Effect:\n");
+    bullet_lines(&mut out, &eff, "- ", "None");
+    Some(out)
 }
 
 /// The refinement reply: rationale lines, then one SEARCH/REPLACE block whose SEARCH side
@@ -173,11 +348,73 @@ pub fn patch_constraint(symbols: &Symbols, procedure: &[Operator]) -> ReplyConst
     grammar.push_str(&search_rules(procedure));
     grammar.push_str(&text_rules());
     grammar.push_str(&symbols.literal_rules());
+    let (_, literal) = symbols.json_patterns();
+    let mut names: Vec<String> = procedure.iter().map(Operator::display_name).collect();
+    names.dedup();
+    let search = if names.is_empty() {
+        json!({"type": "array", "items": {"type": "string"}, "maxItems": 0})
+    } else {
+        array_schema(json!({"type": "string", "enum": names}), 1, SEARCH_SPAN)
+    };
+    let json_schema = object_schema(vec![
+        ("rationale", array_schema(line_schema(), 1, RATIONALE_LINES)),
+        ("search", search),
+        (
+            "replace",
+            array_schema(block_schema(&literal), 0, REPLACEMENT_ACTIONS),
+        ),
+    ]);
     ReplyConstraint {
         name: "patch".into(),
         grammar,
-        json_schema: None,
+        json_schema: Some(json_schema),
     }
+}
+
+/// A patch given as JSON under [`patch_constraint`]'s schema, written out in the prompt's
+/// layout: the SEARCH side prints the first run of consecutive actions of `procedure` with
+/// the names given (or the names alone when no run has them, which the loop then reports as
+/// a SEARCH side it cannot find), the REPLACE side the blocks given. `None` when the reply
+/// is not such an object.
+pub fn patch_layout(reply: &str, procedure: &[Operator]) -> Option<String> {
+    let object = json_object(reply)?;
+    let rationale = strings(&object, "rationale")?;
+    let search = strings(&object, "search")?;
+    let mut out = String::from("* Refinement rationale:\n");
+    for r in &rationale {
+        let _ = writeln!(out, "- {r}");
+    }
+    out.push_str("\n* Refinement patch:\n<<<<<<< SEARCH\n");
+    let names: Vec<String> = procedure.iter().map(Operator::display_name).collect();
+    let start = (!search.is_empty())
+        .then(|| names.windows(search.len()).position(|w| w == search.as_slice()))
+        .flatten();
+    match start {
+        Some(start) => {
+            let run: Vec<String> = procedure[start..start + search.len()]
+                .iter()
+                .map(|op| format!("{op}\n"))
+                .collect();
+            out.push_str(&run.join("\n"));
+        }
+        None => search.iter().for_each(|name| {
+            let _ = writeln!(out, "{name}");
+        }),
+    }
+    out.push_str("=======\n");
+    let mut blocks = Vec::new();
+    for block in object.get("replace")?.as_array()? {
+        let block = block.as_object()?;
+        let name = block.get("name")?.as_str()?.trim();
+        let mut text = format!("{name}\n- Preconditions:\n");
+        bullet_lines(&mut text, &strings(block, "preconditions")?, "\t", "\tNone");
+        text.push_str("- Effects:\n");
+        bullet_lines(&mut text, &strings(block, "effects")?, "\t", "\tNone");
+        blocks.push(text);
+    }
+    out.push_str(&blocks.join("\n"));
+    out.push_str(">>>>>>> REPLACE\n");
+    Some(out)
 }
 
 /// `search` and one rule per action of `procedure` (`step0`, `step1`, ...): every run of
@@ -213,11 +450,37 @@ fn search_rules(procedure: &[Operator]) -> String {
 pub fn translation_constraint(symbols: &Symbols) -> ReplyConstraint {
     let mut grammar = format!("root ::= \"None\\n\" | (\"- \" atom \"\\n\"){{1,{ATOMS_PER_STATE}}}\n");
     grammar.push_str(&symbols.literal_rules());
+    let (atom, _) = symbols.json_patterns();
+    let json_schema = object_schema(vec![(
+        "atoms",
+        array_schema(pattern_schema(&atom), 0, ATOMS_PER_STATE),
+    )]);
     ReplyConstraint {
         name: "translate".into(),
         grammar,
-        json_schema: None,
+        json_schema: Some(json_schema),
     }
+}
+
+/// A translation given as JSON under [`translation_constraint`]'s schema, written out as
+/// the prompt's list of atoms (`None` for an empty list); `None` when the reply is not such
+/// an object.
+///
+/// ```
+/// use nesy_reasoner::constraints::translation_layout;
+/// assert_eq!(translation_layout(r#"{"atoms": ["(GripperOpen)"]}"#).unwrap(), "- (GripperOpen)\n");
+/// assert_eq!(translation_layout(r#"{"atoms": []}"#).unwrap(), "None\n");
+/// ```
+pub fn translation_layout(reply: &str) -> Option<String> {
+    let atoms = strings(&json_object(reply)?, "atoms")?;
+    let mut out = String::new();
+    if atoms.is_empty() {
+        out.push_str("None\n");
+    }
+    for atom in &atoms {
+        let _ = writeln!(out, "- {atom}");
+    }
+    Some(out)
 }
 
 #[cfg(test)]
@@ -288,6 +551,125 @@ line ::= [^\n]{{1,200}}
 {LITERALS}"#
         );
         assert_eq!(patch_constraint(&symbols(), &procedure).grammar, expected);
+    }
+
+    const ATOM: &str = r"\((?:(?:GripperOpen)|(?:Open) (?:red_cube|floor)|(?:OnTopOf) (?:red_cube|floor) (?:red_cube|floor))\)";
+    const QATOM: &str = r"\((?:(?:GripperOpen)|(?:Open) (?:(?:red_cube|floor)|\?x)|(?:OnTopOf) (?:(?:red_cube|floor)|\?x) (?:(?:red_cube|floor)|\?x))\)";
+
+    fn literal_pattern() -> String {
+        format!(r"^(?:{ATOM}|\(not {ATOM}\)|\(forall \(\?x - thing\) (?:{QATOM}|\(not {QATOM}\))\))$")
+    }
+
+    #[test]
+    fn induction_schema_is_the_action_block_over_the_symbols() {
+        let literal = literal_pattern();
+        let expected = json!({
+            "type": "object",
+            "properties": {
+                "rationale": {"type": "array", "items": {"type": "string", "minLength": 1, "maxLength": 200}, "minItems": 1, "maxItems": 4},
+                "action_semantic": {"type": "string", "minLength": 1, "maxLength": 200},
+                "preconditions": {"type": "array", "items": {"type": "string", "pattern": literal}, "minItems": 0, "maxItems": 12},
+                "effects": {"type": "array", "items": {"type": "string", "pattern": literal}, "minItems": 1, "maxItems": 12}
+            },
+            "required": ["rationale", "action_semantic", "preconditions", "effects"],
+            "additionalProperties": false
+        });
+        assert_eq!(induction_constraint(&symbols()).json_schema, Some(expected));
+    }
+
+    #[test]
+    fn translation_schema_lists_grounded_atoms() {
+        let expected = json!({
+            "type": "object",
+            "properties": {
+                "atoms": {"type": "array", "items": {"type": "string", "pattern": format!("^{ATOM}$")}, "minItems": 0, "maxItems": 48}
+            },
+            "required": ["atoms"],
+            "additionalProperties": false
+        });
+        assert_eq!(translation_constraint(&symbols()).json_schema, Some(expected));
+    }
+
+    #[test]
+    fn patch_schema_names_the_procedures_actions() {
+        let procedure = parse_procedure(
+            "OpenDrawer\n- Preconditions:\n\t(GripperOpen)\n- Effects:\n\t(Open floor)\n\n\
+             PlaceCube\n- Preconditions:\n\tNone\n- Effects:\n\t(OnTopOf red_cube floor)",
+        )
+        .unwrap();
+        let literal = literal_pattern();
+        let expected = json!({
+            "type": "object",
+            "properties": {
+                "rationale": {"type": "array", "items": {"type": "string", "minLength": 1, "maxLength": 200}, "minItems": 1, "maxItems": 4},
+                "search": {"type": "array", "items": {"type": "string", "enum": ["OpenDrawer", "PlaceCube"]}, "minItems": 1, "maxItems": 8},
+                "replace": {"type": "array", "items": {
+                    "type": "object",
+                    "properties": {
+                        "name": {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]{0,79}$"},
+                        "preconditions": {"type": "array", "items": {"type": "string", "pattern": literal}, "minItems": 0, "maxItems": 12},
+                        "effects": {"type": "array", "items": {"type": "string", "pattern": literal}, "minItems": 1, "maxItems": 12}
+                    },
+                    "required": ["name", "preconditions", "effects"],
+                    "additionalProperties": false
+                }, "minItems": 0, "maxItems": 6}
+            },
+            "required": ["rationale", "search", "replace"],
+            "additionalProperties": false
+        });
+        assert_eq!(
+            patch_constraint(&symbols(), &procedure).json_schema,
+            Some(expected)
+        );
+        // With no procedure yet, nothing can be searched for.
+        let empty = patch_constraint(&symbols(), &[]).json_schema.unwrap();
+        assert_eq!(empty["properties"]["search"]["maxItems"], 0);
+    }
+
+    /// JSON replies the schemas allow, written out in the layout, are read by the same
+    /// parsers as the grammar's replies.
+    #[test]
+    fn json_replies_the_schemas_allow_parse_after_layout() {
+        let induction = induction_layout(
+            r#"{"rationale": ["The cube was put down."], "action_semantic": "place the cube",
+                "preconditions": ["(not (OnTopOf red_cube floor))", "(forall (?x - thing) (not (Open ?x)))"],
+                "effects": ["(OnTopOf red_cube floor)"]}"#,
+        )
+        .unwrap();
+        let parsed = parse_induction_reply(&normalize_reply(&induction)).unwrap();
+        assert_eq!(parsed.operator.pre.len(), 2);
+        assert_eq!(parsed.operator.eff.len(), 1);
+
+        let procedure = parse_procedure(
+            "OpenDrawer\n- Preconditions:\n\t(GripperOpen)\n- Effects:\n\t(Open floor)\n\n\
+             PlaceCube\n- Preconditions:\n\tNone\n- Effects:\n\t(OnTopOf red_cube floor)",
+        )
+        .unwrap();
+        let patch = patch_layout(
+            r#"{"rationale": ["Drop the opening."], "search": ["OpenDrawer", "PlaceCube"],
+                "replace": [{"name": "PlaceCube", "preconditions": [], "effects": ["(OnTopOf red_cube floor)"]}]}"#,
+            &procedure,
+        )
+        .unwrap();
+        let parsed = parse_refinement_reply(&normalize_reply(&patch)).unwrap();
+        assert_eq!(parsed.patches[0].search, procedure);
+        assert_eq!(parsed.patches[0].replace, procedure[1..]);
+        // Names that are no run of the procedure are written out as they are, for the loop
+        // to report.
+        let unknown = patch_layout(
+            r#"{"rationale": ["x"], "search": ["PlaceCube", "OpenDrawer"], "replace": []}"#,
+            &procedure,
+        )
+        .unwrap();
+        assert!(
+            unknown.contains("<<<<<<< SEARCH\nPlaceCube\nOpenDrawer\n=======\n>>>>>>> REPLACE\n"),
+            "{unknown}"
+        );
+
+        let state =
+            translation_layout(r#"{"atoms": ["(GripperOpen)", "(OnTopOf red_cube floor)"]}"#).unwrap();
+        assert_eq!(parse_state_list(&normalize_reply(&state)).unwrap().len(), 2);
+        assert!(translation_layout(r#"{"atoms": "(GripperOpen)"}"#).is_none());
     }
 
     /// Replies written the way each grammar allows are read by the parsers the loop uses.

@@ -20,7 +20,7 @@ use nesy_vlm::PurposeSettings;
 use nesy_vlm::VlmClient;
 use nesy_vlm::VlmError;
 use nesy_vlm::reply::{self, AskError, CALL_ATTEMPTS, CallProblem};
-use nesy_vlm::{ChatRequest, Message, Part};
+use nesy_vlm::{ChatRequest, Message, Part, ReplyForm};
 
 /// The VLM side of the adaptation loop, plus state translation and code generation.
 ///
@@ -206,16 +206,23 @@ impl VlmReasoner {
     /// Sends an induction or patch request through the shared [`reply`](nesy_vlm::reply)
     /// policy: a reply cut short or with null content is re-asked here (up to
     /// [`CALL_ATTEMPTS`] replies), and the text that arrives (whole, or the last cut-short
-    /// one) goes to nesy-core, which parses it and re-asks within its own budget.
+    /// one) goes to nesy-core, which parses it and re-asks within its own budget. A reply
+    /// held to the call's JSON schema is first written out in the prompt's layout by
+    /// `layout` (a JSON reply that is not the schema's object goes on as it is).
     async fn send(
         &self,
         what: &str,
         chat: Result<ChatRequest, PromptError>,
+        layout: impl Fn(&str) -> Option<String>,
     ) -> Result<String, ReasonerError> {
         let chat =
             chat.map_err(|e| ReasonerError::new(ReasonerErrorKind::Request, format!("{what}: {e}")))?;
+        let json = self.client.reply_form(&chat) == ReplyForm::Json;
         let answer = reply::ask_until_usable(&self.client, chat, CALL_ATTEMPTS, what, |text| {
-            Ok::<_, std::convert::Infallible>(Ok::<_, CallProblem>(text.to_string()))
+            let written_out = if json { layout(text) } else { None };
+            Ok::<_, std::convert::Infallible>(Ok::<_, CallProblem>(
+                written_out.unwrap_or_else(|| text.to_string()),
+            ))
         })
         .await;
         match answer {
@@ -255,12 +262,15 @@ impl Reasoner for VlmReasoner {
             request.attempt + 1
         );
         let chat = self.induction_request(request);
-        self.send(&what, chat).await
+        self.send(&what, chat, constraints::induction_layout).await
     }
 
     async fn propose_patch(&mut self, request: &PatchRequest) -> Result<String, ReasonerError> {
         let what = format!("patch proposal {}", request.iteration + 1);
         let chat = self.patch_request(request);
-        self.send(&what, chat).await
+        self.send(&what, chat, |reply| {
+            constraints::patch_layout(reply, &request.procedure)
+        })
+        .await
     }
 }

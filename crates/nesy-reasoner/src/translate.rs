@@ -20,7 +20,7 @@ use nesy_vlm::CallSettings;
 use nesy_vlm::VlmClient;
 use nesy_vlm::VlmError;
 use nesy_vlm::reply::{self, AskError, Rejected, ReplyProblem};
-use nesy_vlm::{ChatRequest, Message, Part};
+use nesy_vlm::{ChatRequest, Message, Part, ReplyForm};
 
 /// What state translation needs.
 #[derive(Debug, Clone)]
@@ -264,8 +264,15 @@ pub async fn translate_state(
         constraints::translation_constraint(&symbols)
     });
     let what = format!("state translation for {}", request.view_set);
+    // A reply held to the JSON schema is written out as the prompt's list first.
+    let json = client.reply_form(&chat) == ReplyForm::Json;
     let answer = reply::ask_until_usable(client, chat, TRANSLATION_ATTEMPTS, &what, |text| {
-        Ok::<_, std::convert::Infallible>(read_translation(text, request))
+        let written_out = if json {
+            constraints::translation_layout(text)
+        } else {
+            None
+        };
+        Ok::<_, std::convert::Infallible>(read_translation(written_out.as_deref().unwrap_or(text), request))
     })
     .await
     .map_err(|error| match error {

@@ -439,3 +439,53 @@ fn every_template_renders() {
     // Rendering each kind above exercises every template; loading compiles them all.
     Prompts::load().unwrap();
 }
+
+/// A backend that holds replies only to JSON gets each call's schema in its own field, and
+/// the JSON it answers with reaches the loop written out in the prompt's layout.
+#[test]
+fn json_only_backends_get_the_schema_and_their_replies_are_written_out() {
+    use nesy_core::text::{normalize_reply, parse_induction_reply, parse_refinement_reply};
+    use nesy_testkit::Scripted;
+
+    let recorder = recorded();
+    let induction = &recorder.induction_requests[0];
+    let patch = &recorder.patch_requests[0];
+    let first_action = patch.procedure[0].display_name();
+    let patch_reply = format!(
+        r#"{{"rationale": ["Keep the first action."], "search": ["{first_action}"], "replace": []}}"#
+    );
+    let induce_reply = r#"{"rationale": ["The gripper moved."], "action_semantic": "approach the handle",
+        "preconditions": ["(GripperOpen)"], "effects": ["(not (GripperOpen))"]}"#;
+    for backend in [BackendKind::OpenAi, BackendKind::Ollama] {
+        let transport = Scripted::with(&[("induce", &[induce_reply]), ("patch", &[patch_reply.as_str()])]);
+        let config = nesy_testkit::mock_config(backend, "m", "http://127.0.0.1:9");
+        let mut reasoner = VlmReasoner::new(VlmClient::with_transport(&config, transport.clone())).unwrap();
+        let text = pollster::block_on(reasoner.induce_operator(induction)).unwrap();
+        assert!(
+            text.starts_with("* Prediction Rationale:\n- The gripper moved.\n"),
+            "{text}"
+        );
+        let parsed = parse_induction_reply(&normalize_reply(&text)).unwrap();
+        assert_eq!(parsed.operator.pre.len(), 1);
+        let text = pollster::block_on(reasoner.propose_patch(patch)).unwrap();
+        let parsed = parse_refinement_reply(&normalize_reply(&text)).unwrap();
+        assert_eq!(parsed.patches[0].search, patch.procedure[..1]);
+        assert!(parsed.patches[0].replace.is_empty());
+
+        let body = &transport.requests("induce")[0].body;
+        let schema = match backend {
+            BackendKind::OpenAi => {
+                assert_eq!(body["response_format"]["type"], "json_schema");
+                assert_eq!(body["response_format"]["json_schema"]["name"], "induce");
+                assert_eq!(body["response_format"]["json_schema"]["strict"], true);
+                body["response_format"]["json_schema"]["schema"].clone()
+            }
+            _ => body["format"].clone(),
+        };
+        assert_eq!(
+            schema["required"],
+            serde_json::json!(["rationale", "action_semantic", "preconditions", "effects"])
+        );
+        assert!(body.get("grammar").is_none());
+    }
+}

@@ -268,7 +268,11 @@ async fn a_cassette_keeps_what_the_server_announced_for_its_replay() {
     client.chat(constrained()).await.unwrap();
     // The default, sending constraints, is left out of the metadata.
     assert_eq!(recorded.meta.constrain, ConstrainMode::Auto);
-    assert!(!std::fs::read_to_string(&cassette).unwrap().contains("\"constrain\""));
+    assert!(
+        !std::fs::read_to_string(&cassette)
+            .unwrap()
+            .contains("\"constrain\"")
+    );
 }
 
 #[tokio::test]
