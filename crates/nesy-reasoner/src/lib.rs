@@ -39,6 +39,7 @@ mod context;
 mod failure;
 mod keyframes;
 pub mod prompts;
+pub mod readability;
 mod reasoner;
 pub mod translate;
 

@@ -4,7 +4,9 @@
 //! - `prune` drops the interactions a run did not use (from the usage report that run wrote
 //!   with `NESY_CASSETTE_USAGE`), and optionally blobs nothing refers to any more;
 //! - `verify` checks that every blob exists and matches its hash, that stored keys match
-//!   their requests, and that every response decodes. Exit code 1 if anything is wrong.
+//!   their requests, and that every response decodes. Exit code 1 if anything is wrong;
+//! - `replies` counts how many induction, patch and translation replies nesy's parsers read,
+//!   on the first try and after a re-ask, per method of a benchmark run's cassettes.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -48,6 +50,17 @@ pub(crate) enum CassetteAction {
         #[arg(long)]
         json: bool,
     },
+    /// Count the induction, patch and translation replies nesy's parsers read, first tries and
+    /// re-asks apart, grouped by cassette name (a benchmark run's `cassettes/` folder holds
+    /// one per scenario and method, named after the method).
+    Replies {
+        /// Cassette files, or folders searched for them.
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// Print the counts as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Check blobs, keys and response bodies; exit 1 if anything is wrong.
     Verify {
         /// Cassette files.
@@ -63,6 +76,7 @@ pub(crate) enum CassetteAction {
 pub(crate) fn run(args: CassetteArgs) -> anyhow::Result<ExitCode> {
     match args.action {
         CassetteAction::Inspect { cassette, json } => inspect(&cassette, json),
+        CassetteAction::Replies { paths, json } => replies(&paths, json),
         CassetteAction::Prune {
             cassette,
             used,
@@ -196,6 +210,98 @@ fn inspect(cassette: &std::path::Path, json: bool) -> anyhow::Result<ExitCode> {
         listing.distinct_images,
         models.join(", ")
     )?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The cassette files under `path` (itself, when it is a file), in name order; blob folders
+/// are skipped.
+fn cassette_files(path: &std::path::Path, out: &mut Vec<PathBuf>) -> anyhow::Result<()> {
+    if path.is_file() {
+        out.push(path.to_path_buf());
+        return Ok(());
+    }
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(path)
+        .with_context(|| format!("reading {}", path.display()))?
+        .map(|e| e.map(|e| e.path()))
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("reading {}", path.display()))?;
+    entries.sort();
+    for entry in entries {
+        if entry.is_dir() && entry.file_name().is_some_and(|n| n != "blobs") {
+            cassette_files(&entry, out)?;
+        } else if entry.extension().is_some_and(|e| e == "json") {
+            out.push(entry);
+        }
+    }
+    Ok(())
+}
+
+fn replies(paths: &[PathBuf], json: bool) -> anyhow::Result<ExitCode> {
+    use nesy_reasoner::readability::Readability;
+    let mut files = Vec::new();
+    for path in paths {
+        cassette_files(path, &mut files)?;
+    }
+    anyhow::ensure!(!files.is_empty(), "no cassette (*.json) under {paths:?}");
+    let mut readability = Readability::default();
+    for file in &files {
+        let cassette =
+            nesy_vlm::CassetteFile::load(file).with_context(|| format!("reading {}", file.display()))?;
+        let group = file
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        readability.add_cassette(&group, &cassette);
+    }
+    if json {
+        let rows: Vec<serde_json::Value> = readability
+            .groups
+            .iter()
+            .map(|((group, purpose), counts)| serde_json::json!({"group": group, "purpose": purpose, "counts": counts}))
+            .collect();
+        outln!("{}", serde_json::to_string_pretty(&rows)?)?;
+        return Ok(ExitCode::SUCCESS);
+    }
+    let share = |read: u64, of: u64| {
+        if of == 0 {
+            "-".to_owned()
+        } else {
+            format!("{read}/{of} ({:.1} %)", 100.0 * read as f64 / of as f64)
+        }
+    };
+    let width = readability
+        .groups
+        .keys()
+        .map(|(g, _)| g.len())
+        .max()
+        .unwrap_or(0)
+        .max(5);
+    outln!(
+        "{:<width$}  {:<10}  {:>7}  {:>20}  {:>20}  {:>9}  {:>11}",
+        "group",
+        "purpose",
+        "replies",
+        "first try read",
+        "re-asks read",
+        "cut short",
+        "constrained"
+    )?;
+    let by_purpose = readability.by_purpose();
+    let total = by_purpose
+        .iter()
+        .map(|(p, c)| (("(all)".to_owned(), p.clone()), c.clone()));
+    for ((group, purpose), c) in readability.groups.clone().into_iter().chain(total) {
+        outln!(
+            "{:<width$}  {:<10}  {:>7}  {:>20}  {:>20}  {:>9}  {:>11}",
+            group,
+            purpose,
+            c.replies,
+            share(c.first_read, c.first),
+            share(c.reasked_read, c.reasked),
+            c.cut_short,
+            c.constrained
+        )?;
+    }
+    outln!("{} cassette(s)", files.len())?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -14,6 +14,7 @@ mod adapt_live;
 mod adapt_realstyle;
 mod bench_baselines;
 mod bench_cli;
+mod cassette_cli;
 mod real_model;
 mod run_cli;
 mod scenarios_cli;

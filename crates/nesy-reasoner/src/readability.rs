@@ -1,0 +1,148 @@
+//! How often a model's recorded replies can be read: for every induction, patch and
+//! translation reply in a set of cassettes, whether nesy-core's parser reads it, counted
+//! separately for the first reply of each conversation (the model's first try) and for the
+//! replies to re-asks. It measures the layout only; whether the verifier then accepts what
+//! was read is the loop's business.
+//!
+//! Replies held to a JSON schema are written out in the prompt's layout first, as the loop
+//! does. A JSON patch names the actions of its SEARCH side, which only the procedure of its
+//! request can expand, so it counts as read when it is the schema's object.
+
+use std::collections::BTreeMap;
+
+use nesy_core::text::{normalize_reply, parse_induction_reply, parse_refinement_reply, parse_state_list};
+use nesy_vlm::CassetteFile;
+use serde::Serialize;
+use serde_json::Value;
+
+use crate::constraints::{induction_layout, patch_layout, translation_layout};
+
+/// The purposes whose replies have a layout nesy-core parses.
+pub const READ_PURPOSES: [&str; 3] = ["induce", "patch", "translate"];
+
+/// Counts for one group of replies (one method and purpose).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct ReplyCounts {
+    /// Replies recorded (with a status of 200).
+    pub replies: u64,
+    /// Replies cut off at the token cap or the context window (`finish_reason` `length`).
+    pub cut_short: u64,
+    /// First replies of a conversation (a request with one user turn).
+    pub first: u64,
+    /// First replies the parser read.
+    pub first_read: u64,
+    /// Replies to re-asks.
+    pub reasked: u64,
+    /// Replies to re-asks the parser read.
+    pub reasked_read: u64,
+    /// Replies held to a grammar or a JSON schema.
+    pub constrained: u64,
+}
+
+impl ReplyCounts {
+    /// The share of first replies that were read, or `None` without any.
+    pub fn first_try_share(&self) -> Option<f64> {
+        (self.first > 0).then(|| self.first_read as f64 / self.first as f64)
+    }
+
+    fn add(&mut self, other: &ReplyCounts) {
+        self.replies += other.replies;
+        self.cut_short += other.cut_short;
+        self.first += other.first;
+        self.first_read += other.first_read;
+        self.reasked += other.reasked;
+        self.reasked_read += other.reasked_read;
+        self.constrained += other.constrained;
+    }
+}
+
+/// Reply counts by group (the caller's label, e.g. the method) and purpose.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct Readability {
+    /// `(group, purpose)` to counts.
+    pub groups: BTreeMap<(String, String), ReplyCounts>,
+}
+
+impl Readability {
+    /// Counts the induction, patch and translation replies of `cassette` under `group`.
+    pub fn add_cassette(&mut self, group: &str, cassette: &CassetteFile) {
+        for interaction in &cassette.interactions {
+            let Some(purpose) = interaction.purpose.as_deref() else {
+                continue;
+            };
+            if !READ_PURPOSES.contains(&purpose) || interaction.response.status != 200 {
+                continue;
+            }
+            let Some(response) = interaction
+                .response
+                .body
+                .as_ref()
+                .and_then(|raw| serde_json::from_str::<Value>(raw.get()).ok())
+            else {
+                continue;
+            };
+            let choice = &response["choices"][0];
+            let text = choice["message"]["content"].as_str().unwrap_or("");
+            let body = &interaction.request.body;
+            let users = body["messages"]
+                .as_array()
+                .map_or(0, |m| m.iter().filter(|m| m["role"] == "user").count());
+            let counts = self
+                .groups
+                .entry((group.to_owned(), purpose.to_owned()))
+                .or_default();
+            counts.replies += 1;
+            counts.cut_short += u64::from(choice["finish_reason"] == "length");
+            let json_form = body.get("response_format").is_some() || body.get("format").is_some();
+            counts.constrained += u64::from(
+                json_form || body.get("grammar").is_some() || body.get("structured_outputs").is_some(),
+            );
+            let read = reads(purpose, text, json_form);
+            if users <= 1 {
+                counts.first += 1;
+                counts.first_read += u64::from(read);
+            } else {
+                counts.reasked += 1;
+                counts.reasked_read += u64::from(read);
+            }
+        }
+    }
+
+    /// The counts of each purpose over every group.
+    pub fn by_purpose(&self) -> BTreeMap<String, ReplyCounts> {
+        let mut out: BTreeMap<String, ReplyCounts> = BTreeMap::new();
+        for ((_, purpose), counts) in &self.groups {
+            out.entry(purpose.clone()).or_default().add(counts);
+        }
+        out
+    }
+}
+
+/// Whether nesy-core's parser for `purpose` reads `text` (written out of its JSON form
+/// first when it was held to a schema).
+///
+/// ```
+/// use nesy_reasoner::readability::reads;
+/// assert!(reads("translate", "- (GripperOpen)\n", false));
+/// assert!(!reads("translate", "The gripper is open.", false));
+/// assert!(reads("translate", r#"{"atoms": ["(GripperOpen)"]}"#, true));
+/// ```
+pub fn reads(purpose: &str, text: &str, json_form: bool) -> bool {
+    let written_out = if json_form {
+        match purpose {
+            "induce" => induction_layout(text),
+            "patch" => return patch_layout(text, &[]).is_some(),
+            "translate" => translation_layout(text),
+            _ => None,
+        }
+    } else {
+        None
+    };
+    let text = normalize_reply(written_out.as_deref().unwrap_or(text));
+    match purpose {
+        "induce" => parse_induction_reply(&text).is_ok(),
+        "patch" => parse_refinement_reply(&text).is_ok(),
+        "translate" => parse_state_list(&text).is_ok(),
+        _ => false,
+    }
+}
