@@ -33,6 +33,7 @@
 //! ```
 
 pub mod call_budget;
+pub mod compare;
 pub mod demos;
 mod error;
 pub mod harness;
@@ -44,6 +45,7 @@ pub mod pool;
 pub mod report;
 mod shard;
 pub mod slurm;
+pub mod stats;
 mod status;
 pub mod store;
 pub mod studies;

@@ -65,6 +65,10 @@ pub(crate) enum BenchAction {
     /// Write Slurm job-array files for a run: `run.sbatch` (one task per shard) and
     /// `merge.sbatch`.
     Slurm(SlurmArgs),
+    /// Is B better than A? Pairs two runs' units (or two variants of one run) by scenario
+    /// and repeat, and prints per cell and overall both success rates with 95 % Wilson
+    /// intervals, the difference with McNemar's exact test, and the units that changed.
+    Compare(CompareArgs),
     /// List the methods and controls with their classes and settings.
     Methods {
         /// Print them as JSON.
@@ -173,6 +177,28 @@ pub(crate) struct RunArgs {
     pub vlm_config: ConfigOverrides,
 }
 
+/// Arguments of `nesy bench compare`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct CompareArgs {
+    /// Run A (the baseline of the comparison).
+    pub run_a: PathBuf,
+    /// Run B (default: run A, comparing two of its variants).
+    pub run_b: Option<PathBuf>,
+    /// The variant of run A (default: its only one).
+    #[arg(long, value_name = "VARIANT")]
+    pub a: Option<String>,
+    /// The variant of run B (default: its only one).
+    #[arg(long, value_name = "VARIANT")]
+    pub b: Option<String>,
+    /// Exit 1 when B's success rate is below A's by more than PP percentage points with
+    /// p < 0.05 (McNemar's exact test), so that the comparison can gate a change.
+    #[arg(long, value_name = "PP")]
+    pub fail_if_worse: Option<f64>,
+    /// Print the comparison as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
 /// Arguments of `nesy bench demos`.
 #[derive(Debug, clap::Args)]
 pub(crate) struct DemosArgs {
@@ -229,8 +255,84 @@ pub(crate) fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
             merge(&run, allow_partial)
         }
         BenchAction::Slurm(a) => slurm(a),
+        BenchAction::Compare(a) => compare(&a),
         BenchAction::Methods { json } => list_methods(json),
     }
+}
+
+fn compare(args: &CompareArgs) -> anyhow::Result<ExitCode> {
+    use nesy_bench::compare;
+    if let Some(pp) = args.fail_if_worse {
+        anyhow::ensure!(
+            pp.is_finite() && pp >= 0.0,
+            "--fail-if-worse must be a non-negative number of percentage points, got {pp}"
+        );
+    }
+    let run_b = args.run_b.as_deref().unwrap_or(&args.run_a);
+    let a = compare::pick_variant(&args.run_a, args.a.as_deref())?;
+    let b = compare::pick_variant(run_b, args.b.as_deref())?;
+    let result = compare::compare((&args.run_a, &a), (run_b, &b))?;
+    let worse = args.fail_if_worse.is_some_and(|pp| result.worse_by_more_than(pp));
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&result)?)?;
+    } else {
+        outln!("A: {} in {}", result.a.variant, result.a.run)?;
+        outln!("B: {} in {}", result.b.variant, result.b.run)?;
+        outln!(
+            "{:<40}  {:<36}  {:<36}  {:>8}  {:>9}  {:>8}  {:>12}",
+            "cell",
+            "SR of A",
+            "SR of B",
+            "B − A",
+            "A↑ / B↑",
+            "p",
+            "units needed"
+        )?;
+        let rows = result
+            .cells
+            .iter()
+            .map(|(g, c, cell)| (format!("{} / {}", g.title(), c.as_str()), cell))
+            .chain(std::iter::once(("overall".to_owned(), &result.overall)));
+        for (name, cell) in rows {
+            outln!(
+                "{:<40}  {:<36}  {:<36}  {:>+7.1}pp  {:>9}  {:>8.4}  {:>12}",
+                name,
+                cell.a.describe(),
+                cell.b.describe(),
+                cell.difference_pp(),
+                format!("{} / {}", cell.only_a, cell.only_b),
+                cell.p_value,
+                cell.units_needed.map_or("-".to_owned(), |n| n.to_string())
+            )?;
+        }
+        if result.unpaired > 0 {
+            outln!(
+                "{} scored unit(s) had no partner and were left out",
+                result.unpaired
+            )?;
+        }
+        for c in &result.changed {
+            outln!("changed: {}  {} → {}", c.unit, c.a, c.b)?;
+        }
+        if let Some(pp) = args.fail_if_worse {
+            outln!(
+                "{}",
+                if worse {
+                    format!(
+                        "WORSE: B is below A by more than {pp} points with p < {}",
+                        compare::ALPHA
+                    )
+                } else {
+                    format!("not worse by more than {pp} points at p < {}", compare::ALPHA)
+                }
+            )?;
+        }
+    }
+    Ok(if worse {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    })
 }
 
 fn cores() -> usize {

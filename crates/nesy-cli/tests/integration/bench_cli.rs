@@ -304,6 +304,47 @@ fn the_ablation_study_runs_its_rows_and_reports_them_in_table_3_shape() {
     let manifest = std::fs::read_to_string(run.join("manifest.json")).unwrap();
     assert!(manifest.contains("\"study\": \"ablation\""), "{manifest}");
 
+    // Two of its rows compared unit by unit: the two repeats pair up.
+    let variants: Vec<String> = serde_json::from_str::<serde_json::Value>(&manifest).unwrap()["variants"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v["id"].as_str().unwrap().to_owned())
+        .collect();
+    let compare = |extra: &[&str]| {
+        let mut args: Vec<String> = [
+            "bench",
+            "compare",
+            &run.display().to_string(),
+            "--a",
+            &variants[0],
+            "--b",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        args.push(variants[5].clone());
+        args.extend(extra.iter().map(|s| s.to_string()));
+        common::nesy(&args)
+    };
+    let out = compare(&["--json"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let result: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(result["overall"]["a"]["n"], 2);
+    assert_eq!(result["cells"].as_array().unwrap().len(), 1);
+    let table = String::from_utf8_lossy(&compare(&[]).stdout).into_owned();
+    assert!(table.contains("Combination / medium"), "{table}");
+    // Two pairs can never be significant, so no gate fails.
+    assert_eq!(compare(&["--fail-if-worse", "0"]).status.code(), Some(0));
+    let unnamed = common::nesy(&["bench".into(), "compare".into(), run.display().to_string()]);
+    assert_eq!(unnamed.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&unnamed.stderr).contains("holds 6 variants"));
+
     let stateless = common::nesy(&[
         "bench".into(),
         "plan".into(),
