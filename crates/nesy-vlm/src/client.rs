@@ -122,24 +122,32 @@ impl VlmClient {
         live: Option<Arc<dyn Transport>>,
         backend_label: Option<String>,
     ) -> Result<Self, VlmError> {
+        let mut config = config.clone();
         let transport: Arc<dyn Transport> = match &config.cassette {
-            Some(cassette) => Arc::new(CassetteTransport::open(
-                &cassette.path,
-                cassette.mode,
-                live,
-                CassetteOptions {
-                    strict: cassette.strict,
-                    usage_report: cassette.usage_report.clone(),
-                    model: Some(config.model.clone()),
-                    backend: backend_label,
-                    redact: config.api_key.iter().cloned().collect(),
-                    allow_playback_repeats: false,
-                    constrain: config.defaults.constrain,
-                },
-            )?),
+            Some(cassette) => {
+                let transport = CassetteTransport::open(
+                    &cassette.path,
+                    cassette.mode,
+                    live,
+                    CassetteOptions {
+                        strict: cassette.strict,
+                        usage_report: cassette.usage_report.clone(),
+                        model: Some(config.model.clone()),
+                        backend: backend_label,
+                        redact: config.api_key.iter().cloned().collect(),
+                        allow_playback_repeats: false,
+                        constrain: config.defaults.constrain,
+                    },
+                )?;
+                // A pure replay builds its bodies as the recording did, so that they match.
+                if cassette.mode == CassetteMode::None {
+                    config.defaults.constrain = transport.recorded_constrain();
+                }
+                Arc::new(transport)
+            }
             None => live.ok_or_else(|| VlmError::InvalidRequest("no transport configured".into()))?,
         };
-        Ok(Self::with_transport(config, transport))
+        Ok(Self::with_transport(&config, transport))
     }
 
     /// The live HTTP transport for a configuration (checks that a required key is set).

@@ -12,7 +12,7 @@ use crate::unit_record::UnitRecord;
 
 pub(super) fn table1_csv(tables: &Tables) -> String {
     let mut out = String::from(
-        "variant,group,complexity,n,sr_mean,sr_se,gc_mean,gc_se,pd_success_mean,pd_success_se,pd_success_n,pd_all_mean,pd_all_se,latched_sr_mean,latched_sr_se,latched_gc_mean,latched_gc_se\n",
+        "variant,group,complexity,n,sr_mean,sr_se,gc_mean,gc_se,pd_success_mean,pd_success_se,pd_success_n,pd_all_mean,pd_all_se,latched_sr_mean,latched_sr_se,latched_gc_mean,latched_gc_se,sr_k,sr_wilson95_lo,sr_wilson95_hi\n",
     );
     let num = |x: f64| {
         if x.is_nan() {
@@ -26,9 +26,11 @@ pub(super) fn table1_csv(tables: &Tables) -> String {
             let m = t.mean_se().percent();
             format!("{},{}", num(m.mean), num(m.se))
         };
+        let counts = a.sr_counts();
+        let (lo, hi) = counts.wilson_95().unwrap_or((f64::NAN, f64::NAN));
         let _ = writeln!(
             out,
-            "{v},{group},{complexity},{},{},{},{},{},{},{},{}",
+            "{v},{group},{complexity},{},{},{},{},{},{},{},{},{},{},{}",
             a.n(),
             f(&a.sr),
             f(&a.gc),
@@ -36,7 +38,10 @@ pub(super) fn table1_csv(tables: &Tables) -> String {
             a.pd_success.n,
             f(&a.pd_all),
             f(&a.latched_sr),
-            f(&a.latched_gc)
+            f(&a.latched_gc),
+            counts.k,
+            num(100.0 * lo),
+            num(100.0 * hi)
         );
     };
     for v in &tables.variants {

@@ -251,12 +251,57 @@ fn write_table1(md: &mut String, tables: &Tables, records: &[&UnitRecord]) {
             "\nThis run includes scenarios of the auxiliary complexity-gap suite (not part of the 440). They count here under their factor at low complexity, whatever the target's subtask count; the study section gives them by added subtasks."
         );
     }
+    write_wilson(md, tables);
     let _ = writeln!(md, "\n### The authors' latched SR and GC\n");
     let _ = writeln!(
         md,
         "The same units scored as the authors score them: an object counts once it was placed, even if it is knocked out again later.\n"
     );
     md.push_str(&table1_markdown(tables, true));
+}
+
+/// SR as success counts with 95 % Wilson intervals per factor group and overall, and how
+/// many units per method a 10-point difference from each rate would need to be detected.
+fn write_wilson(md: &mut String, tables: &Tables) {
+    let _ = writeln!(md, "\n### SR as counts, with 95 % Wilson intervals\n");
+    let _ = writeln!(
+        md,
+        "k/n successes (strict) and the Wilson score interval, which stays inside 0–100 % for small n. The last column: units per method that a two-sided test at 5 % with 80 % power would need to tell this overall rate from one 10 points lower (or higher, at 100 %); compare two runs unit by unit with `nesy bench compare`.\n"
+    );
+    let mut header = String::from("| Method |");
+    let mut rule = String::from("|---|");
+    for g in FactorGroup::ALL {
+        let _ = write!(header, " {} |", g.title());
+        rule.push_str("---|");
+    }
+    header.push_str(" All | units for ±10 pts |");
+    rule.push_str("---|---|");
+    let _ = writeln!(md, "{header}\n{rule}");
+    let cell = |p: crate::stats::Proportion| match p.wilson_95() {
+        Some((lo, hi)) => format!("{}/{} [{:.1}, {:.1}]", p.k, p.n, 100.0 * lo, 100.0 * hi),
+        None => "–".to_owned(),
+    };
+    for v in &tables.variants {
+        let mut row = format!("| {} |", title_of(v));
+        for g in FactorGroup::ALL {
+            let p = tables.cells[v]
+                .get(&(g, None))
+                .map(|a| a.sr_counts())
+                .unwrap_or_default();
+            let _ = write!(row, " {} |", cell(p));
+        }
+        let all = tables.all[v].sr_counts();
+        let needed = all.rate().and_then(|r| {
+            let other = if r >= 0.1 { r - 0.1 } else { r + 0.1 };
+            crate::stats::units_to_detect(r, other)
+        });
+        let _ = writeln!(
+            md,
+            "{row} {} | {} |",
+            cell(all),
+            needed.map_or("–".to_owned(), |n| n.to_string())
+        );
+    }
 }
 
 /// How every unit ended, the excluded scenarios and the units that did not succeed.

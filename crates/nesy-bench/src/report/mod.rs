@@ -103,6 +103,15 @@ impl Aggregate {
     pub fn n(&self) -> usize {
         self.sr.n
     }
+
+    /// Strict successes out of the scored units.
+    pub fn sr_counts(&self) -> crate::stats::Proportion {
+        crate::stats::Proportion {
+            // SR is 0 or 1 per unit, so its sum counts the successes.
+            k: self.sr.sum.round() as u64,
+            n: self.sr.n as u64,
+        }
+    }
 }
 
 /// A cell of Table 1: a factor group at a complexity, or pooled over complexities (`None`).

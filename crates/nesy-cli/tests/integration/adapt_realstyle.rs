@@ -19,6 +19,14 @@ use serde_json::Value;
 const DEMO_DIR: &str = "fixtures/demos/adapt-realstyle";
 const CASSETTE: &str = "fixtures/cassettes/adapt-realstyle.json";
 
+/// The fixture's client: a model in prose, so no reply is held to a JSON schema (the
+/// cassette says `constrain: off`, and its replays send none either).
+fn unconstrained() -> VlmConfig {
+    let mut config = VlmConfig::new(BackendKind::OpenAi, common::realstyle::MODEL);
+    config.defaults.constrain = nesy_vlm::ConstrainMode::Off;
+    config
+}
+
 #[test]
 #[ignore = "regenerates the committed demo and cassette"]
 fn record_realstyle_fixture() {
@@ -38,7 +46,7 @@ fn record_realstyle_fixture() {
     };
     let setup = VlmSetup {
         source: VlmSource::Transport {
-            config: Box::new(VlmConfig::new(BackendKind::OpenAi, common::realstyle::MODEL)),
+            config: Box::new(unconstrained()),
             transport: Arc::new(common::realstyle::HandWritten),
         },
         record: Some(cassette),

@@ -224,6 +224,8 @@ pub struct CassetteTransport {
     recorded: Vec<Recorded>,
     replay: Mutex<ReplayState>,
     announced: Mutex<Announced>,
+    /// Whether the replayed recording sent constraints (its metadata's `constrain`).
+    recorded_constrain: ConstrainMode,
     /// Serialises writes within the process (the lock file does so across processes) and
     /// remembers whether `all` mode has discarded the old recording yet.
     writer: Mutex<bool>,
@@ -241,6 +243,12 @@ impl fmt::Debug for CassetteTransport {
 }
 
 impl CassetteTransport {
+    /// Whether the recording it replays sent reply constraints (`auto` when it replays
+    /// nothing).
+    pub fn recorded_constrain(&self) -> ConstrainMode {
+        self.recorded_constrain
+    }
+
     /// Opens a cassette. `inner` is the live transport used to record; it may be `None` in
     /// `none` mode (and in `once` mode when the file exists).
     pub fn open(
@@ -263,9 +271,11 @@ impl CassetteTransport {
         let mut recorded = Vec::new();
         let mut state = ReplayState::default();
         let mut announced = Announced::default();
+        let mut recorded_constrain = ConstrainMode::Auto;
         if existed && replays {
             let file = CassetteFile::load(&path)?;
             announced.recorded = file.meta.server.clone();
+            recorded_constrain = file.meta.constrain;
             let mut occurrences: HashMap<String, usize> = HashMap::new();
             for (index, interaction) in file.interactions.into_iter().enumerate() {
                 let key = request_key(&interaction.request.path, &interaction.request.body);
@@ -301,6 +311,7 @@ impl CassetteTransport {
             recorded,
             replay: Mutex::new(state),
             announced: Mutex::new(announced),
+            recorded_constrain,
             writer: Mutex::new(false),
         })
     }
