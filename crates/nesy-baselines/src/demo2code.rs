@@ -3,7 +3,6 @@
 //! out), then one action-planning call that gets the observations, the target's state and
 //! images and the predicates, and answers with the numbered plan for the target.
 
-use futures::future::try_join_all;
 use nesy_vlm::{ReplyLength, VlmClient};
 use serde::Serialize;
 
@@ -70,7 +69,7 @@ pub(crate) async fn observe_all(
         .keyframes
         .iter()
         .map(|keyframe| observe(client, prompts, inputs, keyframe));
-    Ok(try_join_all(calls).await?.into_iter().unzip())
+    Ok(crate::stage::all_in_order(calls).await?.into_iter().unzip())
 }
 
 async fn observe(

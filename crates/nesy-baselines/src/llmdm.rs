@@ -29,7 +29,6 @@
 
 use std::time::Duration;
 
-use futures::future::try_join_all;
 use nesy_core::pddl::{parse_domain, parse_problem};
 use nesy_core::planner::{Grounding, Heuristic, PlannerConfig, Search, plan};
 use nesy_vlm::{Part, ReplyLength, VlmClient};
@@ -280,7 +279,10 @@ impl<'a> Flow<'a> {
             }
         });
         let (models, records): (Vec<ActionModel>, Vec<StageRecord>) =
-            try_join_all(constructions).await?.into_iter().unzip();
+            crate::stage::all_in_order(constructions)
+                .await?
+                .into_iter()
+                .unzip();
         self.stages.extend(records);
         Ok(models)
     }

@@ -202,3 +202,12 @@ pub(crate) fn numbered_plan(reply: &str) -> Result<Vec<String>, String> {
         Ok(steps)
     }
 }
+
+/// Runs every call to its end and returns their results in order, or the first error in
+/// that order. Stopping at the first failure would leave how many of the other calls were
+/// made to timing, and a replay of the run would not make the same calls.
+pub(crate) async fn all_in_order<T, E>(
+    calls: impl IntoIterator<Item = impl std::future::Future<Output = Result<T, E>>>,
+) -> Result<Vec<T>, E> {
+    futures::future::join_all(calls).await.into_iter().collect()
+}

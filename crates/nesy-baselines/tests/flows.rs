@@ -210,6 +210,32 @@ fn in_the_text_observation_setting_no_request_carries_a_picture() {
     assert!(!user.contains("scene front"), "{user}");
 }
 
+/// A reply of Gemma 3 270M (Q4_K_M, pretrained) to Demo2Code's observation prompt in the
+/// text-observation setting, recorded against a local llama.cpp server: it never stops and is
+/// cut off at the 256-token cap.
+const RECORDED_RUNAWAY: &str = "<length>You may give a code at this point to the system.\nYou may give an answer to the system:\n\nThe model has been placed on top of a box and is held by a gripper.\nThis is a 3-state scenario (a 2-state scenario is also possible, but it's not needed here).\n- The robot is holding the box firmly with its mouth open and the gripper is grasping it from the floor.\n- The robot's gripper is working on the box, holding the box firmly with its mouth open.\n- The robot has opened the box and is holding the floor with its mouth closed.\n- The robot has lifted the box from the floor and is in a position to carry the object.\n\nAnswer:\n- The model has been placed on top of a box and is held by a gripper.\n- The robot ";
+
+/// Every observation runs away, as the recorded model's did; the flow fails on the first
+/// keyframe's, but only after every keyframe's observation has ended, so the calls made do
+/// not depend on timing and a replay makes the same ones (with a fast server the others used
+/// to be cancelled at the first failure, with a slow one most had already been made).
+#[test]
+fn a_failed_observation_still_lets_every_keyframe_be_observed() {
+    let transport = Scripted::with(&[(demo2code::OBSERVE, &[RECORDED_RUNAWAY; 6])]);
+    let error = pollster::block_on(demo2code::run(
+        &client(transport.clone(), None),
+        &state_text_inputs(Fidelity::Authors),
+    ))
+    .unwrap_err();
+    assert!(
+        matches!(&error, BaselineError::Unreadable { purpose, attempts: 2, .. } if purpose == "d2c.observe"),
+        "{error:?}"
+    );
+    assert!(error.to_string().contains("cut off at the token cap"), "{error}");
+    // Each of the three keyframes asked twice (the re-ask of a cut-off reply).
+    assert_eq!(transport.requests(demo2code::OBSERVE).len(), 6);
+}
+
 #[test]
 fn an_observation_without_its_line_fails_as_the_authors_parser_does_or_is_re_asked() {
     let prose = "I see a robot and a cube.";

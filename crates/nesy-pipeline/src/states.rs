@@ -244,7 +244,9 @@ fn translation_requests(
 }
 
 /// Runs the translations concurrently (the client caps how many calls are in flight) and
-/// returns them in request order.
+/// returns them in request order. Every translation runs to its end before the first
+/// failure in request order is reported: stopping at the first one to fail would leave the
+/// calls made to timing, and a replay of the run would not make the same ones.
 async fn translate_all(
     reasoner: &VlmReasoner,
     requests: Vec<StateTranslationRequest>,
@@ -259,22 +261,25 @@ async fn translate_all(
             (i, request, result)
         });
     }
-    let mut results: Vec<Option<(StateTranslationRequest, TranslatedState)>> = vec![None; total];
+    let mut results: Vec<Option<Result<(StateTranslationRequest, TranslatedState), PipelineError>>> =
+        (0..total).map(|_| None).collect();
     let mut done = 0;
     while let Some(joined) = set.join_next().await {
         let (i, request, result) = joined.map_err(|e| PipelineError::States {
             message: format!("a state-translation task ended abnormally: {e}"),
             kind: None,
         })?;
-        let translated = result.map_err(|e| PipelineError::States {
-            message: format!("translating the states of {}: {e}", request.view_set),
-            kind: Some(e.reasoner_kind()),
-        })?;
         done += 1;
         progress.detail(&format!("state translation {done}/{total}"));
-        results[i] = Some((request, translated));
+        results[i] = Some(match result {
+            Ok(translated) => Ok((request, translated)),
+            Err(e) => Err(PipelineError::States {
+                message: format!("translating the states of {}: {e}", request.view_set),
+                kind: Some(e.reasoner_kind()),
+            }),
+        });
     }
-    Ok(results.into_iter().flatten().collect())
+    results.into_iter().flatten().collect()
 }
 
 /// Precision, recall and F1 of the translations against ground truth, micro-averaged over
