@@ -40,6 +40,19 @@ fn oldest_follow_up_is_droppable(request: &ChatRequest) -> bool {
 }
 
 /// [`estimate_prompt_tokens`] of a whole request.
+/// `tokens` times `scale`, rounded up.
+fn scaled(tokens: u32, scale: f64) -> u32 {
+    if scale <= 1.0 {
+        return tokens;
+    }
+    let value = (f64::from(tokens) * scale).ceil();
+    if value >= f64::from(u32::MAX) {
+        u32::MAX
+    } else {
+        value as u32
+    }
+}
+
 fn estimate_request_tokens(request: &ChatRequest) -> u32 {
     let text_bytes: usize = request
         .messages
@@ -267,10 +280,12 @@ impl VlmClient {
     /// Checks `request` against what the server announced, and sizes its reply to the room
     /// the context window leaves: pictures never go to a server that takes none, and a
     /// prompt that would not fit is not sent at all.
+    /// `scale` corrects the token estimate when the server has said how far off it was.
     fn fit_to_server(
         &self,
         mut request: ChatRequest,
         caps: &ServerCapabilities,
+        scale: f64,
     ) -> Result<ChatRequest, VlmError> {
         let images = request.image_count();
         if images > 0 && caps.refuses_images() {
@@ -294,12 +309,13 @@ impl VlmClient {
             .max(MIN_REPLY_TOKENS);
         // A conversation of re-asks that outgrows the window loses its oldest rejected
         // reply and correction first; the task and the latest turns stay.
-        let mut estimated = estimate_request_tokens(&request);
+        let estimate = |request: &ChatRequest| scaled(estimate_request_tokens(request), scale);
+        let mut estimated = estimate(&request);
         let mut dropped = 0;
         while estimated.saturating_add(wanted) > context && oldest_follow_up_is_droppable(&request) {
             request.messages.drain(FIRST_FOLLOW_UP..FIRST_FOLLOW_UP + 2);
             dropped += 1;
-            estimated = estimate_request_tokens(&request);
+            estimated = estimate(&request);
         }
         if dropped > 0 {
             tracing::info!(
@@ -332,9 +348,38 @@ impl VlmClient {
             }
         }
         let caps = self.capabilities().await;
-        let request = self.fit_to_server(request, &caps)?;
-        let sent_cap = self.effective_cap(&request);
-        let wire = self.wire_request(&request);
+        // Kept for a second fit when the server says the estimate was short of its count.
+        let original = caps.context_tokens.map(|_| request.clone());
+        let fitted = self.fit_to_server(request, &caps, 1.0)?;
+        let outcome = self.send_fitted(&fitted, &caps).await;
+        let (Some(original), Err(VlmError::Http { provider, .. })) = (original, &outcome) else {
+            return outcome;
+        };
+        let estimated = estimate_request_tokens(&fitted);
+        match provider.prompt_tokens_over_context() {
+            // The prompt is larger than estimated (the tokenizer packs this text less
+            // densely): fit it again with the server's own count, once.
+            Some(actual) if actual > estimated => {
+                let scale = f64::from(actual) / f64::from(estimated.max(1));
+                tracing::info!(
+                    purpose = original.purpose.as_deref().unwrap_or("-"),
+                    "the server counted {actual} prompt tokens where {estimated} were estimated; fitting the request again"
+                );
+                let refitted = self.fit_to_server(original, &caps, scale)?;
+                self.send_fitted(&refitted, &caps).await
+            }
+            _ => outcome,
+        }
+    }
+
+    /// Sends a request already fitted to the server and records it.
+    async fn send_fitted(
+        &self,
+        request: &ChatRequest,
+        caps: &ServerCapabilities,
+    ) -> Result<ChatResponse, VlmError> {
+        let sent_cap = self.effective_cap(request);
+        let wire = self.wire_request(request);
         let started = Instant::now();
         let (result, attempts, origin) = self.send_with_retries(&wire).await;
         let (outcome, usage) = match result {

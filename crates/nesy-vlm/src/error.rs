@@ -278,6 +278,42 @@ impl ProviderError {
         (unsupported && about_images).then_some("image input")
     }
 
+    /// The prompt's size in tokens, when the server refused the request because it does not
+    /// fit its context window and said how large it was: llama.cpp's
+    /// `exceed_context_size_error` (`n_prompt_tokens`), or vLLM's "you requested N tokens
+    /// (P in the messages, …)".
+    ///
+    /// ```
+    /// use nesy_vlm::ProviderError;
+    /// let llama = br#"{"error":{"code":400,"message":"request (8236 tokens) exceeds the available context size (8192 tokens), try increasing it","type":"exceed_context_size_error","n_prompt_tokens":8236,"n_ctx":8192}}"#;
+    /// assert_eq!(ProviderError::from_body(llama).prompt_tokens_over_context(), Some(8236));
+    /// let vllm = br#"{"object":"error","message":"This model's maximum context length is 4096 tokens. However, you requested 4600 tokens (3600 in the messages, 1000 in the completion). Please reduce the length of the messages or completion.","type":"BadRequestError","code":400}"#;
+    /// assert_eq!(ProviderError::from_body(vllm).prompt_tokens_over_context(), Some(3600));
+    /// assert_eq!(ProviderError::from_body(b"busy").prompt_tokens_over_context(), None);
+    /// ```
+    pub fn prompt_tokens_over_context(&self) -> Option<u32> {
+        if self.error_type.as_deref() == Some("exceed_context_size_error") {
+            let body: serde_json::Value = serde_json::from_str(&self.body).ok()?;
+            return body["error"]["n_prompt_tokens"]
+                .as_u64()
+                .and_then(|n| u32::try_from(n).ok());
+        }
+        let message = &self.message;
+        if !message.contains("maximum context length") {
+            return None;
+        }
+        let before = message.split(" in the messages").next()?;
+        let digits: String = before
+            .chars()
+            .rev()
+            .take_while(char::is_ascii_digit)
+            .collect::<Vec<_>>()
+            .into_iter()
+            .rev()
+            .collect();
+        digits.parse().ok()
+    }
+
     /// This error with every occurrence of `secret` redacted (the configured key, whatever
     /// its shape).
     pub fn without_secret(mut self, secret: &crate::secret::SecretString) -> Self {

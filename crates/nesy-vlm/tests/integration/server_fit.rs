@@ -298,3 +298,90 @@ async fn a_cassette_recorded_without_constraints_says_so() {
     let recorded = nesy_vlm::CassetteFile::load(&cassette).unwrap();
     assert_eq!(recorded.meta.constrain, ConstrainMode::Off);
 }
+
+/// The refusal a llama.cpp server sent for a NeSyCR patch proposal against Gemma 3 270M, the
+/// ninth turn of a conversation of re-asks: the estimate had the prompt below 7,168 tokens,
+/// the server counted 8,236.
+const RECORDED_OVERFLOW: &str = r#"{"error":{"code":400,"message":"request (8236 tokens) exceeds the available context size (8192 tokens), try increasing it","type":"exceed_context_size_error","n_prompt_tokens":8236,"n_ctx":8192}}"#;
+
+#[tokio::test]
+async fn a_prompt_the_server_counts_larger_is_fitted_again_with_its_count() {
+    let server = MockServer::start().await;
+    Mock::given(method("GET"))
+        .and(path("/props"))
+        .respond_with(
+            ResponseTemplate::new(200).set_body_json(json!({"default_generation_settings": {"n_ctx": 8192}})),
+        )
+        .mount(&server)
+        .await;
+    Mock::given(method("POST"))
+        .and(path("/v1/chat/completions"))
+        .respond_with(ResponseTemplate::new(400).set_body_raw(RECORDED_OVERFLOW, "application/json"))
+        .up_to_n_times(1)
+        .with_priority(1)
+        .mount(&server)
+        .await;
+    Mock::given(method("POST"))
+        .and(path("/v1/chat/completions"))
+        .respond_with(ResponseTemplate::new(200).set_body_json(completion("* Refinement rationale:\n- x\n")))
+        .mount(&server)
+        .await;
+    let cfg = config(BackendKind::LlamaCpp, "m", &format!("{}/v1", server.uri()));
+    let client = VlmClient::from_config(&cfg).unwrap();
+    // The task and six rejected proposals with their corrections: about 6,500 tokens by the
+    // estimate, which leaves room for the 1,024-token patch cap.
+    let mut request = ChatRequest::new()
+        .purpose("patch")
+        .message(Message::system("Repair the procedure."))
+        .message(Message::user_text("(OnTopOf yellow_cube floor)\n".repeat(420)));
+    for turn in 0..6 {
+        request = request
+            .message(Message::assistant(format!(
+                "proposal {turn}: {}",
+                "- (OverOf orange hinge_body)\n".repeat(30)
+            )))
+            .message(Message::user_text(format!(
+                "rejected {turn}: {}",
+                "- (GripperOpen)\n".repeat(20)
+            )));
+    }
+    let response = client.chat(request).await.unwrap();
+    assert!(response.text.starts_with("* Refinement rationale:"));
+    let bodies = posted_bodies(&server).await;
+    assert_eq!(bodies.len(), 2, "one refusal, then the request fitted again");
+    let messages = |b: &Value| b["messages"].as_array().unwrap().len();
+    assert_eq!(messages(&bodies[0]), 14);
+    assert!(messages(&bodies[1]) < 14, "the oldest re-ask turns were left out");
+    assert_eq!(messages(&bodies[1]) % 2, 0);
+    // The system prompt, the task and the latest exchange stay.
+    assert_eq!(bodies[1]["messages"][1], bodies[0]["messages"][1]);
+    assert_eq!(
+        bodies[1]["messages"].as_array().unwrap().last(),
+        bodies[0]["messages"].as_array().unwrap().last()
+    );
+}
+
+#[tokio::test]
+async fn a_refusal_that_gives_no_count_is_not_sent_again() {
+    let server = MockServer::start().await;
+    Mock::given(method("GET"))
+        .and(path("/props"))
+        .respond_with(
+            ResponseTemplate::new(200).set_body_json(json!({"default_generation_settings": {"n_ctx": 8192}})),
+        )
+        .mount(&server)
+        .await;
+    Mock::given(method("POST"))
+        .and(path("/v1/chat/completions"))
+        .respond_with(ResponseTemplate::new(400).set_body_raw(
+            r#"{"error":{"code":400,"message":"bad grammar","type":"invalid_request_error"}}"#,
+            "application/json",
+        ))
+        .mount(&server)
+        .await;
+    let cfg = config(BackendKind::LlamaCpp, "m", &format!("{}/v1", server.uri()));
+    let client = VlmClient::from_config(&cfg).unwrap();
+    let error = client.chat(constrained()).await.unwrap_err();
+    assert!(matches!(error, VlmError::Http { status: 400, .. }), "{error}");
+    assert_eq!(posted_bodies(&server).await.len(), 1);
+}
