@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 
 use nesy_vlm::TransportError;
 use nesy_vlm::VlmError;
-use nesy_vlm::{BoxFuture, Transport, WireRequest, WireResponse};
+use nesy_vlm::{BoxFuture, ServerCapabilities, Transport, WireRequest, WireResponse};
 use tokio::sync::Semaphore;
 
 /// What a unit's calls came to.
@@ -104,6 +104,12 @@ impl Transport for Metered {
     fn finish(&self) -> Result<(), VlmError> {
         self.inner.finish()
     }
+
+    fn capabilities(&self) -> BoxFuture<'_, ServerCapabilities> {
+        // What the server announces decides how requests are fitted to it (no pictures to a
+        // text-only model, replies sized to the context window); the meter hides none of it.
+        self.inner.capabilities()
+    }
 }
 
 #[cfg(test)]
@@ -123,5 +129,43 @@ mod tests {
         ]});
         assert_eq!(image_count(&body), 3);
         assert_eq!(image_count(&serde_json::json!({})), 0);
+    }
+
+    /// A text-only server with a 4,096-token window.
+    #[derive(Debug)]
+    struct Announcing;
+
+    impl Transport for Announcing {
+        fn send<'a>(&'a self, _: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
+            Box::pin(async {
+                Err(TransportError::Failed {
+                    message: "not sent in this test".into(),
+                    retryable: false,
+                })
+            })
+        }
+
+        fn label(&self) -> String {
+            "announcing".into()
+        }
+
+        fn capabilities(&self) -> BoxFuture<'_, ServerCapabilities> {
+            Box::pin(async {
+                ServerCapabilities {
+                    images: Some(false),
+                    context_tokens: Some(4096),
+                    source: Some("GET /props".into()),
+                }
+            })
+        }
+    }
+
+    /// Under the meter the client still learns what the server takes, so a benchmark unit
+    /// fits its requests to the server as `nesy adapt` does.
+    #[test]
+    fn the_meter_passes_on_what_the_server_announces() {
+        let metered = Metered::new(Arc::new(Announcing), None, Arc::new(Semaphore::new(1)));
+        let caps = pollster::block_on(metered.capabilities());
+        assert_eq!((caps.images, caps.context_tokens), (Some(false), Some(4096)));
     }
 }

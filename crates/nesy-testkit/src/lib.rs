@@ -133,6 +133,10 @@ impl Transport for InFlightCounter {
     fn label(&self) -> String {
         "counter".into()
     }
+
+    fn capabilities(&self) -> BoxFuture<'_, nesy_vlm::ServerCapabilities> {
+        self.inner.capabilities()
+    }
 }
 
 /// A named test of a test binary built with `harness = false`.
