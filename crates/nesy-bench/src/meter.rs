@@ -13,8 +13,12 @@ use tokio::sync::Semaphore;
 /// What a unit's calls came to.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct CallCounts {
-    /// Calls made (attempts included).
+    /// Calls answered by the server (each attempt that got a response, error statuses
+    /// included). A send that got no response at all (a timeout, a dropped connection) is
+    /// not counted: no recording keeps it, and a replay must count what the live run did.
     pub calls: u64,
+    /// Sends in flight, held against the cap until they end.
+    pub pending: u64,
     /// Images sent.
     pub images: u64,
     /// Calls by purpose.
@@ -69,7 +73,7 @@ impl Transport for Metered {
         Box::pin(async move {
             {
                 let mut c = self.counts.lock().unwrap_or_else(|e| e.into_inner());
-                if self.cap.is_some_and(|cap| c.calls >= cap) {
+                if self.cap.is_some_and(|cap| c.calls + c.pending >= cap) {
                     c.cap_reached = true;
                     return Err(TransportError::Failed {
                         message: format!(
@@ -79,21 +83,25 @@ impl Transport for Metered {
                         retryable: false,
                     });
                 }
+                c.pending += 1;
+            }
+            let result = match self.in_flight.acquire().await {
+                Ok(_slot) => self.inner.send(request).await,
+                Err(_) => Err(TransportError::Failed {
+                    message: "the run is shutting down".into(),
+                    retryable: false,
+                }),
+            };
+            let mut c = self.counts.lock().unwrap_or_else(|e| e.into_inner());
+            c.pending -= 1;
+            if result.is_ok() {
                 c.calls += 1;
                 c.images += image_count(&request.body);
                 *c.by_purpose
                     .entry(request.purpose.clone().unwrap_or_else(|| "-".into()))
                     .or_default() += 1;
             }
-            let _slot = self
-                .in_flight
-                .acquire()
-                .await
-                .map_err(|_| TransportError::Failed {
-                    message: "the run is shutting down".into(),
-                    retryable: false,
-                })?;
-            self.inner.send(request).await
+            result
         })
     }
 
@@ -158,6 +166,54 @@ mod tests {
                 }
             })
         }
+    }
+
+    /// Fails its first send without a response, then answers.
+    #[derive(Debug, Default)]
+    struct FlakyOnce {
+        sent: std::sync::atomic::AtomicUsize,
+    }
+
+    impl Transport for FlakyOnce {
+        fn send<'a>(&'a self, _: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
+            Box::pin(async move {
+                if self.sent.fetch_add(1, std::sync::atomic::Ordering::SeqCst) == 0 {
+                    return Err(TransportError::Failed {
+                        message: "timed out".into(),
+                        retryable: true,
+                    });
+                }
+                Ok(WireResponse::new(200, "{}", nesy_vlm::Origin::Live))
+            })
+        }
+
+        fn label(&self) -> String {
+            "flaky".into()
+        }
+    }
+
+    /// A send that got no response is not a call: no recording keeps it, and a replay of the
+    /// unit must count what the live run counted.
+    #[test]
+    fn only_answered_sends_are_counted() {
+        let metered = Metered::new(
+            Arc::new(FlakyOnce::default()),
+            Some(1),
+            Arc::new(Semaphore::new(1)),
+        );
+        let request = WireRequest {
+            path: "/chat/completions".into(),
+            body: serde_json::json!({"messages": []}),
+            task: None,
+            purpose: Some("induce".into()),
+        };
+        assert!(pollster::block_on(metered.send(&request)).is_err());
+        assert_eq!(metered.counts().lock().unwrap().calls, 0);
+        assert!(pollster::block_on(metered.send(&request)).is_ok());
+        assert_eq!(metered.counts().lock().unwrap().calls, 1);
+        // The cap of one call is now reached.
+        assert!(pollster::block_on(metered.send(&request)).is_err());
+        assert!(metered.counts().lock().unwrap().cap_reached);
     }
 
     /// Under the meter the client still learns what the server takes, so a benchmark unit

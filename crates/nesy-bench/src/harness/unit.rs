@@ -144,22 +144,30 @@ pub(super) fn unit_client(
         }
         ResponderSetup::Replay(dir) => {
             let path = cassette_path(unit, dir);
-            if !path.is_file() {
+            let model_free = methods::find(&unit.variant.method)
+                .is_ok_and(|m| m.info().offline == methods::OfflineMeaning::ModelFree);
+            if !path.is_file() && model_free {
+                // A control that calls no model leaves no cassette; it replays without one.
+                let transport: Arc<dyn Transport> = Arc::new(NoRecording { path });
+                (vlm::oracle_config(), transport)
+            } else if !path.is_file() {
                 return Err((
                     UnitStatus::TransportError,
                     format!("{}: no recorded cassette for this unit", path.display()),
                 ));
+            } else {
+                let file =
+                    CassetteFile::load(&path).map_err(|e| (UnitStatus::TransportError, e.to_string()))?;
+                let c = vlm::replay_config(&path, &file)
+                    .map_err(|e| (UnitStatus::TransportError, e.to_string()))?;
+                let options = CassetteOptions {
+                    allow_playback_repeats: true,
+                    ..CassetteOptions::default()
+                };
+                let t = CassetteTransport::open(&path, CassetteMode::None, None, options)
+                    .map_err(|e| (UnitStatus::TransportError, e.to_string()))?;
+                (c, Arc::new(t))
             }
-            let file = CassetteFile::load(&path).map_err(|e| (UnitStatus::TransportError, e.to_string()))?;
-            let c =
-                vlm::replay_config(&path, &file).map_err(|e| (UnitStatus::TransportError, e.to_string()))?;
-            let options = CassetteOptions {
-                allow_playback_repeats: true,
-                ..CassetteOptions::default()
-            };
-            let t = CassetteTransport::open(&path, CassetteMode::None, None, options)
-                .map_err(|e| (UnitStatus::TransportError, e.to_string()))?;
-            (c, Arc::new(t))
         }
         ResponderSetup::Live(_) => {
             let (c, http) = shared
@@ -177,6 +185,31 @@ pub(super) fn unit_client(
         VlmClient::with_transport(&client_config, Arc::new(metered)),
         counts,
     ))
+}
+
+/// The transport of a replayed unit that has no cassette because its method calls no
+/// model: a call it makes after all fails, naming the missing file.
+#[derive(Debug)]
+struct NoRecording {
+    path: PathBuf,
+}
+
+impl Transport for NoRecording {
+    fn send<'a>(
+        &'a self,
+        _: &'a nesy_vlm::WireRequest,
+    ) -> nesy_vlm::BoxFuture<'a, Result<nesy_vlm::WireResponse, nesy_vlm::TransportError>> {
+        Box::pin(async move {
+            Err(nesy_vlm::TransportError::Failed {
+                message: format!("{}: no recorded cassette for this unit", self.path.display()),
+                retryable: false,
+            })
+        })
+    }
+
+    fn label(&self) -> String {
+        "no recording".into()
+    }
 }
 
 /// A cassette at `path` recording (new episodes; replaying what it already holds) around

@@ -607,9 +607,11 @@ async fn all_methods_replay_to_identical_records_over_the_fixture_scenarios() {
     for name in ["replay-1", "replay-2"] {
         let run = scratch.path().join(name);
         let (run_dir, demos_dir, vlm) = (run.clone(), demos.clone(), vlm.clone());
-        tokio::task::spawn_blocking(move || bench_with(&run_dir, &demos_dir, &vlm, "all", FIXTURES, &[]))
-            .await
-            .unwrap();
+        tokio::task::spawn_blocking(move || {
+            bench_with(&run_dir, &demos_dir, &vlm, "all,imitation,replan", FIXTURES, &[])
+        })
+        .await
+        .unwrap();
         replays.push(records_by_unit(&run));
     }
     let strip = |mut r: Value| {
@@ -618,6 +620,13 @@ async fn all_methods_replay_to_identical_records_over_the_fixture_scenarios() {
         r
     };
     assert_eq!(replays[0], replays[1], "two replays differ");
+    // The controls call no model and left no cassette; they replay without one.
+    for scenario in FIXTURES.split(',') {
+        for control in ["imitation", "replan"] {
+            let status = &replays[0][&format!("{scenario}/{control}")]["status"];
+            assert_ne!(status, "transport_error", "{scenario}/{control}");
+        }
+    }
     for (unit, record) in &recorded {
         let got = replays[0]
             .get(unit)
