@@ -37,6 +37,13 @@ pub struct ReplyCounts {
     pub reasked_read: u64,
     /// Replies held to a grammar or a JSON schema.
     pub constrained: u64,
+    /// Prompt tokens, as the server counted them.
+    pub prompt_tokens: u64,
+    /// Reply tokens, as the server counted them.
+    pub completion_tokens: u64,
+    /// Milliseconds the server spent reading prompts and generating, when it reports them
+    /// (llama.cpp's `timings`); unlike the call latency, this leaves out queueing.
+    pub server_ms: u64,
 }
 
 impl ReplyCounts {
@@ -53,6 +60,9 @@ impl ReplyCounts {
         self.reasked += other.reasked;
         self.reasked_read += other.reasked_read;
         self.constrained += other.constrained;
+        self.prompt_tokens += other.prompt_tokens;
+        self.completion_tokens += other.completion_tokens;
+        self.server_ms += other.server_ms;
     }
 }
 
@@ -93,6 +103,12 @@ impl Readability {
                 .or_default();
             counts.replies += 1;
             counts.cut_short += u64::from(choice["finish_reason"] == "length");
+            counts.prompt_tokens += response["usage"]["prompt_tokens"].as_u64().unwrap_or(0);
+            counts.completion_tokens += response["usage"]["completion_tokens"].as_u64().unwrap_or(0);
+            let timings = &response["timings"];
+            let ms = timings["prompt_ms"].as_f64().unwrap_or(0.0)
+                + timings["predicted_ms"].as_f64().unwrap_or(0.0);
+            counts.server_ms += ms.round() as u64;
             let json_form = body.get("response_format").is_some() || body.get("format").is_some();
             counts.constrained += u64::from(
                 json_form || body.get("grammar").is_some() || body.get("structured_outputs").is_some(),

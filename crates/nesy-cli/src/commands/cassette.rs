@@ -276,14 +276,16 @@ fn replies(paths: &[PathBuf], json: bool) -> anyhow::Result<ExitCode> {
         .unwrap_or(0)
         .max(5);
     outln!(
-        "{:<width$}  {:<10}  {:>7}  {:>20}  {:>20}  {:>9}  {:>11}",
+        "{:<width$}  {:<10}  {:>7}  {:>20}  {:>20}  {:>9}  {:>11}  {:>12}  {:>9}",
         "group",
         "purpose",
         "replies",
         "first try read",
         "re-asks read",
         "cut short",
-        "constrained"
+        "constrained",
+        "tokens out",
+        "server s"
     )?;
     let by_purpose = readability.by_purpose();
     let total = by_purpose
@@ -291,14 +293,16 @@ fn replies(paths: &[PathBuf], json: bool) -> anyhow::Result<ExitCode> {
         .map(|(p, c)| (("(all)".to_owned(), p.clone()), c.clone()));
     for ((group, purpose), c) in readability.groups.clone().into_iter().chain(total) {
         outln!(
-            "{:<width$}  {:<10}  {:>7}  {:>20}  {:>20}  {:>9}  {:>11}",
+            "{:<width$}  {:<10}  {:>7}  {:>20}  {:>20}  {:>9}  {:>11}  {:>12}  {:>9.1}",
             group,
             purpose,
             c.replies,
             share(c.first_read, c.first),
             share(c.reasked_read, c.reasked),
             c.cut_short,
-            c.constrained
+            c.constrained,
+            c.completion_tokens,
+            c.server_ms as f64 / 1000.0
         )?;
     }
     outln!("{} cassette(s)", files.len())?;

@@ -23,7 +23,8 @@ fn interaction(purpose: &str, user_turns: usize, content: &str, finish: &str, co
         "request": {"method": "POST", "path": "/chat/completions", "body": body},
         "response": {"status": 200, "headers": {}, "body": {
             "choices": [{"index": 0, "message": {"role": "assistant", "content": content}, "finish_reason": finish}],
-            "usage": {"prompt_tokens": 10, "completion_tokens": 10}
+            "usage": {"prompt_tokens": 10, "completion_tokens": 10},
+            "timings": {"prompt_ms": 100.4, "predicted_ms": 200.2}
         }}
     })
 }
@@ -102,7 +103,8 @@ fn replies_counts_first_tries_and_re_asks_per_method() {
     };
     assert_eq!(
         row("induce"),
-        json!({"replies": 3, "cut_short": 0, "first": 2, "first_read": 1, "reasked": 1, "reasked_read": 1, "constrained": 3})
+        json!({"replies": 3, "cut_short": 0, "first": 2, "first_read": 1, "reasked": 1, "reasked_read": 1, "constrained": 3,
+               "prompt_tokens": 30, "completion_tokens": 30, "server_ms": 903})
     );
     assert_eq!(row("patch")["cut_short"], 1);
     assert_eq!(row("patch")["first_read"], 0);
