@@ -1,11 +1,8 @@
 //! One stage's call: a system prompt, a user message of text and captioned images, the
 //! stage's reader, and the reply policy of [`crate::Fidelity`].
 
-use nesy_vlm::{ChatRequest, Message, Part, ReasoningEffort, VlmClient};
-use nesy_vlm::{
-    ReplyLength,
-    reply::{self, AskError, CALL_ATTEMPTS, NULL_CONTENT_TEXT, ReplyProblem, truncation_text},
-};
+use nesy_vlm::reply::{self, AskError, CALL_ATTEMPTS, NULL_CONTENT_TEXT, ReplyProblem, truncation_text};
+use nesy_vlm::{ChatRequest, Message, Part, ReasoningEffort, ReplyLength, VlmClient};
 use serde::Serialize;
 
 use crate::error::BaselineError;

@@ -39,7 +39,6 @@ fn oldest_follow_up_is_droppable(request: &ChatRequest) -> bool {
         && role(FIRST_FOLLOW_UP + 1) == Role::User
 }
 
-/// [`estimate_prompt_tokens`] of a whole request.
 /// `tokens` times `scale`, rounded up.
 fn scaled(tokens: u32, scale: f64) -> u32 {
     if scale <= 1.0 {
@@ -53,6 +52,7 @@ fn scaled(tokens: u32, scale: f64) -> u32 {
     }
 }
 
+/// [`estimate_prompt_tokens`] of a whole request.
 fn estimate_request_tokens(request: &ChatRequest) -> u32 {
     let text_bytes: usize = request
         .messages
@@ -279,8 +279,8 @@ impl VlmClient {
 
     /// Checks `request` against what the server announced, and sizes its reply to the room
     /// the context window leaves: pictures never go to a server that takes none, and a
-    /// prompt that would not fit is not sent at all.
-    /// `scale` corrects the token estimate when the server has said how far off it was.
+    /// prompt that would not fit is not sent at all. `scale` corrects the token estimate
+    /// when the server has said how far off it was.
     fn fit_to_server(
         &self,
         mut request: ChatRequest,
@@ -382,11 +382,10 @@ impl VlmClient {
         let wire = self.wire_request(request);
         let started = Instant::now();
         let (result, attempts, origin) = self.send_with_retries(&wire).await;
-        let (outcome, usage) = match result {
+        let (mut outcome, usage) = match result {
             Ok(response) => self.read_success(response, attempts, started),
             Err(err) => (Err(err), None),
         };
-        let mut outcome = outcome;
         // Only the client knows what the request was sent with; the cut is judged by it.
         if let Err(VlmError::Truncated { cap, context, .. }) = &mut outcome {
             *cap = sent_cap;

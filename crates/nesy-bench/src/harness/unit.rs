@@ -144,18 +144,7 @@ pub(super) fn unit_client(
         }
         ResponderSetup::Replay(dir) => {
             let path = cassette_path(unit, dir);
-            let model_free = methods::find(&unit.variant.method)
-                .is_ok_and(|m| m.info().offline == methods::OfflineMeaning::ModelFree);
-            if !path.is_file() && model_free {
-                // A control that calls no model leaves no cassette; it replays without one.
-                let transport: Arc<dyn Transport> = Arc::new(NoRecording { path });
-                (vlm::oracle_config(), transport)
-            } else if !path.is_file() {
-                return Err((
-                    UnitStatus::TransportError,
-                    format!("{}: no recorded cassette for this unit", path.display()),
-                ));
-            } else {
+            if path.is_file() {
                 let file =
                     CassetteFile::load(&path).map_err(|e| (UnitStatus::TransportError, e.to_string()))?;
                 let c = vlm::replay_config(&path, &file)
@@ -167,6 +156,13 @@ pub(super) fn unit_client(
                 let t = CassetteTransport::open(&path, CassetteMode::None, None, options)
                     .map_err(|e| (UnitStatus::TransportError, e.to_string()))?;
                 (c, Arc::new(t))
+            } else if methods::find(&unit.variant.method)
+                .is_ok_and(|m| m.info().offline == methods::OfflineMeaning::ModelFree)
+            {
+                // A control that calls no model leaves no cassette; it replays without one.
+                (vlm::oracle_config(), Arc::new(NoRecording { path }))
+            } else {
+                return Err((UnitStatus::TransportError, NoRecording { path }.message()));
             }
         }
         ResponderSetup::Live(_) => {
@@ -187,11 +183,17 @@ pub(super) fn unit_client(
     ))
 }
 
-/// The transport of a replayed unit that has no cassette because its method calls no
-/// model: a call it makes after all fails, naming the missing file.
+/// A replayed unit's missing cassette: the transport of a control that calls no model (a
+/// call it makes after all fails, naming the file), and the message that names it.
 #[derive(Debug)]
 struct NoRecording {
     path: PathBuf,
+}
+
+impl NoRecording {
+    fn message(&self) -> String {
+        format!("{}: no recorded cassette for this unit", self.path.display())
+    }
 }
 
 impl Transport for NoRecording {
@@ -201,7 +203,7 @@ impl Transport for NoRecording {
     ) -> nesy_vlm::BoxFuture<'a, Result<nesy_vlm::WireResponse, nesy_vlm::TransportError>> {
         Box::pin(async move {
             Err(nesy_vlm::TransportError::Failed {
-                message: format!("{}: no recorded cassette for this unit", self.path.display()),
+                message: self.message(),
                 retryable: false,
             })
         })

@@ -299,6 +299,19 @@ async fn a_cassette_recorded_without_constraints_says_so() {
     assert_eq!(recorded.meta.constrain, ConstrainMode::Off);
 }
 
+/// Answers chat requests with HTTP 400 and `body` ahead of the server's other answers: the
+/// first `times` of them, or all.
+async fn refuse_first(server: &MockServer, body: &'static str, times: Option<u64>) {
+    let refusal = Mock::given(method("POST"))
+        .and(path("/v1/chat/completions"))
+        .respond_with(ResponseTemplate::new(400).set_body_raw(body, "application/json"))
+        .with_priority(1);
+    match times {
+        Some(n) => refusal.up_to_n_times(n).mount(server).await,
+        None => refusal.mount(server).await,
+    }
+}
+
 /// The refusal a llama.cpp server sent for a NeSyCR patch proposal against Gemma 3 270M, the
 /// ninth turn of a conversation of re-asks: the estimate had the prompt below 7,168 tokens,
 /// the server counted 8,236.
@@ -306,24 +319,12 @@ const RECORDED_OVERFLOW: &str = r#"{"error":{"code":400,"message":"request (8236
 
 #[tokio::test]
 async fn a_prompt_the_server_counts_larger_is_fitted_again_with_its_count() {
-    let server = MockServer::start().await;
-    Mock::given(method("GET"))
-        .and(path("/props"))
-        .respond_with(
-            ResponseTemplate::new(200).set_body_json(json!({"default_generation_settings": {"n_ctx": 8192}})),
-        )
-        .mount(&server)
-        .await;
-    Mock::given(method("POST"))
-        .and(path("/v1/chat/completions"))
-        .respond_with(ResponseTemplate::new(400).set_body_raw(RECORDED_OVERFLOW, "application/json"))
-        .up_to_n_times(1)
-        .with_priority(1)
-        .mount(&server)
-        .await;
+    let server = props_server(json!({"default_generation_settings": {"n_ctx": 8192}})).await;
+    refuse_first(&server, RECORDED_OVERFLOW, Some(1)).await;
     Mock::given(method("POST"))
         .and(path("/v1/chat/completions"))
         .respond_with(ResponseTemplate::new(200).set_body_json(completion("* Refinement rationale:\n- x\n")))
+        .with_priority(2)
         .mount(&server)
         .await;
     let cfg = config(BackendKind::LlamaCpp, "m", &format!("{}/v1", server.uri()));
@@ -363,22 +364,13 @@ async fn a_prompt_the_server_counts_larger_is_fitted_again_with_its_count() {
 
 #[tokio::test]
 async fn a_refusal_that_gives_no_count_is_not_sent_again() {
-    let server = MockServer::start().await;
-    Mock::given(method("GET"))
-        .and(path("/props"))
-        .respond_with(
-            ResponseTemplate::new(200).set_body_json(json!({"default_generation_settings": {"n_ctx": 8192}})),
-        )
-        .mount(&server)
-        .await;
-    Mock::given(method("POST"))
-        .and(path("/v1/chat/completions"))
-        .respond_with(ResponseTemplate::new(400).set_body_raw(
-            r#"{"error":{"code":400,"message":"bad grammar","type":"invalid_request_error"}}"#,
-            "application/json",
-        ))
-        .mount(&server)
-        .await;
+    let server = props_server(json!({"default_generation_settings": {"n_ctx": 8192}})).await;
+    refuse_first(
+        &server,
+        r#"{"error":{"code":400,"message":"bad grammar","type":"invalid_request_error"}}"#,
+        None,
+    )
+    .await;
     let cfg = config(BackendKind::LlamaCpp, "m", &format!("{}/v1", server.uri()));
     let client = VlmClient::from_config(&cfg).unwrap();
     let error = client.chat(constrained()).await.unwrap_err();
