@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 # The workspace's own crates.
 NESY = {
-    "nesy-core", "nesy-input", "nesy-sim", "nesy-policy", "nesy-vlm", "nesy-reasoner",
+    "nesy-core", "nesy-input", "nesy-import", "nesy-sim", "nesy-policy", "nesy-vlm", "nesy-reasoner",
     "nesy-oracle", "nesy-pipeline", "nesy-bench", "nesy-baselines", "nesy-cli", "nesy-testkit",
 }
 # What a crate that talks to models only must not link: the simulator, the sandbox,
@@ -48,6 +48,8 @@ DEPENDENCY_RULES = {
                  "the simulator links no model client, no async runtime and no Python"),
     "nesy-policy": ({"nesy-policy", "nesy-sim", "nesy-core", "nesy-input"}, {"tokio", "reqwest"},
                     "the sandbox knows nothing of models"),
+    "nesy-import": ({"nesy-import", "nesy-sim", "nesy-core", "nesy-input"}, {"pyo3", "tokio", "reqwest"},
+                    "importing reads pictures and writes a demo folder: no model, no runtime, no Python"),
     "nesy-oracle": ({"nesy-oracle", "nesy-reasoner", "nesy-vlm", "nesy-sim", "nesy-core", "nesy-input"},
                     {"pyo3"}, "the offline responder does not run programs"),
 }
@@ -57,7 +59,7 @@ PYO3_OWNER = "nesy-policy"
 DEV_ONLY = "nesy-testkit"
 
 # Crates whose files import each other in no circle.
-ACYCLIC = ["nesy-sim", "nesy-input", "nesy-reasoner", "nesy-oracle", "nesy-pipeline", "nesy-baselines", "nesy-bench",
+ACYCLIC = ["nesy-sim", "nesy-input", "nesy-import", "nesy-reasoner", "nesy-oracle", "nesy-pipeline", "nesy-baselines", "nesy-bench",
            "nesy-cli", "nesy-testkit"]
 
 # Source rules: crate -> [(pattern, why)].

@@ -28,6 +28,7 @@ seed cassette ../fixtures/cassettes/*.json
 seed manifest seeds/manifest/*
 seed unit_records seeds/unit_records/*
 seed policy_source seeds/policy_source/*
+seed vocabulary_file ../fixtures/vocabulary/*.toml
 seed pddl ../fixtures/pddl/*/*.pddl ../assets/pddl/*.pddl ../fixtures/planning/*.pddl
 seed plan ../fixtures/pddl/*/*.plan
 

@@ -6,22 +6,22 @@ use nesy_reasoner::Views;
 use nesy_vlm::Part;
 use serde::Serialize;
 
-/// The six images of one scene: the top, front and back views, as rendered and with the
-/// object names written next to the objects.
+/// The images of one scene: each camera view as rendered and with the object names written
+/// next to the objects (six images for the simulator's top, front and back cameras).
 #[derive(Debug, Clone)]
-pub struct SixViews {
+pub struct SceneViews {
     /// The views as rendered.
     pub raw: Views,
     /// The same views with object labels.
     pub marked: Views,
 }
 
-impl SixViews {
-    /// The six images as request parts, each after its own caption (`"{scene} top"`,
+impl SceneViews {
+    /// The images as request parts, each after its own caption (`"{scene} top"`,
     /// `"{scene} top (with object labels)"`, …), as the authors attach them.
     pub fn parts(&self, scene: &str) -> Vec<Part> {
-        let mut parts = Vec::with_capacity(12);
-        for ((name, raw), (_, marked)) in self.raw.named().into_iter().zip(self.marked.named()) {
+        let mut parts = Vec::with_capacity(4 * self.raw.len());
+        for ((name, raw), (_, marked)) in self.raw.named().zip(self.marked.named()) {
             parts.push(Part::text(format!("{scene} {name}")));
             parts.push(Part::Image(raw.clone()));
             parts.push(Part::text(format!("{scene} {name} (with object labels)")));
@@ -34,8 +34,8 @@ impl SixViews {
 /// What a flow is shown of one scene where the authors attach its pictures.
 #[derive(Debug, Clone)]
 pub enum SceneObservation {
-    /// The six images, as the authors attach them.
-    Images(SixViews),
+    /// The scene's images, as the authors attach them.
+    Images(SceneViews),
     /// The scene's ground-truth state written out in place of the images: the setting in
     /// which every method runs on a text-only model under the same perception.
     StateText(State),
@@ -73,7 +73,7 @@ impl SceneObservation {
 pub struct Keyframe {
     /// The ground-truth state at the keyframe.
     pub state: State,
-    /// What the flows see of it in place of pictures, or its six images.
+    /// What the flows see of it in place of pictures, or its images.
     pub observation: SceneObservation,
 }
 
@@ -113,7 +113,7 @@ pub struct BaselineInputs {
     pub target_objects: Vec<String>,
     /// The target's ground-truth initial state.
     pub target_state: State,
-    /// The target scene as the flows see it: its six images, or its state as text.
+    /// The target scene as the flows see it: its images, or its state as text.
     pub target_observation: SceneObservation,
     /// The predicates, for the tier texts.
     pub vocabulary: Vocabulary,

@@ -55,7 +55,7 @@ mod stage;
 pub mod statler;
 
 pub use error::BaselineError;
-pub use inputs::{BaselineInputs, Fidelity, Keyframe, SceneObservation, SixViews};
+pub use inputs::{BaselineInputs, Fidelity, Keyframe, SceneObservation, SceneViews};
 pub use prompts::{BaselinePrompts, PromptError};
 pub use stage::{REPAIRED_ATTEMPTS, StageProblem, StageRecord};
 

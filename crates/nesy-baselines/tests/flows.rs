@@ -5,8 +5,8 @@
 use std::sync::Arc;
 
 use nesy_baselines::{
-    BaselineError, BaselineInputs, Fidelity, Keyframe, SceneObservation, SixViews, critic, demo2code, gpt4v,
-    llmdm, morevqa, statler,
+    BaselineError, BaselineInputs, Fidelity, Keyframe, SceneObservation, SceneViews, critic, demo2code,
+    gpt4v, llmdm, morevqa, statler,
 };
 use nesy_core::State;
 use nesy_core::Vocabulary;
@@ -28,13 +28,9 @@ fn png(seed: u8) -> Image {
     Image::png(nesy_testkit::png(2, u64::from(seed))).unwrap()
 }
 
-fn six(seed: u8) -> SixViews {
-    let views = |s: u8| Views {
-        top: png(s),
-        front: png(s + 1),
-        back: png(s + 2),
-    };
-    SixViews {
+fn six(seed: u8) -> SceneViews {
+    let views = |s: u8| Views::new([("top", png(s)), ("front", png(s + 1)), ("back", png(s + 2))]);
+    SceneViews {
         raw: views(seed),
         marked: views(seed + 3),
     }

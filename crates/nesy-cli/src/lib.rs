@@ -49,6 +49,10 @@ pub(crate) enum Command {
     Bench(commands::bench::BenchArgs),
     /// Inspect, prune or verify VLM cassettes (recorded model calls for offline replay).
     Cassette(commands::cassette::CassetteArgs),
+    /// Import a real-world demonstration (frames, or the authors' format) as a demo folder.
+    Demo(commands::demo::DemoArgs),
+    /// Export or list the prompt templates NeSyCR's model calls are rendered from.
+    Prompts(commands::prompts::PromptsArgs),
     /// Record a scripted-expert demonstration of a benchmark scenario as MCAP.
     Record(commands::record::RecordArgs),
     /// Render a scene's top, front and back views as PNG (plain and labelled).
@@ -104,6 +108,8 @@ pub(crate) fn run(cli: Cli) -> ExitCode {
         Command::Adapt(args) => commands::adapt::run(*args),
         Command::Bench(args) => commands::bench::run(args),
         Command::Cassette(args) => commands::cassette::run(args),
+        Command::Demo(args) => commands::demo::run(args),
+        Command::Prompts(args) => commands::prompts::run(args),
         Command::Record(args) => commands::record::run(args),
         Command::Render(args) => commands::render::run(args),
         Command::Run(args) => commands::run::run(args),

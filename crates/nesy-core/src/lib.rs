@@ -44,6 +44,7 @@ mod state;
 mod symbol;
 pub mod text;
 mod types;
+mod vocabulary_file;
 
 pub use atom::{Args, Atom, AtomParseError};
 pub use embodiment::Embodiment;
@@ -57,7 +58,12 @@ pub use formula::{
 };
 pub use operator::{CompiledOperator, Operator, format_procedure};
 pub use patch::{ActionKey, AppliedPatch, ClosestCandidate, Patch, PatchError, apply_patch};
-pub use predicates::{Category, PredicateInfo, Tier, Vocabulary, VocabularyError, builtin_predicates};
+pub use predicates::{
+    Category, KindInfo, PredicateInfo, Tier, Vocabulary, VocabularyError, builtin_predicates,
+};
 pub use state::{State, StateDiff};
 pub use symbol::Symbol;
 pub use types::{PDDL_ROOT_TYPE, ROOT_TYPE, TypeError, TypeHierarchy, Universe};
+pub use vocabulary_file::{
+    MAX_PREDICATE_ARITY, VOCABULARY_FORMAT_VERSION, VocabularyFileError, parse_vocabulary_file,
+};

@@ -17,12 +17,14 @@
 //! declared otherwise, which matters for goal derivation (embodiment-specific atoms never
 //! enter a goal).
 
+use std::collections::BTreeMap;
 use std::fmt;
 use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
 use crate::symbol::Symbol;
+use crate::types::{PDDL_ROOT_TYPE, ROOT_TYPE, TypeHierarchy};
 
 /// Whether a predicate describes the world or the robot.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -97,20 +99,49 @@ pub struct PredicateInfo {
     /// Tiers that include this predicate (empty for user-declared extras, which every
     /// tier includes).
     pub tiers: Vec<Tier>,
+    /// The object kind of each parameter, when a vocabulary file declared one (empty: every
+    /// parameter takes any object, as the built-ins do).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub kinds: Vec<Symbol>,
 }
 
 impl PredicateInfo {
     /// The line a prompt's "predicate definitions" block uses, e.g.
     /// `(OnTopOf ?a ?b): ?a is resting on and supported by ?b.`
+    /// A parameter with a declared kind other than the root is written `?x - parts`.
     pub fn definition_line(&self) -> String {
         let mut head = format!("({}", self.name);
-        for p in &self.params {
+        for (i, p) in self.params.iter().enumerate() {
             head.push_str(" ?");
             head.push_str(p);
+            if let Some(kind) = self.kind_of_param(i) {
+                head.push_str(" - ");
+                head.push_str(kind.as_str());
+            }
         }
         head.push(')');
         format!("{head}: {}", self.definition)
     }
+
+    /// The declared kind of parameter `index`, unless it is the root kind (any object).
+    pub fn kind_of_param(&self, index: usize) -> Option<Symbol> {
+        self.kinds
+            .get(index)
+            .copied()
+            .filter(|k| k.as_str() != ROOT_TYPE && k.as_str() != PDDL_ROOT_TYPE)
+    }
+}
+
+/// An object kind a vocabulary declares, e.g. `parts` under `thing`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct KindInfo {
+    /// The kind's name.
+    pub name: Symbol,
+    /// The kind it refines ([`ROOT_TYPE`] for a top-level kind).
+    pub parent: Symbol,
+    /// A one-line meaning, for people reading the vocabulary.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub meaning: String,
 }
 
 struct Builtin {
@@ -243,6 +274,7 @@ pub fn builtin_predicates() -> Vec<PredicateInfo> {
             params: b.params.iter().map(|p| p.to_string()).collect(),
             definition: b.definition.to_string(),
             tiers: b.tiers.to_vec(),
+            kinds: Vec::new(),
         })
         .collect()
 }
@@ -278,28 +310,76 @@ pub enum VocabularyError {
         /// The number of arguments used.
         found: usize,
     },
+    /// A kind, or a parameter's or an object's kind, names a kind never declared.
+    #[error("unknown object kind `{name}` (declared kinds: {known})")]
+    UnknownKind {
+        /// The kind as written.
+        name: String,
+        /// The declared kinds, comma-separated.
+        known: String,
+    },
+    /// A kind is declared twice.
+    #[error("object kind `{name}` is declared twice")]
+    DuplicateKind {
+        /// The kind.
+        name: String,
+    },
+    /// An object is given a kind twice, with different kinds.
+    #[error("object `{object}` is given kind `{first}` and kind `{second}`")]
+    ConflictingObjectKind {
+        /// The object.
+        object: String,
+        /// Its first kind.
+        first: String,
+        /// Its second kind.
+        second: String,
+    },
+    /// An atom's argument is an object whose declared kind is not the parameter's kind.
+    #[error("argument {position} of `{predicate}` must be a `{expected}`, but `{object}` is a `{found}`")]
+    WrongKind {
+        /// The predicate.
+        predicate: String,
+        /// The argument's position, from 1.
+        position: usize,
+        /// The object.
+        object: String,
+        /// The parameter's kind.
+        expected: String,
+        /// The object's kind.
+        found: String,
+    },
 }
 
-/// The built-in predicates plus user-declared extras.
+/// The built-in predicates plus user-declared extras, and the object kinds a vocabulary
+/// file declares.
 ///
-/// The list is shared (`Arc`) and copied on write: every model request carries the task's
+/// The lists are shared (`Arc`) and copied on write: every model request carries the task's
 /// vocabulary, and cloning it must not copy every definition.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(from = "VocabularyRepr", into = "VocabularyRepr")]
 pub struct Vocabulary {
     predicates: Arc<Vec<PredicateInfo>>,
+    kinds: Arc<Vec<KindInfo>>,
+    object_kinds: Arc<BTreeMap<String, Symbol>>,
 }
 
-/// The serialised form of a [`Vocabulary`] (unchanged by the sharing).
+/// The serialised form of a [`Vocabulary`] (unchanged by the sharing; kinds only when
+/// declared).
 #[derive(Serialize, Deserialize)]
 struct VocabularyRepr {
     predicates: Vec<PredicateInfo>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    kinds: Vec<KindInfo>,
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    object_kinds: BTreeMap<String, Symbol>,
 }
 
 impl From<VocabularyRepr> for Vocabulary {
     fn from(repr: VocabularyRepr) -> Self {
         Vocabulary {
             predicates: Arc::new(repr.predicates),
+            kinds: Arc::new(repr.kinds),
+            object_kinds: Arc::new(repr.object_kinds),
         }
     }
 }
@@ -308,6 +388,8 @@ impl From<Vocabulary> for VocabularyRepr {
     fn from(v: Vocabulary) -> Self {
         VocabularyRepr {
             predicates: Arc::unwrap_or_clone(v.predicates),
+            kinds: Arc::unwrap_or_clone(v.kinds),
+            object_kinds: Arc::unwrap_or_clone(v.object_kinds),
         }
     }
 }
@@ -316,6 +398,8 @@ impl Default for Vocabulary {
     fn default() -> Self {
         Vocabulary {
             predicates: Arc::new(builtin_predicates()),
+            kinds: Arc::default(),
+            object_kinds: Arc::default(),
         }
     }
 }
@@ -324,6 +408,119 @@ impl Vocabulary {
     /// The built-in predicate set.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A vocabulary with no predicates and no kinds, for a task that declares its own.
+    pub fn empty() -> Self {
+        Vocabulary {
+            predicates: Arc::default(),
+            kinds: Arc::default(),
+            object_kinds: Arc::default(),
+        }
+    }
+
+    /// Declares a predicate in full ([`PredicateInfo`], with parameter kinds). Redeclaring
+    /// with the same arity replaces the definition and kinds (a built-in keeps its tiers);
+    /// another arity is an error, and so is a parameter kind never declared.
+    pub fn declare_predicate(&mut self, mut info: PredicateInfo) -> Result<(), VocabularyError> {
+        for kind in &info.kinds {
+            self.check_kind(*kind)?;
+        }
+        let predicates = Arc::make_mut(&mut self.predicates);
+        if let Some(existing) = predicates.iter_mut().find(|p| p.name == info.name) {
+            if existing.arity != info.arity {
+                return Err(VocabularyError::ArityConflict {
+                    name: info.name.to_string(),
+                    existing: existing.arity,
+                    declared: info.arity,
+                });
+            }
+            info.tiers = existing.tiers.clone();
+            *existing = info;
+            return Ok(());
+        }
+        predicates.push(info);
+        Ok(())
+    }
+
+    /// Declares an object kind under `parent` (the root, [`ROOT_TYPE`], or a kind declared
+    /// before). Kinds form a tree, so a parameter of kind `container` accepts a `box`
+    /// declared under it.
+    pub fn declare_kind(&mut self, name: &str, parent: &str, meaning: &str) -> Result<(), VocabularyError> {
+        let name = Symbol::new(name);
+        if self.is_kind(name) {
+            return Err(VocabularyError::DuplicateKind {
+                name: name.to_string(),
+            });
+        }
+        let parent = self.check_kind(Symbol::new(parent))?;
+        Arc::make_mut(&mut self.kinds).push(KindInfo {
+            name,
+            parent,
+            meaning: meaning.to_string(),
+        });
+        Ok(())
+    }
+
+    /// Gives `object` a declared kind; its atoms are then checked against the parameters'
+    /// kinds. Objects without one take any parameter (free-form object lists).
+    pub fn assign_kind(&mut self, object: &str, kind: &str) -> Result<(), VocabularyError> {
+        let kind = self.check_kind(Symbol::new(kind))?;
+        let map = Arc::make_mut(&mut self.object_kinds);
+        if let Some(first) = map.get(object).filter(|k| **k != kind) {
+            return Err(VocabularyError::ConflictingObjectKind {
+                object: object.to_string(),
+                first: first.to_string(),
+                second: kind.to_string(),
+            });
+        }
+        map.insert(object.to_string(), kind);
+        Ok(())
+    }
+
+    /// The declared object kinds, in declaration order.
+    pub fn kinds(&self) -> &[KindInfo] {
+        &self.kinds
+    }
+
+    /// The declared kind of `object`, if it has one.
+    pub fn kind_of(&self, object: &str) -> Option<Symbol> {
+        self.object_kinds.get(object).copied()
+    }
+
+    fn is_kind(&self, name: Symbol) -> bool {
+        matches!(name.as_str(), ROOT_TYPE | PDDL_ROOT_TYPE) || self.kinds.iter().any(|k| k.name == name)
+    }
+
+    /// `name` if it is the root or a declared kind.
+    pub(crate) fn check_kind(&self, name: Symbol) -> Result<Symbol, VocabularyError> {
+        if self.is_kind(name) {
+            return Ok(name);
+        }
+        let mut known = vec![ROOT_TYPE.to_string()];
+        known.extend(self.kinds.iter().map(|k| k.name.to_string()));
+        Err(VocabularyError::UnknownKind {
+            name: name.to_string(),
+            known: known.join(", "),
+        })
+    }
+
+    /// The kinds as a type hierarchy (for subkind tests).
+    fn hierarchy(&self) -> TypeHierarchy {
+        let mut types = TypeHierarchy::new();
+        for kind in self.kinds.iter() {
+            // Parents are declared before their children, so this cannot fail.
+            let _ = types.declare(kind.name, kind.parent);
+        }
+        types
+    }
+
+    /// The parameter kind an argument of `predicate` at `index` fails, as (expected, found),
+    /// when `object` has a declared kind that is not the parameter's or one under it.
+    pub fn kind_mismatch(&self, predicate: Symbol, index: usize, object: &str) -> Option<(Symbol, Symbol)> {
+        let expected = self.get(predicate)?.kind_of_param(index)?;
+        let found = self.kind_of(object)?;
+        (!self.hierarchy().is_subtype(found, expected)).then_some((expected, found))
     }
 
     /// Declares an extra predicate, e.g. `declare("Gathered", &["x"], Category::Physics,
@@ -336,31 +533,15 @@ impl Vocabulary {
         category: Category,
         definition: &str,
     ) -> Result<(), VocabularyError> {
-        let info = PredicateInfo {
+        self.declare_predicate(PredicateInfo {
             name: Symbol::new(name),
             arity: params.len(),
             category,
             params: params.iter().map(|p| p.to_string()).collect(),
             definition: definition.to_string(),
             tiers: Vec::new(),
-        };
-        let predicates = Arc::make_mut(&mut self.predicates);
-        if let Some(existing) = predicates.iter_mut().find(|p| p.name == info.name) {
-            if existing.arity != info.arity {
-                return Err(VocabularyError::ArityConflict {
-                    name: name.to_string(),
-                    existing: existing.arity,
-                    declared: info.arity,
-                });
-            }
-            *existing = PredicateInfo {
-                tiers: existing.tiers.clone(),
-                ..info
-            };
-            return Ok(());
-        }
-        predicates.push(info);
-        Ok(())
+            kinds: Vec::new(),
+        })
     }
 
     /// Looks a predicate up by name.
@@ -378,6 +559,24 @@ impl Vocabulary {
     /// never saw; only the known embodiment predicates are excluded from goals).
     pub fn is_physics(&self, name: Symbol) -> bool {
         self.get(name).is_none_or(|p| p.category == Category::Physics)
+    }
+
+    /// Checks a ground atom against the declarations: its predicate and arity, and each
+    /// argument's kind where both the parameter and the object have one.
+    pub fn check_atom(&self, atom: &crate::Atom) -> Result<(), VocabularyError> {
+        self.check_use(atom.pred(), atom.args().len())?;
+        for (i, arg) in atom.args().iter().enumerate() {
+            if let Some((expected, found)) = self.kind_mismatch(atom.pred(), i, arg.as_str()) {
+                return Err(VocabularyError::WrongKind {
+                    predicate: atom.pred().to_string(),
+                    position: i + 1,
+                    object: arg.to_string(),
+                    expected: expected.to_string(),
+                    found: found.to_string(),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Checks that an atom-shaped use of a predicate matches its declaration.

@@ -25,6 +25,15 @@ pub enum PipelineError {
         /// What is wrong, naming the JSON field.
         message: String,
     },
+    /// A task input beside the demo and the scene cannot be used: the vocabulary file, the
+    /// prompt templates.
+    #[error("{}: {message}", path.display())]
+    TaskFile {
+        /// The file or folder.
+        path: PathBuf,
+        /// What is wrong, naming the line and field.
+        message: String,
+    },
     /// The model client cannot be set up (configuration, cassette, offline responder).
     #[error("setting up the VLM: {message}")]
     VlmSetup {
@@ -137,7 +146,10 @@ impl PipelineError {
     pub fn is_bad_input(&self) -> bool {
         matches!(
             self,
-            PipelineError::Demo { .. } | PipelineError::Target { .. } | PipelineError::VlmSetup { .. }
+            PipelineError::Demo { .. }
+                | PipelineError::Target { .. }
+                | PipelineError::TaskFile { .. }
+                | PipelineError::VlmSetup { .. }
         )
     }
 

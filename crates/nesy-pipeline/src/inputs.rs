@@ -9,9 +9,10 @@ use std::time::{Duration, Instant};
 
 use nesy_core::Embodiment;
 use nesy_core::State;
+use nesy_core::Vocabulary;
 use nesy_reasoner::{KeyframeImages, Views};
 use nesy_sim::api::ApiCall;
-use nesy_sim::demo::{CameraName, Demo};
+use nesy_sim::demo::Demo;
 use nesy_sim::perception::observer::observe;
 use nesy_sim::perception::render::{self, View};
 use nesy_sim::scene::{SceneSpec, parts};
@@ -32,8 +33,9 @@ pub struct DemoInput {
 }
 
 impl DemoInput {
-    /// Reads a demo; errors name the file and what was wrong with it.
-    pub fn load(path: &Path) -> Result<DemoInput, PipelineError> {
+    /// Reads a demo; errors name the file and what was wrong with it. Its ground-truth states
+    /// must use `vocabulary`'s predicates (the built-ins unless a vocabulary file was given).
+    pub fn load(path: &Path, vocabulary: &Vocabulary) -> Result<DemoInput, PipelineError> {
         let started = Instant::now();
         // DemoError's message names the file and the field already (and its I/O cause).
         let demo = nesy_sim::demo::read(path).map_err(|e| PipelineError::Demo {
@@ -49,7 +51,7 @@ impl DemoInput {
                 ),
             });
         }
-        check_demo(&demo).map_err(|message| PipelineError::Demo {
+        check_demo(&demo, vocabulary).map_err(|message| PipelineError::Demo {
             path: path.to_owned(),
             message,
         })?;
@@ -91,11 +93,11 @@ impl DemoInput {
 pub(crate) const MAX_KEYFRAME_TIME_S: f64 = 86_400.0;
 
 /// What the pipeline needs of a demo's contents beyond its format: keyframe times that are
-/// finite, non-negative and in order, and ground-truth states whose atoms use nesy's
-/// predicates at their arity over the demo's objects (the scene's, the floor and the robot's
-/// own parts). Such an atom would otherwise enter the world model as a fact.
-pub(crate) fn check_demo(demo: &Demo) -> Result<(), String> {
-    let vocabulary = nesy_core::Vocabulary::new();
+/// finite, non-negative and in order, and ground-truth states whose atoms use the
+/// vocabulary's predicates at their arity (and declared kinds) over the demo's objects (the
+/// scene's, the floor and the robot's own parts). Such an atom would otherwise enter the
+/// world model as a fact.
+pub(crate) fn check_demo(demo: &Demo, vocabulary: &Vocabulary) -> Result<(), String> {
     let known: std::collections::HashSet<&str> = demo
         .metadata
         .objects
@@ -123,7 +125,7 @@ pub(crate) fn check_demo(demo: &Demo) -> Result<(), String> {
                         .map(|p| p.name.to_string())
                         .collect();
                     return Err(format!(
-                        "{at}: `{}` is not one of nesy's predicates ({})",
+                        "{at}: `{}` is not one of the task's predicates ({}; a vocabulary file, --vocabulary, declares more)",
                         atom.pred(),
                         names.join(", ")
                     ));
@@ -138,11 +140,44 @@ pub(crate) fn check_demo(demo: &Demo) -> Result<(), String> {
                 }
                 Some(_) => {}
             }
+            if let Err(wrong_kind) = vocabulary.check_atom(atom) {
+                return Err(format!("{at}: {wrong_kind}"));
+            }
             if let Some(unknown) = atom.args().iter().find(|a| !known.contains(a.as_str())) {
                 return Err(format!(
                     "{at}: `{unknown}` is not among the demo's objects (metadata.objects)"
                 ));
             }
+        }
+    }
+    Ok(())
+}
+
+/// Reads a vocabulary file (`nesy_core::parse_vocabulary_file` documents the format); the
+/// error names the file, the line and the field.
+pub fn load_vocabulary(path: &Path) -> Result<Vocabulary, PipelineError> {
+    let text =
+        nesy_input::read_text(path, nesy_input::MAX_JSON_BYTES).map_err(|e| PipelineError::TaskFile {
+            path: path.to_owned(),
+            message: format!("reading the vocabulary file: {e}"),
+        })?;
+    nesy_core::parse_vocabulary_file(&text).map_err(|e| PipelineError::TaskFile {
+        path: path.to_owned(),
+        message: format!("vocabulary file: {e}"),
+    })
+}
+
+/// Checks that a simulated target's observed state is in the vocabulary: the simulator
+/// observes the built-in predicates, so a vocabulary without them cannot describe its scene.
+pub(crate) fn check_target_state(target: &TargetInput, vocabulary: &Vocabulary) -> Result<(), PipelineError> {
+    for atom in target.observed.iter() {
+        if let Err(e) = vocabulary.check_use(atom.pred(), atom.args().len()) {
+            return Err(PipelineError::Target {
+                path: target.path.clone(),
+                message: format!(
+                    "the simulated scene's state holds {atom}, but {e} in the task's vocabulary; a vocabulary for a simulated target keeps the built-in predicates (builtin = true)"
+                ),
+            });
         }
     }
     Ok(())
@@ -265,24 +300,16 @@ impl TargetInput {
     }
 
     fn views_of(&self, marked: bool) -> Result<Views, PipelineError> {
-        let find = |name: &str| -> Result<Image, PipelineError> {
-            let bad = |message: String| PipelineError::Target {
-                path: self.path.clone(),
-                message,
-            };
-            let view = self
-                .views
-                .iter()
-                .find(|v| v.camera == name)
-                .ok_or_else(|| bad(format!("the renderer produced no {name} view")))?;
+        let mut views = Vec::with_capacity(self.views.len());
+        for view in &self.views {
             let image = if marked { &view.marked } else { &view.image };
-            Image::png(image.to_png()).map_err(|e| bad(format!("the {name} view: {e}")))
-        };
-        Ok(Views {
-            top: find("top")?,
-            front: find("front")?,
-            back: find("back")?,
-        })
+            let image = Image::png(image.to_png()).map_err(|e| PipelineError::Target {
+                path: self.path.clone(),
+                message: format!("the {} view: {e}", view.camera),
+            })?;
+            views.push((view.camera.to_string(), image));
+        }
+        Ok(Views::new(views))
     }
 }
 
@@ -293,22 +320,23 @@ pub struct DemoKeyframes {
 }
 
 impl DemoKeyframes {
-    /// Decodes the demo's images; a keyframe whose images are not PNG is an error naming it.
+    /// Reads the demo's images, every view in the demo's order; a keyframe whose images
+    /// are neither PNG nor JPEG is an error naming it and the view.
     pub fn from_demo(input: &DemoInput) -> Result<DemoKeyframes, PipelineError> {
         let demo: &Demo = &input.demo;
         let mut views = Vec::with_capacity(demo.keyframes.len());
         for k in &demo.keyframes {
-            let image = |camera: CameraName| -> Result<Image, PipelineError> {
-                Image::png(k.views.get(camera).marked_or_raw().to_vec()).map_err(|e| PipelineError::Demo {
-                    path: input.path.clone(),
-                    message: format!("keyframe {}: {} view: {e}", k.index, camera.as_str()),
-                })
-            };
-            views.push(Some(Views {
-                top: image(CameraName::Top)?,
-                front: image(CameraName::Front)?,
-                back: image(CameraName::Back)?,
-            }));
+            let mut named = Vec::with_capacity(k.views.len());
+            for view in k.views.iter() {
+                let image = Image::from_encoded(view.images.marked_or_raw().to_vec()).map_err(|e| {
+                    PipelineError::Demo {
+                        path: input.path.clone(),
+                        message: format!("keyframe {}: {} view: {e}", k.index, view.name),
+                    }
+                })?;
+                named.push((view.name.clone(), image));
+            }
+            views.push(Some(Views::new(named)));
         }
         Ok(DemoKeyframes { views })
     }
@@ -332,16 +360,42 @@ mod tests {
 
     fn fixture() -> Demo {
         let dir = nesy_testkit::workspace_root().join("fixtures/demos/adapt-realstyle");
-        DemoInput::load(&dir).expect("the fixture is a valid demo").demo
+        DemoInput::load(&dir, &Vocabulary::new())
+            .expect("the fixture is a valid demo")
+            .demo
     }
 
-    fn with_atom(atom: &str) -> String {
+    fn demo_with_atom(atom: &str) -> Demo {
         let mut demo = fixture();
         let state = demo.keyframes[1].state.as_mut().unwrap();
         let mut atoms: Vec<Atom> = state.iter().copied().collect();
         atoms.push(atom.parse().unwrap());
         *state = State::from_atoms(atoms);
-        check_demo(&demo).unwrap_err()
+        demo
+    }
+
+    fn with_atom(atom: &str) -> String {
+        check_demo(&demo_with_atom(atom), &Vocabulary::new()).unwrap_err()
+    }
+
+    #[test]
+    fn a_vocabulary_file_admits_its_predicates_and_checks_their_kinds() {
+        let demo = demo_with_atom("(Finegrained red_cylinder)");
+        let err = check_demo(&demo, &Vocabulary::new()).unwrap_err();
+        assert!(
+            err.contains("`Finegrained` is not one of the task's predicates"),
+            "{err}"
+        );
+        let file = "format_version = 1\n[[kinds]]\nname = \"parts\"\n[[predicates]]\nname = \"Finegrained\"\nparams = [\"x - parts\"]\nmeaning = \"?x consists of many small loose parts.\"\n[[predicates]]\nname = \"Gathered\"\nparams = [\"x\"]\nmeaning = \"the parts of ?x lie in one pile.\"\n";
+        let vocabulary = nesy_core::parse_vocabulary_file(file).unwrap();
+        check_demo(&demo, &vocabulary).unwrap();
+        let typed = nesy_core::parse_vocabulary_file(&format!("{file}[objects]\nred_cylinder = \"thing\"\n"))
+            .unwrap();
+        let err = check_demo(&demo, &typed).unwrap_err();
+        assert!(
+            err.contains("argument 1 of `Finegrained` must be a `parts`"),
+            "{err}"
+        );
     }
 
     #[test]
@@ -349,7 +403,7 @@ mod tests {
         let err = with_atom("(Flying red_cylinder)");
         assert!(
             err.starts_with(
-                "keyframes[1].state: (Flying red_cylinder): `Flying` is not one of nesy's predicates"
+                "keyframes[1].state: (Flying red_cylinder): `Flying` is not one of the task's predicates"
             ),
             "{err}"
         );
@@ -365,7 +419,7 @@ mod tests {
             let mut demo = fixture();
             demo.keyframes[1].time = demo.keyframes[1].time.max(0.5);
             demo.keyframes[k].time = time;
-            let err = check_demo(&demo).unwrap_err();
+            let err = check_demo(&demo, &Vocabulary::new()).unwrap_err();
             assert!(err.starts_with(&format!("keyframes[{k}].time")), "{err}");
         }
     }

@@ -32,7 +32,7 @@
 //! use nesy_pipeline::{AdaptOptions, DemoInput, TargetInput, derive_setting};
 //!
 //! let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/demos/adapt-realstyle");
-//! let demo = DemoInput::load(dir.as_ref()).unwrap();
+//! let demo = DemoInput::load(dir.as_ref(), &nesy_core::Vocabulary::new()).unwrap();
 //! let target = TargetInput::load(Some(format!("{dir}/target.json").as_ref()), &demo).unwrap();
 //! assert_eq!(demo.demo.keyframes.len(), 9);
 //! let setting = derive_setting(&demo, &target, &AdaptOptions::default());
@@ -60,6 +60,7 @@ use nesy_core::adapt::{self, AdaptConfig, Adaptation, Demonstration, Target, Tas
 use nesy_core::{Operator, State};
 use nesy_policy::{Limits, WorkerCommand};
 use nesy_reasoner::VlmReasoner;
+use nesy_reasoner::prompts::{Prompts, TemplateRecord};
 use nesy_vlm::RunUsage;
 use serde::Serialize;
 
@@ -68,7 +69,7 @@ use states::{StateSource, StatesMode, SymbolicStates};
 use synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest, SynthesizedPolicy};
 
 pub use error::{PipelineError, StopReason};
-pub use inputs::{DemoInput, DemoKeyframes, TargetInput};
+pub use inputs::{DemoInput, DemoKeyframes, TargetInput, load_vocabulary};
 pub use progress::{LogProgress, NoProgress, Progress};
 pub use setting::{ImagesMode, Setting, derive_setting};
 pub use timing::TimeBreakdown;
@@ -97,6 +98,12 @@ pub struct AdaptOptions {
     /// The run directory: the target scene and the program are written here before
     /// execution, and [`output::RunDir::write_all`] writes the rest.
     pub out_dir: PathBuf,
+    /// The task's predicates and object kinds: the built-ins, or a vocabulary file's
+    /// ([`load_vocabulary`]).
+    pub vocabulary: Vocabulary,
+    /// NeSyCR's prompt templates with a user's overrides (`--prompts DIR`); `None` uses the
+    /// bundled ones.
+    pub prompts: Option<Arc<Prompts>>,
 }
 
 impl Default for AdaptOptions {
@@ -111,6 +118,8 @@ impl Default for AdaptOptions {
             limits: Limits::default(),
             worker: None,
             out_dir: PathBuf::from("nesy-out"),
+            vocabulary: Vocabulary::new(),
+            prompts: None,
         }
     }
 }
@@ -178,6 +187,12 @@ pub struct AdaptRun {
     pub timing: TimeBreakdown,
     /// Model calls, tokens, latency.
     pub usage: RunUsage,
+    /// Every prompt file the run's model calls were rendered from, with its SHA-256 (and the
+    /// override's path where `--prompts` replaced it).
+    pub prompts: Vec<TemplateRecord>,
+    /// The vocabulary's predicates beyond the built-ins, as the prompts define them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub declared_predicates: Vec<String>,
 }
 
 impl AdaptRun {
@@ -324,22 +339,24 @@ pub async fn run(
     };
     let mut setting = derive_setting(demo, target, options);
     setting.images = options.images.sends_images(&client.capabilities().await);
-    let reasoner = build_reasoner(client, demo, &setting)?;
+    let reasoner = build_reasoner(client, demo, &setting, options.prompts.clone())?;
+    let prompts = reasoner.prompts().templates().to_vec();
 
     progress.stage("symbolic states");
-    let vocabulary = Vocabulary::new();
+    let vocabulary = &options.vocabulary;
+    inputs::check_target_state(target, vocabulary)?;
     let states = states::symbolic_states(
         &reasoner,
         demo,
         target,
         &setting,
         options.states,
-        &vocabulary,
+        vocabulary,
         progress.as_ref(),
     )
     .await?;
     timing.vlm_s += states.vlm_time.as_secs_f64();
-    let (demonstration, target_task) = adaptation_inputs(demo, target, &setting, &states, &vocabulary);
+    let (demonstration, target_task) = adaptation_inputs(demo, target, &setting, &states, vocabulary);
     let config = AdaptConfig {
         budget: setting.budget,
         ..options.adapt
@@ -406,7 +423,21 @@ pub async fn run(
         execution,
         timing,
         usage,
+        prompts,
+        declared_predicates: declared_predicates(vocabulary),
     })
+}
+
+/// The definition lines of the predicates `vocabulary` adds to, or redefines among, the
+/// built-ins.
+fn declared_predicates(vocabulary: &Vocabulary) -> Vec<String> {
+    let builtins = nesy_core::builtin_predicates();
+    vocabulary
+        .predicates()
+        .iter()
+        .filter(|p| !builtins.contains(p))
+        .map(|p| p.definition_line())
+        .collect()
 }
 
 /// NeSyCR's reasoner over `client`: the demo's keyframe images, both end effectors, and the
@@ -415,10 +446,14 @@ fn build_reasoner(
     client: nesy_vlm::VlmClient,
     demo: &DemoInput,
     setting: &Setting,
+    prompts: Option<Arc<Prompts>>,
 ) -> Result<VlmReasoner, PipelineError> {
-    let reasoner = VlmReasoner::new(client).map_err(|e| PipelineError::VlmSetup {
+    let mut reasoner = VlmReasoner::new(client).map_err(|e| PipelineError::VlmSetup {
         message: format!("loading nesy's prompts: {e}"),
     })?;
+    if let Some(prompts) = prompts {
+        reasoner = reasoner.with_prompts(prompts);
+    }
     // Without pictures the prompts carry the states as text alone, as they always do.
     let reasoner = if setting.images {
         reasoner.with_keyframes(Arc::new(DemoKeyframes::from_demo(demo)?))

@@ -26,7 +26,7 @@ fn main() -> ExitCode {
 
 fn inputs() -> (DemoInput, TargetInput) {
     let dir = nesy_testkit::workspace_root().join("fixtures/demos/adapt-realstyle");
-    let demo = DemoInput::load(&dir).expect("the fixture demo loads");
+    let demo = DemoInput::load(&dir, &nesy_core::Vocabulary::new()).expect("the fixture demo loads");
     let target = TargetInput::load(Some(&dir.join("target.json")), &demo).expect("its target loads");
     (demo, target)
 }

@@ -69,10 +69,12 @@ fn prompts(c: &mut Criterion) {
         ))
         .expect("scenario adapts");
     let (top, front) = rendered_views();
-    let views = |_| nesy_reasoner::Views {
-        top: Image::png(top.clone()).expect("png"),
-        front: Image::png(front.clone()).expect("png"),
-        back: Image::png(top.clone()).expect("png"),
+    let views = |_| {
+        nesy_reasoner::Views::new([
+            ("top", Image::png(top.clone()).expect("png")),
+            ("front", Image::png(front.clone()).expect("png")),
+            ("back", Image::png(top.clone()).expect("png")),
+        ])
     };
     let keyframes = Arc::new(nesy_reasoner::KeyframeList {
         views: (0..5).map(views).collect(),
@@ -106,7 +108,7 @@ fn prompts(c: &mut Criterion) {
     });
     group.bench_function("code_generation_extended_request", |b| {
         b.iter(|| {
-            nesy_reasoner::codegen::build_request(prompts, &codegen, &Default::default()).expect("renders")
+            nesy_reasoner::codegen::build_request(&prompts, &codegen, &Default::default()).expect("renders")
         })
     });
     group.bench_function("extract_code", |b| {

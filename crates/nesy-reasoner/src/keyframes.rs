@@ -4,27 +4,56 @@
 
 use nesy_vlm::{Image, Part};
 
-/// The three labelled ("marked") camera views of one scene state.
+/// The camera views of one scene state, each under its name, in the order prompts show
+/// them: the simulator's top, front and back, or a real demonstration's own views (one
+/// camera or several, named as the user named them).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Views {
-    /// The top view.
-    pub top: Image,
-    /// The front view (looking at the robot).
-    pub front: Image,
-    /// The back view (from behind the robot).
-    pub back: Image,
+    views: Vec<(String, Image)>,
 }
 
 impl Views {
-    /// The views with their names, in prompt order: top, front, back.
-    pub fn named(&self) -> [(&'static str, &Image); 3] {
-        [("top", &self.top), ("front", &self.front), ("back", &self.back)]
+    /// Views from `(name, image)` pairs, in prompt order.
+    ///
+    /// ```
+    /// use nesy_reasoner::Views;
+    /// use nesy_vlm::Image;
+    ///
+    /// let png = |seed| Image::png(nesy_testkit::png(4, seed)).unwrap();
+    /// let views = Views::new([("top", png(1)), ("wrist", png(2))]);
+    /// assert_eq!(views.names().collect::<Vec<_>>(), ["top", "wrist"]);
+    /// assert_eq!(views.parts("Before the action").len(), 4);
+    /// ```
+    pub fn new<N: Into<String>>(views: impl IntoIterator<Item = (N, Image)>) -> Views {
+        Views {
+            views: views.into_iter().map(|(n, i)| (n.into(), i)).collect(),
+        }
+    }
+
+    /// The views with their names, in prompt order.
+    pub fn named(&self) -> impl Iterator<Item = (&str, &Image)> {
+        self.views.iter().map(|(n, i)| (n.as_str(), i))
+    }
+
+    /// The view names, in prompt order.
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.views.iter().map(|(n, _)| n.as_str())
+    }
+
+    /// How many views there are.
+    pub fn len(&self) -> usize {
+        self.views.len()
+    }
+
+    /// True when there is no view.
+    pub fn is_empty(&self) -> bool {
+        self.views.is_empty()
     }
 
     /// Message parts: a short text label before each image, e.g. `Before the action, top
     /// view:`.
     pub fn parts(&self, caption: &str) -> Vec<Part> {
-        let mut parts = Vec::with_capacity(6);
+        let mut parts = Vec::with_capacity(2 * self.views.len());
         for (name, image) in self.named() {
             parts.push(Part::text(format!("{caption}, {name} view:")));
             parts.push(Part::Image(image.clone()));

@@ -38,7 +38,7 @@ use nesy_vlm::{ChatRequest, Message, Part, ReplyForm};
 #[derive(Clone)]
 pub struct VlmReasoner {
     client: VlmClient,
-    prompts: &'static Prompts,
+    prompts: Arc<Prompts>,
     keyframes: Arc<dyn KeyframeImages>,
     source: Embodiment,
     target: Embodiment,
@@ -107,8 +107,14 @@ impl VlmReasoner {
     }
 
     /// The prompts in use.
-    pub fn prompts(&self) -> &'static Prompts {
-        self.prompts
+    pub fn prompts(&self) -> &Prompts {
+        &self.prompts
+    }
+
+    /// Prompts other than the bundled ones (`Prompts::with_overrides`).
+    pub fn with_prompts(mut self, prompts: Arc<Prompts>) -> Self {
+        self.prompts = prompts;
+        self
     }
 
     /// The operator-induction chat request for `request`, as [`Reasoner::induce_operator`]
@@ -185,7 +191,7 @@ impl VlmReasoner {
         &self,
         request: &StateTranslationRequest,
     ) -> Result<TranslatedState, TranslateError> {
-        translate::translate_state(&self.client, self.prompts, request, &self.settings.translate).await
+        translate::translate_state(&self.client, &self.prompts, request, &self.settings.translate).await
     }
 
     /// Code generation with this reasoner's client, prompts and `codegen` settings.
@@ -195,7 +201,7 @@ impl VlmReasoner {
         })?;
         codegen::generate_code(
             &self.client,
-            self.prompts,
+            &self.prompts,
             request,
             &self.settings.codegen,
             checks,

@@ -37,6 +37,22 @@ pub fn workspace_root() -> PathBuf {
         .unwrap_or(here)
 }
 
+/// Copies the folder `from` and everything below it to `to` (created if missing).
+pub fn copy_tree(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).expect("creating the copy's folder");
+    for entry in std::fs::read_dir(from)
+        .expect("reading the folder to copy")
+        .flatten()
+    {
+        let target = to.join(entry.file_name());
+        if entry.path().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).expect("copying a file");
+        }
+    }
+}
+
 /// A chat-completions success body whose one choice says `text` and stopped normally, with
 /// token usage (including reasoning tokens) so that accounting has something to count.
 pub fn completion(text: &str) -> Value {

@@ -89,7 +89,8 @@ pub(super) async fn scenario_inputs(
         let s = scenario.clone();
         cpu(shared, move || -> Result<ScenarioInputs, String> {
             let cached = cache.ensure(&s, 1).map_err(|e| e.to_string())?;
-            let demo = DemoInput::load(&cached.demo).map_err(|e| e.to_string())?;
+            let demo =
+                DemoInput::load(&cached.demo, &nesy_core::Vocabulary::new()).map_err(|e| e.to_string())?;
             let target = TargetInput::load(Some(&cached.target), &demo).map_err(|e| e.to_string())?;
             let keyframes = DemoKeyframes::from_demo(&demo).map_err(|e| e.to_string())?;
             Ok(ScenarioInputs {

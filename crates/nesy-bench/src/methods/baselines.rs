@@ -11,12 +11,11 @@ use std::time::Instant;
 use futures::FutureExt as _;
 use futures::future::BoxFuture;
 use nesy_baselines::{
-    Baseline, BaselineError, BaselineInputs, BaselinePlan, Fidelity, Keyframe, SceneObservation, SixViews,
+    Baseline, BaselineError, BaselineInputs, BaselinePlan, Fidelity, Keyframe, SceneObservation, SceneViews,
 };
 use nesy_core::Vocabulary;
 use nesy_pipeline::synth::CodegenMode;
 use nesy_reasoner::Views;
-use nesy_sim::demo::CameraName;
 use nesy_vlm::{Image, VlmClient};
 
 use super::{
@@ -223,24 +222,21 @@ fn baseline_inputs(inputs: &UnitInputs, fidelity: Fidelity) -> Result<BaselineIn
             ))
         })?;
         let view = |marked: bool| -> Result<Views, MethodFailure> {
-            let image = |camera: CameraName| {
-                let images = k.views.get(camera);
+            let mut named = Vec::with_capacity(k.views.len());
+            for view in k.views.iter() {
                 let bytes = if marked {
-                    images.marked_or_raw()
+                    view.images.marked_or_raw()
                 } else {
-                    &images.raw
+                    &view.images.raw
                 };
-                Image::png(bytes.to_vec())
-                    .map_err(|e| fail(format!("keyframe {}: {} view: {e}", k.index, camera.as_str())))
-            };
-            Ok(Views {
-                top: image(CameraName::Top)?,
-                front: image(CameraName::Front)?,
-                back: image(CameraName::Back)?,
-            })
+                let image = Image::from_encoded(bytes.to_vec())
+                    .map_err(|e| fail(format!("keyframe {}: {} view: {e}", k.index, view.name)))?;
+                named.push((view.name.clone(), image));
+            }
+            Ok(Views::new(named))
         };
         let observation = if pictures {
-            SceneObservation::Images(SixViews {
+            SceneObservation::Images(SceneViews {
                 raw: view(false)?,
                 marked: view(true)?,
             })
@@ -251,7 +247,7 @@ fn baseline_inputs(inputs: &UnitInputs, fidelity: Fidelity) -> Result<BaselineIn
     }
     let target = &inputs.target;
     let target_observation = if pictures {
-        SceneObservation::Images(SixViews {
+        SceneObservation::Images(SceneViews {
             raw: target.raw_views().map_err(|e| fail(e.to_string()))?,
             marked: target.marked_views().map_err(|e| fail(e.to_string()))?,
         })

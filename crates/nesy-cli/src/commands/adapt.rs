@@ -31,6 +31,14 @@ pub(crate) struct AdaptArgs {
     /// The target scene (`scene.json`); defaults to the target scene recorded in the demo.
     #[arg(long, value_name = "SCENE")]
     pub target: Option<PathBuf>,
+    /// The task's predicates and object kinds (a TOML vocabulary file); the default is the
+    /// benchmark's fifteen predicates.
+    #[arg(long, value_name = "FILE")]
+    pub vocabulary: Option<PathBuf>,
+    /// A folder of prompt files replacing the bundled ones by name (`nesy prompts export`
+    /// writes them); the run's summary.json records the hash of every template used.
+    #[arg(long, value_name = "DIR")]
+    pub prompts: Option<PathBuf>,
     /// Who answers: `oracle` (offline reference responder), `replay:CASSETTE`, or the URL of
     /// an OpenAI-compatible server. Default: the configured VLM (NESY_VLM_* settings).
     #[arg(long, value_name = "URL|replay:CASSETTE|oracle")]
@@ -131,7 +139,7 @@ pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     }
     let progress = make_progress(args.json);
     progress.stage("reading the demo");
-    let demo = DemoInput::load(&args.demo)?;
+    let demo = DemoInput::load(&args.demo, &options.vocabulary)?;
     progress.stage("building the target scene");
     let target = TargetInput::load(args.target.as_deref(), &demo)?;
     progress.stage("connecting the VLM");
@@ -187,7 +195,17 @@ fn options(args: &AdaptArgs) -> anyhow::Result<AdaptOptions> {
             PathBuf::from("runs/adapt").join(name)
         }
     };
+    let vocabulary = match &args.vocabulary {
+        Some(path) => pipeline::load_vocabulary(path)?,
+        None => nesy_core::Vocabulary::new(),
+    };
+    let prompts = match &args.prompts {
+        Some(dir) => Some(Arc::new(nesy_reasoner::prompts::Prompts::with_overrides(dir)?)),
+        None => None,
+    };
     Ok(AdaptOptions {
+        vocabulary,
+        prompts,
         states: args.states,
         codegen: args.codegen,
         execute: args.execute,

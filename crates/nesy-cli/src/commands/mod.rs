@@ -3,6 +3,8 @@
 pub(crate) mod adapt;
 pub(crate) mod bench;
 pub(crate) mod cassette;
+pub(crate) mod demo;
+pub(crate) mod prompts;
 pub(crate) mod record;
 pub(crate) mod render;
 pub(crate) mod run;

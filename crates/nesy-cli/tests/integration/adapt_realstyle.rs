@@ -35,7 +35,7 @@ fn record_realstyle_fixture() {
     common::record_demo(&root.join("fixtures/scenes/drawer_finger.json"), &demo_path, 384);
     let cassette = root.join(CASSETTE);
     let _ = std::fs::remove_file(&cassette);
-    let demo = DemoInput::load(&demo_path).unwrap();
+    let demo = DemoInput::load(&demo_path, &nesy_core::Vocabulary::new()).unwrap();
     let target = TargetInput::load(Some(&root.join(DEMO_DIR).join("target.json")), &demo).unwrap();
     let out = common::scratch();
     let options = AdaptOptions {

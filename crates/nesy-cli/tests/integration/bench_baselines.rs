@@ -600,7 +600,7 @@ async fn all_methods_replay_to_identical_records_over_the_fixture_scenarios() {
 
     let cassettes = scratch.path().join("cassettes");
     for from in [oracle.join("cassettes"), live.join("cassettes")] {
-        copy_tree(&from, &cassettes);
+        nesy_testkit::copy_tree(&from, &cassettes);
     }
     let vlm = format!("replay:{}", cassettes.display());
     let mut replays = Vec::new();
@@ -640,17 +640,5 @@ async fn all_methods_replay_to_identical_records_over_the_fixture_scenarios() {
             "succeeded",
             "{scenario}"
         );
-    }
-}
-
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap().flatten() {
-        let target = to.join(entry.file_name());
-        if entry.path().is_dir() {
-            copy_tree(&entry.path(), &target);
-        } else {
-            std::fs::copy(entry.path(), &target).unwrap();
-        }
     }
 }

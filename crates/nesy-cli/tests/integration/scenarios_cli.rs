@@ -10,16 +10,6 @@ use std::process::{Command, Stdio};
 
 use nesy_sim::scene::SceneSpec;
 
-fn nesy(args: &[&str]) -> (Option<i32>, String, String) {
-    let args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
-    let output = common::nesy(&args);
-    (
-        output.status.code(),
-        String::from_utf8_lossy(&output.stdout).into_owned(),
-        String::from_utf8_lossy(&output.stderr).into_owned(),
-    )
-}
-
 /// The numbers of the table row that starts with `label`.
 fn row(table: &str, label: &str) -> Vec<u32> {
     let line = table
@@ -34,7 +24,7 @@ fn row(table: &str, label: &str) -> Vec<u32> {
 
 #[test]
 fn list_prints_the_papers_table_6() {
-    let (code, stdout, stderr) = nesy(&["scenarios", "list"]);
+    let (code, stdout, stderr) = common::run(&["scenarios", "list"]);
     assert_eq!(code, Some(0), "{stderr}");
     for factor in ["obst", "affo", "grip", "vacu"] {
         assert_eq!(row(&stdout, factor), [30, 30, 20, 80], "{factor}");
@@ -48,21 +38,21 @@ fn a_generated_suite_reads_back_to_the_same_scenarios() {
     let dir = common::scratch();
     let suite = dir.path().join("suite");
     let suite_arg = suite.to_str().unwrap();
-    let (code, stdout, stderr) = nesy(&["scenarios", "generate", "--out", suite_arg]);
+    let (code, stdout, stderr) = common::run(&["scenarios", "generate", "--out", suite_arg]);
     assert_eq!(code, Some(0), "{stderr}");
     assert_eq!(stdout.lines().count(), 15, "{stdout}");
     assert_eq!(std::fs::read_dir(&suite).unwrap().count(), 15);
 
-    let (_, generated, _) = nesy(&["scenarios", "list", "--ids"]);
-    let (code, read_back, stderr) = nesy(&["scenarios", "list", "--ids", "--suite", suite_arg]);
+    let (_, generated, _) = common::run(&["scenarios", "list", "--ids"]);
+    let (code, read_back, stderr) = common::run(&["scenarios", "list", "--ids", "--suite", suite_arg]);
     assert_eq!(code, Some(0), "{stderr}");
     assert_eq!(read_back, generated);
     assert_eq!(read_back.lines().count(), 440);
 
     for side in ["source", "target"] {
-        let (code, shown, stderr) = nesy(&["scenarios", "show", "grip_medium_03_s1", "--side", side]);
+        let (code, shown, stderr) = common::run(&["scenarios", "show", "grip_medium_03_s1", "--side", side]);
         assert_eq!(code, Some(0), "{stderr}");
-        let (_, from_suite, _) = nesy(&[
+        let (_, from_suite, _) = common::run(&[
             "scenarios",
             "show",
             "grip_medium_03_s1",
@@ -84,10 +74,10 @@ fn a_gap_suite_lists_by_added_subtasks_not_under_table_6() {
     let dir = common::scratch();
     let suite = dir.path().join("gap");
     let suite_arg = suite.to_str().unwrap();
-    let (code, stdout, stderr) = nesy(&["scenarios", "generate", "--gap", "--out", suite_arg]);
+    let (code, stdout, stderr) = common::run(&["scenarios", "generate", "--gap", "--out", suite_arg]);
     assert_eq!(code, Some(0), "{stderr}");
     assert_eq!(stdout.lines().count(), 4, "{stdout}");
-    let (code, table, stderr) = nesy(&["scenarios", "list", "--suite", suite_arg]);
+    let (code, table, stderr) = common::run(&["scenarios", "list", "--suite", suite_arg]);
     assert_eq!(code, Some(0), "{stderr}");
     assert!(table.contains("not part of the 440"), "{table}");
     for added in 0..4 {
@@ -98,7 +88,7 @@ fn a_gap_suite_lists_by_added_subtasks_not_under_table_6() {
         !table.contains("Total scenarios") && !table.contains("obst "),
         "{table}"
     );
-    let (code, ids, stderr) = nesy(&["scenarios", "list", "--ids", "--suite", suite_arg]);
+    let (code, ids, stderr) = common::run(&["scenarios", "list", "--ids", "--suite", suite_arg]);
     assert_eq!(code, Some(0), "{stderr}");
     assert_eq!(ids.lines().count(), 80);
     assert!(ids.lines().all(|id| id.starts_with("gap_obst_plus")), "{ids}");
@@ -109,10 +99,13 @@ fn bad_input_names_the_file_or_the_id() {
     let dir = common::scratch();
     let suite = dir.path().join("suite");
     let suite_arg = suite.to_str().unwrap();
-    assert_eq!(nesy(&["scenarios", "generate", "--out", suite_arg]).0, Some(0));
+    assert_eq!(
+        common::run(&["scenarios", "generate", "--out", suite_arg]).0,
+        Some(0)
+    );
     let broken = suite.join("obst_low.json");
     std::fs::write(&broken, "{\n  \"factor\": \"obst\",\n  \"complexity\": \n}\n").unwrap();
-    let (code, _, stderr) = nesy(&["scenarios", "list", "--suite", suite_arg]);
+    let (code, _, stderr) = common::run(&["scenarios", "list", "--suite", suite_arg]);
     assert_eq!(code, Some(2), "{stderr}");
     assert!(
         stderr.contains("obst_low.json") && stderr.contains("line 4"),
@@ -120,10 +113,10 @@ fn bad_input_names_the_file_or_the_id() {
     );
     assert!(!stderr.contains("panicked"), "{stderr}");
 
-    let (code, _, stderr) = nesy(&["scenarios", "show", "obst_low_99_s7"]);
+    let (code, _, stderr) = common::run(&["scenarios", "show", "obst_low_99_s7"]);
     assert_eq!(code, Some(2), "{stderr}");
     assert!(stderr.contains("obst_low_99_s7"), "{stderr}");
-    let (code, _, stderr) = nesy(&["record", "--scenario", "nope", "--out", suite_arg]);
+    let (code, _, stderr) = common::run(&["record", "--scenario", "nope", "--out", suite_arg]);
     assert_eq!(code, Some(2), "{stderr}");
     assert!(stderr.contains("\"nope\""), "{stderr}");
 }
@@ -133,7 +126,7 @@ fn record_writes_a_demo_that_reads_back_and_the_target_scene() {
     let dir = common::scratch();
     let out = dir.path().join("demo");
     let id = "obst_low_00_s0";
-    let (code, _, stderr) = nesy(&[
+    let (code, _, stderr) = common::run(&[
         "record",
         "--scenario",
         id,
@@ -158,7 +151,7 @@ fn record_writes_a_demo_that_reads_back_and_the_target_scene() {
         assert!(keyframe.state.is_some());
     }
 
-    let (_, shown, _) = nesy(&["scenarios", "show", id, "--side", "target"]);
+    let (_, shown, _) = common::run(&["scenarios", "show", id, "--side", "target"]);
     let written = std::fs::read_to_string(out.join("target.json")).unwrap();
     assert_eq!(
         SceneSpec::from_json_str(&written, "target.json").unwrap(),

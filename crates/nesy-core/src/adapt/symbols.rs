@@ -42,6 +42,15 @@ pub enum SymbolProblem {
     },
     /// Not an object of the task.
     UnknownObject,
+    /// An object whose declared kind the predicate's parameter does not take.
+    WrongKind {
+        /// The argument's position, from 1.
+        position: usize,
+        /// The parameter's kind.
+        expected: Symbol,
+        /// The object's kind.
+        found: Symbol,
+    },
 }
 
 impl std::fmt::Display for UnknownSymbol {
@@ -52,6 +61,15 @@ impl std::fmt::Display for UnknownSymbol {
                 write!(f, "`{}` takes {expected} argument(s), not {found}", self.name)?
             }
             SymbolProblem::UnknownObject => write!(f, "`{}` is not an object of this task", self.name)?,
+            SymbolProblem::WrongKind {
+                position,
+                expected,
+                found,
+            } => write!(
+                f,
+                "argument {position} of `{}` must be a `{expected}`, but it is a `{found}`",
+                self.name
+            )?,
         }
         if let Some(s) = &self.suggestion {
             write!(f, "; did you mean `{s}`?")?;
@@ -101,7 +119,8 @@ pub fn unknown_symbols(
 
 /// The names in `atoms` (a state list, such as a state translation's reply) that
 /// `vocabulary` and `objects` do not know, each once, in the order they first appear: the
-/// same rules as [`unknown_symbols`], applied to ground atoms.
+/// same rules as [`unknown_symbols`], applied to ground atoms, and each argument's declared
+/// kind checked against its parameter's (only vocabulary files declare kinds).
 ///
 /// ```
 /// use nesy_core::adapt::unknown_atom_symbols;
@@ -129,8 +148,19 @@ pub fn unknown_atom_symbols<'a>(
     let mut names = NameCheck::new(vocabulary, Some(objects));
     for atom in atoms {
         names.predicate(atom.pred(), atom.args().len());
-        for arg in atom.args() {
+        for (i, arg) in atom.args().iter().enumerate() {
             names.object(*arg);
+            if let Some((expected, found)) = vocabulary.kind_mismatch(atom.pred(), i, arg.as_str()) {
+                names.push(UnknownSymbol {
+                    kind: SymbolProblem::WrongKind {
+                        position: i + 1,
+                        expected,
+                        found,
+                    },
+                    name: atom.pred().to_string(),
+                    suggestion: None,
+                });
+            }
         }
     }
     names.found

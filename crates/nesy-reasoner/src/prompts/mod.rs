@@ -15,7 +15,9 @@
 pub mod api_docs;
 pub mod examples;
 
-use std::sync::OnceLock;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
 
 use minijinja::{AutoEscape, Environment, UndefinedBehavior};
 use nesy_core::State;
@@ -32,6 +34,36 @@ use examples::{CodeExample, InductionExample, StateExample};
 /// NeSyCR's induction prompt and the baselines' prompts so that every method is told the
 /// same. Templates see it as `{{ physical_constraints }}`.
 pub const PHYSICAL_CONSTRAINTS: &str = include_str!("../../prompts/physical_constraints.txt");
+
+/// The file name under which [`PHYSICAL_CONSTRAINTS`] is exported and overridden.
+pub const PHYSICAL_CONSTRAINTS_FILE: &str = "physical_constraints.txt";
+
+/// One prompt file a run used: its name, the SHA-256 of its text, and the file it was read
+/// from when it overrides the bundled one.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct TemplateRecord {
+    /// The file name, e.g. `induction.user.j2`.
+    pub name: String,
+    /// Hex SHA-256 of the text used.
+    pub sha256: String,
+    /// Where an override came from (absent for the bundled text).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub overridden_by: Option<PathBuf>,
+}
+
+impl TemplateRecord {
+    fn new(name: &str, text: &str, path: Option<&PathBuf>) -> TemplateRecord {
+        use sha2::{Digest, Sha256};
+        TemplateRecord {
+            name: name.to_string(),
+            sha256: Sha256::digest(text.as_bytes())
+                .iter()
+                .map(|b| format!("{b:02x}"))
+                .collect(),
+            overridden_by: path.cloned(),
+        }
+    }
+}
 
 /// The template environment every prompt of the project is rendered in: block tags trim
 /// their newline, the trailing newline is dropped, an undefined variable is an error, nothing
@@ -50,55 +82,122 @@ pub fn template_environment() -> Result<Environment<'static>, minijinja::Error> 
     Ok(env)
 }
 
-const TEMPLATES: &[(&str, &str)] = &[
-    (
-        "induction.system.j2",
-        include_str!("../../prompts/induction.system.j2"),
-    ),
-    (
-        "induction.user.j2",
-        include_str!("../../prompts/induction.user.j2"),
-    ),
-    (
-        "induction.feedback.j2",
-        include_str!("../../prompts/induction.feedback.j2"),
-    ),
-    (
-        "refinement.system.j2",
-        include_str!("../../prompts/refinement.system.j2"),
-    ),
-    (
-        "refinement.user.j2",
-        include_str!("../../prompts/refinement.user.j2"),
-    ),
-    (
-        "refinement.feedback.j2",
-        include_str!("../../prompts/refinement.feedback.j2"),
-    ),
-    (
-        "state_translation.system.j2",
-        include_str!("../../prompts/state_translation.system.j2"),
-    ),
-    (
-        "state_translation.user.j2",
-        include_str!("../../prompts/state_translation.user.j2"),
-    ),
-    (
-        "code_generation.system.j2",
-        include_str!("../../prompts/code_generation.system.j2"),
-    ),
-    (
-        "code_generation.user.j2",
-        include_str!("../../prompts/code_generation.user.j2"),
-    ),
-    (
-        "code_generation_extended.system.j2",
-        include_str!("../../prompts/code_generation_extended.system.j2"),
-    ),
-    (
-        "code_generation_extended.user.j2",
-        include_str!("../../prompts/code_generation_extended.user.j2"),
-    ),
+/// What the induction templates are given.
+const INDUCTION_VARIABLES: &[&str] = &[
+    "predicates",
+    "examples",
+    "instruction",
+    "objects",
+    "previous",
+    "current",
+    "diff",
+    "images",
+];
+/// What the feedback templates (after a rejected reply) are given.
+const FEEDBACK_VARIABLES: &[&str] = &["attempt", "message", "unreadable"];
+/// What the refinement templates are given.
+const REFINEMENT_VARIABLES: &[&str] = &[
+    "kind",
+    "predicates",
+    "instruction",
+    "objects",
+    "procedure",
+    "executed",
+    "erroneous",
+    "remaining",
+    "initial_state",
+    "error_state",
+    "unmet",
+];
+/// What the state-translation templates are given.
+const STATE_TRANSLATION_VARIABLES: &[&str] = &[
+    "predicates",
+    "examples",
+    "instruction",
+    "objects",
+    "known",
+    "images",
+];
+/// What the code-generation templates are given.
+const CODE_GENERATION_VARIABLES: &[&str] = &[
+    "imports",
+    "docstrings",
+    "examples",
+    "instruction",
+    "objects",
+    "end_effector",
+    "summary",
+];
+
+/// A bundled template file: its name (as templates and overrides refer to it), its text,
+/// and the variables its render call gives it (besides the global `physical_constraints`).
+struct BundledTemplate {
+    name: &'static str,
+    text: &'static str,
+    variables: &'static [&'static str],
+}
+
+const TEMPLATES: &[BundledTemplate] = &[
+    BundledTemplate {
+        name: "induction.system.j2",
+        text: include_str!("../../prompts/induction.system.j2"),
+        variables: INDUCTION_VARIABLES,
+    },
+    BundledTemplate {
+        name: "induction.user.j2",
+        text: include_str!("../../prompts/induction.user.j2"),
+        variables: INDUCTION_VARIABLES,
+    },
+    BundledTemplate {
+        name: "induction.feedback.j2",
+        text: include_str!("../../prompts/induction.feedback.j2"),
+        variables: FEEDBACK_VARIABLES,
+    },
+    BundledTemplate {
+        name: "refinement.system.j2",
+        text: include_str!("../../prompts/refinement.system.j2"),
+        variables: REFINEMENT_VARIABLES,
+    },
+    BundledTemplate {
+        name: "refinement.user.j2",
+        text: include_str!("../../prompts/refinement.user.j2"),
+        variables: REFINEMENT_VARIABLES,
+    },
+    BundledTemplate {
+        name: "refinement.feedback.j2",
+        text: include_str!("../../prompts/refinement.feedback.j2"),
+        variables: FEEDBACK_VARIABLES,
+    },
+    BundledTemplate {
+        name: "state_translation.system.j2",
+        text: include_str!("../../prompts/state_translation.system.j2"),
+        variables: STATE_TRANSLATION_VARIABLES,
+    },
+    BundledTemplate {
+        name: "state_translation.user.j2",
+        text: include_str!("../../prompts/state_translation.user.j2"),
+        variables: STATE_TRANSLATION_VARIABLES,
+    },
+    BundledTemplate {
+        name: "code_generation.system.j2",
+        text: include_str!("../../prompts/code_generation.system.j2"),
+        variables: CODE_GENERATION_VARIABLES,
+    },
+    BundledTemplate {
+        name: "code_generation.user.j2",
+        text: include_str!("../../prompts/code_generation.user.j2"),
+        variables: CODE_GENERATION_VARIABLES,
+    },
+    BundledTemplate {
+        name: "code_generation_extended.system.j2",
+        text: include_str!("../../prompts/code_generation_extended.system.j2"),
+        variables: CODE_GENERATION_VARIABLES,
+    },
+    BundledTemplate {
+        name: "code_generation_extended.user.j2",
+        text: include_str!("../../prompts/code_generation_extended.user.j2"),
+        variables: CODE_GENERATION_VARIABLES,
+    },
 ];
 
 /// Why a prompt could not be built. These are defects of nesy's own template or example
@@ -112,6 +211,14 @@ pub enum PromptError {
         name: &'static str,
         /// minijinja's error (with the line).
         error: minijinja::Error,
+    },
+    /// A user's prompt file (`--prompts DIR`) cannot be used.
+    #[error("{}: {message}", path.display())]
+    Override {
+        /// The file (or the folder).
+        path: PathBuf,
+        /// What is wrong: an unknown name, a syntax error with its line, an unknown variable.
+        message: String,
     },
     /// An example file is malformed.
     #[error("prompt example {file}: {message}")]
@@ -176,6 +283,7 @@ impl CodeGenerationPrompt<'_> {
 /// The loaded templates and examples. Build once ([`Prompts::builtin`]) and share.
 pub struct Prompts {
     env: Environment<'static>,
+    templates: Vec<TemplateRecord>,
     induction_examples: Vec<InductionExample>,
     state_examples: Vec<StateExample>,
     finger_code: Vec<CodeExample>,
@@ -187,7 +295,7 @@ impl std::fmt::Debug for Prompts {
         f.debug_struct("Prompts")
             .field(
                 "templates",
-                &TEMPLATES.iter().map(|(n, _)| *n).collect::<Vec<_>>(),
+                &self.templates.iter().map(|t| t.name.as_str()).collect::<Vec<_>>(),
             )
             .field("induction_examples", &self.induction_examples.len())
             .field("state_examples", &self.state_examples.len())
@@ -251,18 +359,127 @@ struct CodeExampleVars<'a> {
 }
 
 impl Prompts {
-    /// Compiles the templates and loads the examples.
+    /// Compiles the bundled templates and loads the examples.
     pub fn load() -> Result<Prompts, PromptError> {
+        Prompts::assemble(&BTreeMap::new())
+    }
+
+    /// The bundled prompts with some files replaced by the ones in `dir`, by file name: any
+    /// template ([`Prompts::template_names`]) and `physical_constraints.txt`. A file of
+    /// another name, a template that does not compile, or one that uses a variable its
+    /// render call does not give is refused, naming the file; files starting with `.` are
+    /// skipped. `nesy prompts export` writes the bundled files as a starting point.
+    pub fn with_overrides(dir: &Path) -> Result<Prompts, PromptError> {
+        let refuse = |path: &Path, message: String| PromptError::Override {
+            path: path.to_owned(),
+            message,
+        };
+        let entries =
+            std::fs::read_dir(dir).map_err(|e| refuse(dir, format!("reading the prompts folder: {e}")))?;
+        let mut overrides = BTreeMap::new();
+        for entry in entries {
+            let entry = entry.map_err(|e| refuse(dir, format!("reading the prompts folder: {e}")))?;
+            let path = entry.path();
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if name.starts_with('.') {
+                continue;
+            }
+            let known = name == PHYSICAL_CONSTRAINTS_FILE || TEMPLATES.iter().any(|t| t.name == name);
+            if !known {
+                let mut names: Vec<&str> = Prompts::template_names().collect();
+                names.push(PHYSICAL_CONSTRAINTS_FILE);
+                return Err(refuse(
+                    &path,
+                    format!(
+                        "not a prompt file nesy uses; expected one of {}",
+                        names.join(", ")
+                    ),
+                ));
+            }
+            let text = nesy_input::read_text(&path, nesy_input::MAX_JSON_BYTES)
+                .map_err(|e| refuse(&path, format!("reading the template: {e}")))?;
+            overrides.insert(name, (path, text));
+        }
+        Prompts::assemble(&overrides)
+    }
+
+    /// Compiles the bundled templates with `overrides` (file name to path and text) in
+    /// their place.
+    fn assemble(overrides: &BTreeMap<String, (PathBuf, String)>) -> Result<Prompts, PromptError> {
         let mut env = template_environment().map_err(|error| PromptError::Template {
             name: "(syntax configuration)",
             error,
         })?;
-        for (name, text) in TEMPLATES {
-            env.add_template(name, text)
-                .map_err(|error| PromptError::Template { name, error })?;
+        let mut templates = Vec::with_capacity(TEMPLATES.len() + 1);
+        match overrides.get(PHYSICAL_CONSTRAINTS_FILE) {
+            Some((path, text)) => {
+                env.add_global("physical_constraints", text.trim_end().to_string());
+                templates.push(TemplateRecord::new(PHYSICAL_CONSTRAINTS_FILE, text, Some(path)));
+            }
+            None => templates.push(TemplateRecord::new(
+                PHYSICAL_CONSTRAINTS_FILE,
+                PHYSICAL_CONSTRAINTS,
+                None,
+            )),
+        }
+        for bundled in TEMPLATES {
+            match overrides.get(bundled.name) {
+                Some((path, text)) => {
+                    env.add_template_owned(bundled.name, text.clone())
+                        .map_err(|error| PromptError::Override {
+                            path: path.clone(),
+                            message: format!("{error:#}"),
+                        })?;
+                    templates.push(TemplateRecord::new(bundled.name, text, Some(path)));
+                }
+                None => {
+                    env.add_template(bundled.name, bundled.text)
+                        .map_err(|error| PromptError::Template {
+                            name: bundled.name,
+                            error,
+                        })?;
+                    templates.push(TemplateRecord::new(bundled.name, bundled.text, None));
+                }
+            }
+        }
+        // An override may only use what its render call gives (an undefined variable would
+        // otherwise stop the run at its first call); checked once every template is in, so
+        // that `extends` resolves.
+        for bundled in TEMPLATES {
+            let Some((path, _)) = overrides.get(bundled.name) else {
+                continue;
+            };
+            let template = env
+                .get_template(bundled.name)
+                .map_err(|error| PromptError::Override {
+                    path: path.clone(),
+                    message: format!("{error:#}"),
+                })?;
+            let mut unknown: Vec<String> = template
+                .undeclared_variables(false)
+                .into_iter()
+                .filter(|v| v != "physical_constraints" && !bundled.variables.contains(&v.as_str()))
+                .collect();
+            unknown.sort();
+            if !unknown.is_empty() {
+                return Err(PromptError::Override {
+                    path: path.clone(),
+                    message: format!(
+                        "uses {}, which {} is not given; it is given {} and physical_constraints",
+                        unknown
+                            .iter()
+                            .map(|v| format!("`{v}`"))
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                        bundled.name,
+                        bundled.variables.join(", ")
+                    ),
+                });
+            }
         }
         Ok(Prompts {
             env,
+            templates,
             induction_examples: examples::induction_examples()?,
             state_examples: examples::state_examples()?,
             finger_code: examples::code_examples(Embodiment::Finger)?,
@@ -270,14 +487,49 @@ impl Prompts {
         })
     }
 
-    /// The process-wide instance, loaded on first use.
-    pub fn builtin() -> Result<&'static Prompts, PromptError> {
-        static PROMPTS: OnceLock<Prompts> = OnceLock::new();
+    /// The process-wide bundled instance, loaded on first use.
+    pub fn builtin() -> Result<Arc<Prompts>, PromptError> {
+        static PROMPTS: OnceLock<Arc<Prompts>> = OnceLock::new();
         if let Some(prompts) = PROMPTS.get() {
-            return Ok(prompts);
+            return Ok(prompts.clone());
         }
-        let loaded = Prompts::load()?;
-        Ok(PROMPTS.get_or_init(|| loaded))
+        let loaded = Arc::new(Prompts::load()?);
+        Ok(PROMPTS.get_or_init(|| loaded).clone())
+    }
+
+    /// Every template file in use with its SHA-256, and the file it was read from when it
+    /// overrides the bundled one. A run records them.
+    pub fn templates(&self) -> &[TemplateRecord] {
+        &self.templates
+    }
+
+    /// Writes the bundled template files and `physical_constraints.txt` into `dir` (created
+    /// if missing), refusing to overwrite a file that exists; returns the paths written.
+    pub fn export_bundled(dir: &Path) -> Result<Vec<PathBuf>, PromptError> {
+        let failed = |path: &Path, e: std::io::Error| PromptError::Override {
+            path: path.to_owned(),
+            message: format!("writing the template: {e}"),
+        };
+        std::fs::create_dir_all(dir).map_err(|e| failed(dir, e))?;
+        let files = std::iter::once((PHYSICAL_CONSTRAINTS_FILE, PHYSICAL_CONSTRAINTS))
+            .chain(TEMPLATES.iter().map(|t| (t.name, t.text)));
+        let mut written = Vec::new();
+        for (name, text) in files {
+            let path = dir.join(name);
+            let mut file = std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&path)
+                .map_err(|e| failed(&path, e))?;
+            std::io::Write::write_all(&mut file, text.as_bytes()).map_err(|e| failed(&path, e))?;
+            written.push(path);
+        }
+        Ok(written)
+    }
+
+    /// The variables the template `name` is given (besides `physical_constraints`).
+    pub fn template_variables(name: &str) -> Option<&'static [&'static str]> {
+        TEMPLATES.iter().find(|t| t.name == name).map(|t| t.variables)
     }
 
     /// SHA-256 (hex) over every embedded prompt file: templates, few-shot examples and API
@@ -292,8 +544,8 @@ impl Prompts {
             h.update((text.len() as u64).to_le_bytes());
             h.update(text.as_bytes());
         };
-        for (name, text) in TEMPLATES {
-            add(name, text);
+        for template in TEMPLATES {
+            add(template.name, template.text);
         }
         add("physical_constraints.txt", PHYSICAL_CONSTRAINTS);
         for files in [
@@ -315,7 +567,7 @@ impl Prompts {
 
     /// The names of all template files.
     pub fn template_names() -> impl Iterator<Item = &'static str> {
-        TEMPLATES.iter().map(|(n, _)| *n)
+        TEMPLATES.iter().map(|t| t.name)
     }
 
     /// The induction examples.

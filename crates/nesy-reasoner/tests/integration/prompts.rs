@@ -221,6 +221,47 @@ fn induction_prompts() {
     );
 }
 
+/// A vocabulary file's predicates reach every prompt that lists predicates, with their
+/// kinds; the built-ins keep their lines.
+#[test]
+fn a_vocabulary_file_extends_the_prompts() {
+    let file = nesy_testkit::workspace_root().join("fixtures/vocabulary/fine-parts.toml");
+    let vocabulary = nesy_core::parse_vocabulary_file(&std::fs::read_to_string(file).unwrap()).unwrap();
+    let recorder = recorded();
+    let mut induction = recorder.induction_requests[0].clone();
+    induction.task.vocabulary = vocabulary.clone();
+    let rendered = render(
+        &reasoner(Arc::new(NoKeyframes))
+            .induction_request(&induction)
+            .unwrap(),
+    );
+    assert_snapshot("induction_with_vocabulary_file", &rendered);
+    let mut patch = recorder.patch_requests[0].clone();
+    patch.task.vocabulary = vocabulary.clone();
+    let prompts = Prompts::builtin().unwrap();
+    let translation = StateTranslationRequest {
+        view_set: "target/initial".into(),
+        instruction: "Gather the screws on the tray.".into(),
+        objects: vec!["black_screws".into(), "tray".into()],
+        tier: Tier::Full,
+        vocabulary,
+        known: Default::default(),
+        views: views(3),
+        ground_truth: None,
+    };
+    let translation =
+        nesy_reasoner::translate::build_request(&prompts, &translation, &Default::default()).unwrap();
+    for text in [
+        rendered,
+        render(&reasoner(Arc::new(NoKeyframes)).patch_request(&patch).unwrap()),
+        render(&translation),
+    ] {
+        assert!(text.contains("(OnTopOf ?a ?b): ?a is resting on and supported by ?b."));
+        assert!(text.contains("(Finegrained ?x - parts): ?x consists of many small loose parts"));
+        assert!(text.contains("(Gathered ?x - parts): the parts of ?x lie together in one pile."));
+    }
+}
+
 #[test]
 fn refinement_prompts() {
     let recorder = recorded();
@@ -308,11 +349,11 @@ fn refinement_prompts() {
 
 fn views(seed: u64) -> Views {
     let png = |s| Image::png(nesy_testkit::png(16, s)).unwrap();
-    Views {
-        top: png(seed),
-        front: png(seed + 1),
-        back: png(seed + 2),
-    }
+    Views::new([
+        ("top", png(seed)),
+        ("front", png(seed + 1)),
+        ("back", png(seed + 2)),
+    ])
 }
 
 #[test]
@@ -328,12 +369,12 @@ fn state_translation_prompts() {
         views: views(5),
         ground_truth: Some(scenario::target().init),
     };
-    let full = nesy_reasoner::translate::build_request(prompts, &request, &Default::default()).unwrap();
+    let full = nesy_reasoner::translate::build_request(&prompts, &request, &Default::default()).unwrap();
     roundtrip(&full);
     assert_snapshot("state_translation_full_images", &render(&full));
     request.tier = Tier::Partial;
     request.known = Default::default();
-    let partial = nesy_reasoner::translate::build_request(prompts, &request, &Default::default()).unwrap();
+    let partial = nesy_reasoner::translate::build_request(&prompts, &request, &Default::default()).unwrap();
     assert_snapshot("state_translation_partial", &render(&partial));
     assert!(
         !render(&partial).contains("Open hinge_lid"),
@@ -362,7 +403,7 @@ fn codegen_request(embodiment: Embodiment, extended: bool) -> ChatRequest {
     };
     let prompts = Prompts::builtin().unwrap();
     let (chat, used) = nesy_reasoner::codegen::build_request(
-        prompts,
+        &prompts,
         &request,
         &nesy_vlm::PurposeSettings::default().codegen,
     )

@@ -378,11 +378,7 @@ async fn state_translation_adds_checked_atoms_to_the_known_ones() {
         tier: Tier::Full,
         vocabulary: Vocabulary::new(),
         known: scenario::state(&["(GripperOpen)"]),
-        views: Views {
-            top: png(1),
-            front: png(2),
-            back: png(3),
-        },
+        views: Views::new([("top", png(1)), ("front", png(2)), ("back", png(3))]),
         ground_truth: Some(scenario::target().init),
     };
     // An object the scene does not have is not dropped quietly: the reply is re-asked with

@@ -86,10 +86,12 @@ pub(crate) fn config() -> AdaptConfig {
 /// Five keyframes of three views each (distinct real PNGs).
 pub(crate) fn keyframes() -> Arc<KeyframeList> {
     let views = (0..5u64)
-        .map(|k| Views {
-            top: Image::png(nesy_testkit::png(24, 10 * k + 1)).unwrap(),
-            front: Image::png(nesy_testkit::png(24, 10 * k + 2)).unwrap(),
-            back: Image::png(nesy_testkit::png(24, 10 * k + 3)).unwrap(),
+        .map(|k| {
+            Views::new([
+                ("top", Image::png(nesy_testkit::png(24, 10 * k + 1)).unwrap()),
+                ("front", Image::png(nesy_testkit::png(24, 10 * k + 2)).unwrap()),
+                ("back", Image::png(nesy_testkit::png(24, 10 * k + 3)).unwrap()),
+            ])
         })
         .collect();
     Arc::new(KeyframeList { views })

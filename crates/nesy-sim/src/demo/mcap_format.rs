@@ -28,7 +28,8 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::{
-    CameraImages, CameraName, Demo, DemoError, DemoMetadata, Keyframe, KeyframeViews, NESY_VERSION, check_png,
+    CameraImages, CameraName, Demo, DemoError, DemoMetadata, Demonstrator, Keyframe, KeyframeViews,
+    NESY_VERSION, check_png,
 };
 use crate::api::{Embodiment, TraceEntry};
 use crate::scene::SceneSpec;
@@ -253,7 +254,10 @@ pub fn write_mcap<W: Write + Seek>(demo: &Demo, w: W) -> Result<W, mcap::McapErr
         };
         let timestamp = Timestamp::from_nanos(ns);
         for &(camera, marked, channel) in &image_channels {
-            let images = keyframe.views.get(camera);
+            // MCAP demos carry the simulator's three cameras; other views are not written.
+            let Some(images) = keyframe.views.get(camera.as_str()) else {
+                continue;
+            };
             let png = if marked {
                 images.marked.as_deref()
             } else {
@@ -736,6 +740,8 @@ fn parse_metadata(map: &BTreeMap<String, String>, path: &Path) -> Result<(DemoMe
         instruction,
         objects,
         embodiment,
+        demonstrator: Demonstrator::Robot,
+        imported_from: None,
         scenario_id: get(MetadataKey::ScenarioId).map(str::to_owned),
         side: get(MetadataKey::Side).map(str::to_owned),
         nesy_version: get(MetadataKey::NesyVersion).map(str::to_owned),

@@ -3,14 +3,15 @@
 //! A [`Demo`] is its metadata (instruction, objects, embodiment, scenario, version, and
 //! optionally the target scene it is meant to be adapted to) plus its keyframes. A keyframe
 //! is the initial state or the state after one completed action call (the authors'
-//! definition, `docs/benchmark.md` §7); it carries the three camera views (plain and labelled PNG), the
+//! definition, `docs/benchmark.md` §7); it carries its camera views (plain and labelled), the
 //! ground-truth symbolic state when one is known, and the API call that led to it.
 //!
 //! Two storage layouts are read by [`read`]:
 //! - `demo.mcap` (written by [`write_mcap`] / `nesy record`): the topics are listed in
 //!   [`mcap_format`] and in the crate README;
-//! - a folder with `manifest.json` and `frames/NNNN_{top,front,back}.png` ([`read_folder`], [`write_folder`]), the
-//!   path for real-world demos, which have images but no ground-truth states.
+//! - a folder with `manifest.json` and `frames/NNNN_<view>.{png,jpg}` ([`read_folder`],
+//!   [`write_folder`]), the path for real-world demos: any number of named camera views,
+//!   usually no ground-truth states, and possibly a person as the demonstrator.
 
 mod folder;
 pub mod mcap_format;
@@ -25,7 +26,10 @@ use serde::{Deserialize, Serialize};
 use crate::api::{Embodiment, TraceEntry};
 use crate::scene::SceneSpec;
 
-pub use folder::{Manifest, ManifestKeyframe, frame_file_name, manifest_schema, read_folder, write_folder};
+pub use folder::{
+    DemoEmbodiment, Manifest, ManifestKeyframe, frame_file_name, is_view_name, manifest_schema, read_folder,
+    write_folder,
+};
 pub use mcap_format::{read_mcap, read_mcap_bytes, write_mcap, write_mcap_file};
 pub use record::{ExpertRun, RecordError, RecordOptions, Recording, record_scene, run_expert};
 
@@ -66,7 +70,7 @@ impl CameraName {
     }
 }
 
-/// One camera's images of a keyframe, PNG-encoded.
+/// One camera's images of a keyframe, PNG- or JPEG-encoded.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CameraImages {
     /// The plain rendering (or photograph).
@@ -83,35 +87,85 @@ impl CameraImages {
     }
 }
 
-/// The three views of a keyframe.
+/// One named camera view of a keyframe.
 #[derive(Clone, Debug, PartialEq, Eq)]
+pub struct NamedView {
+    /// The view's name: `top`, `front` or `back` for the simulator; a real demo's own
+    /// (`wrist`, `realsense`, ...).
+    pub name: String,
+    /// Its images.
+    pub images: CameraImages,
+}
+
+/// The camera views of a keyframe, in the order prompts show them: the simulator's top,
+/// front and back, or any number of named views of a real demonstration.
+#[derive(Clone, Debug, PartialEq, Eq, Default)]
 pub struct KeyframeViews {
-    /// Top camera.
-    pub top: CameraImages,
-    /// Front camera.
-    pub front: CameraImages,
-    /// Back camera.
-    pub back: CameraImages,
+    views: Vec<NamedView>,
 }
 
 impl KeyframeViews {
-    /// The images of one camera.
-    pub fn get(&self, camera: CameraName) -> &CameraImages {
-        match camera {
-            CameraName::Top => &self.top,
-            CameraName::Front => &self.front,
-            CameraName::Back => &self.back,
-        }
+    /// Views from a list, in prompt order (the readers check that names are unique and the
+    /// same at every keyframe).
+    pub fn new(views: Vec<NamedView>) -> KeyframeViews {
+        KeyframeViews { views }
     }
 
-    /// Builds the views from a function of the camera.
-    pub fn from_fn<E>(mut f: impl FnMut(CameraName) -> Result<CameraImages, E>) -> Result<KeyframeViews, E> {
-        Ok(KeyframeViews {
-            top: f(CameraName::Top)?,
-            front: f(CameraName::Front)?,
-            back: f(CameraName::Back)?,
-        })
+    /// The images of the view named `name`.
+    pub fn get(&self, name: &str) -> Option<&CameraImages> {
+        self.views.iter().find(|v| v.name == name).map(|v| &v.images)
     }
+
+    /// The images of the view named `name`, to change them.
+    pub fn get_mut(&mut self, name: &str) -> Option<&mut CameraImages> {
+        self.views
+            .iter_mut()
+            .find(|v| v.name == name)
+            .map(|v| &mut v.images)
+    }
+
+    /// The views, in prompt order.
+    pub fn iter(&self) -> std::slice::Iter<'_, NamedView> {
+        self.views.iter()
+    }
+
+    /// The view names, in prompt order.
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.views.iter().map(|v| v.name.as_str())
+    }
+
+    /// How many views there are.
+    pub fn len(&self) -> usize {
+        self.views.len()
+    }
+
+    /// True when there is no view.
+    pub fn is_empty(&self) -> bool {
+        self.views.is_empty()
+    }
+
+    /// The simulator's three views, built from a function of the camera.
+    pub fn from_fn<E>(mut f: impl FnMut(CameraName) -> Result<CameraImages, E>) -> Result<KeyframeViews, E> {
+        let mut views = Vec::with_capacity(CameraName::ALL.len());
+        for camera in CameraName::ALL {
+            views.push(NamedView {
+                name: camera.as_str().to_owned(),
+                images: f(camera)?,
+            });
+        }
+        Ok(KeyframeViews { views })
+    }
+}
+
+/// Who gave the demonstration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Demonstrator {
+    /// A robot (the simulator's scripted expert, or a teleoperated arm).
+    Robot,
+    /// A person. Their hand is read as a finger gripper: what the hand grasps, the states
+    /// say the gripper holds, so the target robot's procedure follows the same steps.
+    Human,
 }
 
 /// One keyframe of a demo.
@@ -122,7 +176,7 @@ pub struct Keyframe {
     /// Simulated time in seconds when the keyframe was taken (for real-world demos: as
     /// given in the manifest, else the index).
     pub time: f64,
-    /// The camera views.
+    /// The camera views (at least one).
     pub views: KeyframeViews,
     /// The ground-truth symbolic state, when known (always for simulated demos).
     pub state: Option<State>,
@@ -138,8 +192,14 @@ pub struct DemoMetadata {
     pub instruction: String,
     /// The scene's object names, in scene order (as `get_obj_names` lists them).
     pub objects: Vec<String>,
-    /// The demonstrating robot's end effector.
+    /// The end effector the demonstration's states describe: the demonstrating robot's, or
+    /// `finger` for a person's hand.
     pub embodiment: Embodiment,
+    /// A robot or a person.
+    pub demonstrator: Demonstrator,
+    /// Where the demo was imported from, when `nesy demo import` wrote it (free-form JSON:
+    /// the source's kind, path and the keyframe choice).
+    pub imported_from: Option<serde_json::Value>,
     /// The benchmark scenario the demo was recorded from (e.g. `obst_low_03_s0`).
     pub scenario_id: Option<String>,
     /// Which side of the scenario the demo shows (`source` or `target`).
@@ -287,22 +347,145 @@ impl DemoError {
     }
 }
 
-/// Checks that `bytes` are a PNG image.
-pub(crate) fn check_png(path: &Path, location: &str, bytes: &[u8]) -> Result<(), DemoError> {
-    if bytes.starts_with(&PNG_SIGNATURE) {
-        Ok(())
-    } else {
+/// The eight bytes every PNG file starts with are [`PNG_SIGNATURE`]; a JPEG file starts
+/// with these three.
+pub const JPEG_SIGNATURE: [u8; 3] = [0xFF, 0xD8, 0xFF];
+
+/// The encoding of a demo image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// PNG.
+    Png,
+    /// JPEG.
+    Jpeg,
+}
+
+impl ImageFormat {
+    /// The format of `bytes`, from their signature.
+    pub fn of(bytes: &[u8]) -> Option<ImageFormat> {
+        if bytes.starts_with(&PNG_SIGNATURE) {
+            Some(ImageFormat::Png)
+        } else if bytes.starts_with(&JPEG_SIGNATURE) {
+            Some(ImageFormat::Jpeg)
+        } else {
+            None
+        }
+    }
+
+    /// The file extension the folder layout writes: `png` or `jpg`.
+    pub fn extension(self) -> &'static str {
+        match self {
+            ImageFormat::Png => "png",
+            ImageFormat::Jpeg => "jpg",
+        }
+    }
+}
+
+/// Width and height of a PNG (from its header) or a JPEG (from its frame header), without
+/// decoding the pixels; `None` when the header is missing or damaged.
+///
+/// ```
+/// use nesy_sim::demo::image_size;
+///
+/// let image = nesy_sim::perception::render::Image { width: 5, height: 3, rgb: vec![0; 45] };
+/// let png = image.to_png();
+/// assert_eq!(image_size(&png), Some((5, 3)));
+/// assert_eq!(image_size(b"not an image"), None);
+/// ```
+pub fn image_size(bytes: &[u8]) -> Option<(u32, u32)> {
+    match ImageFormat::of(bytes)? {
+        ImageFormat::Png => {
+            // The IHDR chunk comes first: length, "IHDR", width, height (big-endian).
+            let header = bytes.get(12..24)?;
+            if &header[..4] != b"IHDR" {
+                return None;
+            }
+            let width = u32::from_be_bytes(header[4..8].try_into().ok()?);
+            let height = u32::from_be_bytes(header[8..12].try_into().ok()?);
+            (width > 0 && height > 0).then_some((width, height))
+        }
+        ImageFormat::Jpeg => {
+            // Walk the marker segments to the first start-of-frame (SOF0..SOF15 except the
+            // DHT, JPG and DAC markers), whose payload gives precision, height and width.
+            let mut at = 2;
+            loop {
+                while bytes.get(at) == Some(&0xFF) && bytes.get(at + 1) == Some(&0xFF) {
+                    at += 1;
+                }
+                if bytes.get(at) != Some(&0xFF) {
+                    return None;
+                }
+                let marker = *bytes.get(at + 1)?;
+                let length = u16::from_be_bytes([*bytes.get(at + 2)?, *bytes.get(at + 3)?]) as usize;
+                let is_frame = (0xC0..=0xCF).contains(&marker) && !matches!(marker, 0xC4 | 0xC8 | 0xCC);
+                if is_frame {
+                    let height = u16::from_be_bytes([*bytes.get(at + 5)?, *bytes.get(at + 6)?]) as u32;
+                    let width = u16::from_be_bytes([*bytes.get(at + 7)?, *bytes.get(at + 8)?]) as u32;
+                    return (width > 0 && height > 0).then_some((width, height));
+                }
+                if marker == 0xD9 || marker == 0xDA || length < 2 {
+                    return None;
+                }
+                at += 2 + length;
+            }
+        }
+    }
+}
+
+/// Checks that `bytes` are a PNG or JPEG image with a readable size, and returns its format
+/// and size.
+pub(crate) fn check_image(
+    path: &Path,
+    location: &str,
+    bytes: &[u8],
+) -> Result<(ImageFormat, (u32, u32)), DemoError> {
+    let head = || {
         let head: Vec<String> = bytes.iter().take(8).map(|b| format!("{b:02x}")).collect();
-        Err(DemoError::invalid(
+        if head.is_empty() {
+            "no data".to_owned()
+        } else {
+            format!("bytes {}", head.join(" "))
+        }
+    };
+    let Some(format) = ImageFormat::of(bytes) else {
+        return Err(DemoError::invalid(
             path,
             location,
-            "PNG data (starting 89 50 4e 47 0d 0a 1a 0a)",
-            if head.is_empty() {
-                "no data".to_owned()
-            } else {
-                format!("bytes {}", head.join(" "))
-            },
-        ))
+            "PNG data (starting 89 50 4e 47 0d 0a 1a 0a) or JPEG data (starting ff d8 ff)",
+            head(),
+        ));
+    };
+    let size = image_size(bytes).ok_or_else(|| {
+        DemoError::invalid(
+            path,
+            location,
+            format!(
+                "a {} image with a readable header",
+                format.extension().to_uppercase()
+            ),
+            "a truncated or damaged header",
+        )
+    })?;
+    Ok((format, size))
+}
+
+/// Checks that `bytes` are a PNG image (the MCAP layout stores PNG only).
+pub(crate) fn check_png(path: &Path, location: &str, bytes: &[u8]) -> Result<(), DemoError> {
+    match ImageFormat::of(bytes) {
+        Some(ImageFormat::Png) => Ok(()),
+        _ => {
+            let head: Vec<String> = bytes.iter().take(8).map(|b| format!("{b:02x}")).collect();
+            Err(DemoError::invalid(
+                path,
+                location,
+                "PNG data (starting 89 50 4e 47 0d 0a 1a 0a)",
+                if head.is_empty() {
+                    "no data".to_owned()
+                } else {
+                    format!("bytes {}", head.join(" "))
+                },
+            ))
+        }
     }
 }
 

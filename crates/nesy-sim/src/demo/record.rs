@@ -5,7 +5,9 @@
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use super::{CameraImages, CameraName, Demo, DemoMetadata, Keyframe, KeyframeViews, NESY_VERSION};
+use super::{
+    CameraImages, CameraName, Demo, DemoMetadata, Demonstrator, Keyframe, KeyframeViews, NESY_VERSION,
+};
 use crate::api::{RobotApi, TraceEntry};
 use crate::perception::render::{View, render_views};
 use crate::scene::{SceneError, SceneSpec};
@@ -134,17 +136,7 @@ fn encode_views(views: &[View]) -> KeyframeViews {
             .ok_or(())
     };
     // The renderer always produces the three benchmark cameras.
-    KeyframeViews::from_fn(images).unwrap_or_else(|()| {
-        let empty = || CameraImages {
-            raw: Vec::new(),
-            marked: None,
-        };
-        KeyframeViews {
-            top: empty(),
-            front: empty(),
-            back: empty(),
-        }
-    })
+    KeyframeViews::from_fn(images).unwrap_or_default()
 }
 
 /// Builds `scene`, runs the scripted expert on its goals while recording keyframes, and
@@ -176,6 +168,8 @@ pub fn record_scene(scene: &SceneSpec, options: &RecordOptions) -> Result<Record
             instruction: scene.instruction.clone(),
             objects,
             embodiment: scene.embodiment,
+            demonstrator: Demonstrator::Robot,
+            imported_from: None,
             scenario_id: options.scenario_id.clone(),
             side: options.side.clone(),
             nesy_version: Some(NESY_VERSION.to_owned()),

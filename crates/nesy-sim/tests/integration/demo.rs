@@ -10,7 +10,8 @@ use nesy_core::State;
 use nesy_sim::api::{ApiCall, ApiValue, Direction, TraceEntry};
 use nesy_sim::demo::mcap_format::{self, ACTION_TOPIC, STATE_TOPIC, image_topic, topics};
 use nesy_sim::demo::{
-    CameraImages, CameraName, Demo, DemoError, DemoMetadata, Keyframe, KeyframeViews, RecordOptions,
+    CameraImages, CameraName, Demo, DemoError, DemoMetadata, Demonstrator, ImageFormat, Keyframe,
+    KeyframeViews, RecordOptions,
 };
 use nesy_sim::perception::render::Image;
 use nesy_sim::scene::SubtaskKind;
@@ -24,6 +25,115 @@ fn png(seed: u8) -> Vec<u8> {
         rgb: (0..36).map(|i| seed.wrapping_mul(31).wrapping_add(i)).collect(),
     }
     .to_png()
+}
+
+fn jpeg(width: u16, height: u16, seed: u8) -> Vec<u8> {
+    let rgb: Vec<u8> = (0..usize::from(width) * usize::from(height) * 3)
+        .map(|i| seed.wrapping_mul(17).wrapping_add(i as u8))
+        .collect();
+    let mut out = Vec::new();
+    jpeg_encoder::Encoder::new(&mut out, 85)
+        .encode(&rgb, width, height, jpeg_encoder::ColorType::Rgb)
+        .unwrap();
+    out
+}
+
+/// A folder demo with `views` (name, width, height) at `keyframes` keyframes, as JPEG.
+fn jpeg_folder(manifest: &str, views: &[(&str, u16, u16)], keyframes: usize) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("frames")).unwrap();
+    std::fs::write(dir.path().join("manifest.json"), manifest).unwrap();
+    for k in 0..keyframes {
+        for &(view, width, height) in views {
+            let name = nesy_sim::demo::frame_file_name(k, view, false, ImageFormat::Jpeg);
+            std::fs::write(dir.path().join("frames").join(name), jpeg(width, height, k as u8)).unwrap();
+        }
+    }
+    dir
+}
+
+const HUMAN: &str = r#"{"format_version": 1, "instruction": "Gather the screws on the tray.",
+    "objects": ["black_screws", "tray"], "embodiment": "human"}"#;
+
+#[test]
+fn a_one_view_jpeg_folder_of_a_human_demonstration_reads() {
+    let dir = jpeg_folder(HUMAN, &[("realsense", 64, 48)], 3);
+    let demo = nesy_sim::demo::read(dir.path()).unwrap();
+    assert_eq!(demo.keyframes.len(), 3);
+    assert_eq!(demo.metadata.demonstrator, Demonstrator::Human);
+    assert_eq!(
+        demo.metadata.embodiment,
+        Embodiment::Finger,
+        "a hand reads as a finger gripper"
+    );
+    let views = &demo.keyframes[2].views;
+    assert_eq!(views.names().collect::<Vec<_>>(), ["realsense"]);
+    assert_eq!(
+        nesy_sim::demo::image_size(&views.get("realsense").unwrap().raw),
+        Some((64, 48))
+    );
+
+    // Written back, it reads the same (JPEG stays JPEG, `human` stays human).
+    let copy = tempfile::tempdir().unwrap();
+    nesy_sim::demo::write_folder(&demo, copy.path()).unwrap();
+    assert!(copy.path().join("frames/0002_realsense.jpg").is_file());
+    assert_eq!(nesy_sim::demo::read(copy.path()).unwrap(), demo);
+}
+
+#[test]
+fn views_keep_the_manifest_order_and_bad_folders_name_the_file() {
+    let ordered = HUMAN.replace("\"human\"", "\"human\", \"views\": [\"wrist\", \"overhead\"]");
+    let dir = jpeg_folder(&ordered, &[("overhead", 32, 24), ("wrist", 16, 16)], 2);
+    let demo = nesy_sim::demo::read(dir.path()).unwrap();
+    assert_eq!(
+        demo.keyframes[0].views.names().collect::<Vec<_>>(),
+        ["wrist", "overhead"]
+    );
+
+    // One frame of another resolution.
+    std::fs::write(dir.path().join("frames/0001_wrist.jpg"), jpeg(20, 16, 1)).unwrap();
+    let err = nesy_sim::demo::read(dir.path()).unwrap_err().to_string();
+    assert!(
+        err.contains("0001_wrist.jpg") && err.contains("16x16") && err.contains("20x16"),
+        "{err}"
+    );
+    std::fs::write(dir.path().join("frames/0001_wrist.jpg"), jpeg(16, 16, 1)).unwrap();
+
+    // A view the manifest does not list.
+    std::fs::write(dir.path().join("frames/0001_side.jpg"), jpeg(16, 16, 1)).unwrap();
+    let err = nesy_sim::demo::read(dir.path()).unwrap_err().to_string();
+    assert!(
+        err.contains("0001_side.jpg") && err.contains("view `side`"),
+        "{err}"
+    );
+    std::fs::remove_file(dir.path().join("frames/0001_side.jpg")).unwrap();
+
+    // The same frame twice, as PNG and JPEG.
+    std::fs::write(dir.path().join("frames/0001_wrist.png"), png(1)).unwrap();
+    let err = nesy_sim::demo::read(dir.path()).unwrap_err().to_string();
+    assert!(err.contains("one file per keyframe and view"), "{err}");
+    std::fs::remove_file(dir.path().join("frames/0001_wrist.png")).unwrap();
+
+    // A truncated JPEG and a file that is no image.
+    let whole = jpeg(16, 16, 1);
+    std::fs::write(dir.path().join("frames/0001_wrist.jpg"), &whole[..8]).unwrap();
+    let err = nesy_sim::demo::read(dir.path()).unwrap_err().to_string();
+    assert!(
+        err.contains("0001_wrist.jpg") && err.contains("truncated or damaged"),
+        "{err}"
+    );
+    std::fs::write(dir.path().join("frames/0001_wrist.jpg"), b"GIF89a").unwrap();
+    let err = nesy_sim::demo::read(dir.path()).unwrap_err().to_string();
+    assert!(
+        err.contains("0001_wrist.jpg") && err.contains("JPEG data"),
+        "{err}"
+    );
+
+    // A person is the only new demonstrator.
+    let robot = HUMAN.replace("\"human\"", "\"octopus\"");
+    let dir = jpeg_folder(&robot, &[("top", 8, 8)], 2);
+    let err = nesy_sim::demo::read(dir.path()).unwrap_err().to_string();
+    assert!(err.contains("embodiment") && err.contains("human"), "{err}");
 }
 
 /// A small hand-made demo: three keyframes, marked views missing on the last one.
@@ -71,6 +181,8 @@ fn synthetic_demo() -> Demo {
                 "gripper".into(),
             ],
             embodiment: Embodiment::Finger,
+            demonstrator: Demonstrator::Robot,
+            imported_from: None,
             scenario_id: Some("obst_low_00_s0".into()),
             side: Some("source".into()),
             nesy_version: Some(nesy_sim::demo::NESY_VERSION.into()),
@@ -140,15 +252,20 @@ fn minimal_real_world_folder_reads_without_ground_truth() {
     .unwrap();
     for k in 0..2 {
         for camera in CameraName::ALL {
-            let name = nesy_sim::demo::frame_file_name(k, camera, false);
+            let name = nesy_sim::demo::frame_file_name(k, camera.as_str(), false, ImageFormat::Png);
             std::fs::write(dir.path().join("frames").join(name), png(k as u8)).unwrap();
         }
     }
     let demo = nesy_sim::demo::read(dir.path()).unwrap();
     assert_eq!(demo.keyframes.len(), 2);
     assert_eq!(demo.metadata.embodiment, Embodiment::Vacuum);
-    assert!(demo.states().is_none() && demo.keyframes[1].views.back.marked.is_none());
-    assert_eq!(demo.keyframes[1].views.back.marked_or_raw(), &png(1)[..]);
+    let back = demo.keyframes[1].views.get("back").unwrap();
+    assert!(demo.states().is_none() && back.marked.is_none());
+    assert_eq!(back.marked_or_raw(), &png(1)[..]);
+    assert_eq!(
+        demo.keyframes[1].views.names().collect::<Vec<_>>(),
+        ["top", "front", "back"]
+    );
 
     // A missing view names the file.
     std::fs::remove_file(dir.path().join("frames/0001_front.png")).unwrap();
@@ -279,7 +396,7 @@ fn missing_topics_and_metadata_are_named() {
 #[test]
 fn bad_message_payloads_name_topic_keyframe_and_field() {
     let mut demo = synthetic_demo();
-    demo.keyframes[1].views.front.raw = b"not a png".to_vec();
+    demo.keyframes[1].views.get_mut("front").unwrap().raw = b"not a png".to_vec();
     let err = read_bytes(&to_bytes(&demo)).unwrap_err().to_string();
     assert!(
         err.contains("/camera/front keyframe 1") && err.contains("field data") && err.contains("PNG"),

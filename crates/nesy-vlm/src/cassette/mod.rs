@@ -450,6 +450,13 @@ impl CassetteTransport {
             },
             response: StoredResponse::from_wire(response),
         };
+        self.write_with(Some(interaction))
+    }
+
+    /// Loads (or starts) the cassette file, brings its metadata up to date (recorder, model,
+    /// backend, what the server announced, the constraint setting), appends `interaction` if
+    /// there is one, and writes the file atomically under its lock.
+    fn write_with(&self, interaction: Option<Interaction>) -> Result<(), CassetteError> {
         let mut cleared = self
             .writer
             .lock()
@@ -461,9 +468,8 @@ impl CassetteTransport {
             .clone()
             .or_else(|| self.inner.as_ref().map(|inner| inner.label()));
         let model = interaction
-            .request
-            .body
-            .get("model")
+            .as_ref()
+            .and_then(|i| i.request.body.get("model"))
             .and_then(|m| m.as_str())
             .map(str::to_string);
         let mut file = if (*cleared || self.mode != CassetteMode::All) && self.path.exists() {
@@ -473,7 +479,9 @@ impl CassetteTransport {
         };
         *cleared = true;
         file.meta.recorder = format::recorder();
-        file.meta.updated_at = interaction.recorded_at.clone();
+        file.meta.updated_at = interaction
+            .as_ref()
+            .map_or_else(crate::timefmt::now_rfc3339, |i| i.recorded_at.clone());
         file.meta.model = model.or_else(|| self.options.model.clone()).or(file.meta.model);
         file.meta.backend = backend.or(file.meta.backend);
         let probed = self
@@ -484,8 +492,28 @@ impl CassetteTransport {
             .clone();
         file.meta.server = probed.or(file.meta.server);
         file.meta.constrain = self.options.constrain;
-        file.interactions.push(interaction);
+        file.interactions.extend(interaction);
         write_atomically(&self.path, file.to_pretty_json(&self.options.redact).as_bytes())
+    }
+
+    /// A recording that sent no request still keeps what the server announced: a run
+    /// refused before its first call (a prompt larger than the context window, pictures for
+    /// a text-only server) then replays to the same refusal.
+    fn keep_announcement(&self) -> Result<(), CassetteError> {
+        let announced = self
+            .announced
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+            .probed
+            .is_some();
+        let written = *self
+            .writer
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        if self.records && announced && !written && !self.path.exists() {
+            self.write_with(None)?;
+        }
+        Ok(())
     }
 
     fn write_usage_report(&self, path: &Path) -> Result<(), CassetteError> {
@@ -559,6 +587,7 @@ impl Transport for CassetteTransport {
     }
 
     fn finish(&self) -> Result<(), VlmError> {
+        self.keep_announcement()?;
         if let Some(report) = &self.options.usage_report {
             self.write_usage_report(report)?;
         }

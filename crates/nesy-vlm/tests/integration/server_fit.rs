@@ -275,6 +275,47 @@ async fn a_cassette_keeps_what_the_server_announced_for_its_replay() {
     );
 }
 
+/// A run refused before its first call (its prompt outgrows the window) still leaves a
+/// cassette with the announcement, and its replay is refused the same way instead of
+/// missing a recording.
+#[tokio::test]
+async fn a_refusal_before_any_call_replays_as_the_same_refusal() {
+    let server = props_server(json!({"default_generation_settings": {"n_ctx": 256}})).await;
+    let dir = tempfile::tempdir().unwrap();
+    let cassette = dir.path().join("c.json");
+    let mut cfg = config(BackendKind::LlamaCpp, "m", &format!("{}/v1", server.uri()));
+    cfg.cassette = Some(CassetteSettings {
+        path: cassette.clone(),
+        mode: CassetteMode::NewEpisodes,
+        strict: false,
+        usage_report: None,
+    });
+    let long = || {
+        ChatRequest::new()
+            .message(Message::user_text("the scene holds a red cube. ".repeat(400)))
+            .purpose("translate")
+    };
+    let client = VlmClient::from_config(&cfg).unwrap();
+    let live = client.chat(long()).await.unwrap_err().to_string();
+    assert!(live.contains("context window holds 256"), "{live}");
+    client.finish().unwrap();
+    assert!(posted_bodies(&server).await.is_empty(), "nothing was sent");
+    let recorded = nesy_vlm::CassetteFile::load(&cassette).unwrap();
+    assert!(recorded.interactions.is_empty());
+    assert_eq!(recorded.meta.server.unwrap().context_tokens, Some(256));
+
+    drop(server);
+    cfg.base_url = "http://127.0.0.1:9/v1".into();
+    cfg.cassette.as_mut().unwrap().mode = CassetteMode::None;
+    let replayed = VlmClient::from_config(&cfg)
+        .unwrap()
+        .chat(long())
+        .await
+        .unwrap_err()
+        .to_string();
+    assert_eq!(replayed, live);
+}
+
 #[tokio::test]
 async fn a_cassette_recorded_without_constraints_says_so() {
     let server = props_server(json!({"default_generation_settings": {"n_ctx": 4096}})).await;

@@ -34,6 +34,17 @@ pub(crate) fn nesy(args: &[String]) -> Output {
     nesy_with_env(args, &[])
 }
 
+/// Runs the `nesy` binary with `args`: its exit code, stdout and stderr.
+pub(crate) fn run(args: &[&str]) -> (Option<i32>, String, String) {
+    let args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
+    let output = nesy(&args);
+    (
+        output.status.code(),
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
+
 /// Runs the `nesy` binary with `args` and only the VLM settings of `env` (`(name, value)`).
 pub(crate) fn nesy_with_env(args: &[String], env: &[(&str, &str)]) -> Output {
     let mut command = Command::new(env!("CARGO_BIN_EXE_nesy"));

@@ -1,0 +1,125 @@
+//! `nesy demo`: bring a real-world demonstration into nesy.
+//!
+//! - `import SOURCE --out DIR` writes the demo folder `nesy adapt --demo` reads, from a
+//!   folder of frames (one view, or one subfolder per view) or the authors' demo format
+//!   (`data.json` and `frames/<view>/frame_<i>.jpg`), choosing keyframes and writing a
+//!   contact sheet of the choice.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use nesy_import::{DEFAULT_VIEW, ImportOptions, KeyframeMode};
+use nesy_sim::demo::DemoEmbodiment;
+
+/// Arguments of `nesy demo`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct DemoArgs {
+    /// What to do.
+    #[command(subcommand)]
+    pub action: DemoAction,
+}
+
+/// Who demonstrated, as the command line writes it.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub(crate) enum DemonstratorArg {
+    /// A person (the hand is read as a finger gripper).
+    Human,
+    /// A robot with a two-finger gripper.
+    Finger,
+    /// A robot with a vacuum suction tool.
+    Vacuum,
+}
+
+/// The `nesy demo` actions.
+#[derive(Debug, clap::Subcommand)]
+pub(crate) enum DemoAction {
+    /// Write a demo folder from a frames folder or the authors' demo format.
+    Import {
+        /// A folder of frames (`*.jpg`/`*.png`, or one subfolder per view), or a folder with
+        /// the authors' `data.json` and `frames/`.
+        source: PathBuf,
+        /// The demo folder to write (new, or empty).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Keyframes: `auto` (where the scene, having changed, comes to rest), `every:SECONDS`,
+        /// `at:T1,T2,...` (seconds), or `all` (every frame; the default, and the only choice
+        /// for the authors' format).
+        #[arg(long, value_name = "MODE", default_value = "all", value_parser = parse_mode)]
+        keyframes: KeyframeMode,
+        /// Frames per second of a frames folder (needed by auto, every: and at:).
+        #[arg(long, value_name = "FPS")]
+        fps: Option<f64>,
+        /// The view name of a folder holding its frames directly.
+        #[arg(long, value_name = "NAME", default_value = DEFAULT_VIEW)]
+        view: String,
+        /// The task's instruction (required for a frames folder).
+        #[arg(long, value_name = "TEXT")]
+        instruction: Option<String>,
+        /// The objects in the scene, comma-separated (required for a frames folder).
+        #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
+        objects: Option<Vec<String>>,
+        /// Who demonstrated (default: human for frames, finger for the authors' format).
+        #[arg(long, value_enum)]
+        demonstrator: Option<DemonstratorArg>,
+        /// Print the import report as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn parse_mode(text: &str) -> Result<KeyframeMode, String> {
+    text.parse()
+}
+
+/// Runs `nesy demo`.
+pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
+    let DemoAction::Import {
+        source,
+        out,
+        keyframes,
+        fps,
+        view,
+        instruction,
+        objects,
+        demonstrator,
+        json,
+    } = args.action;
+    let options = ImportOptions {
+        keyframes,
+        fps,
+        view,
+        instruction,
+        objects: objects.map(|list| {
+            list.into_iter()
+                .map(|o| o.trim().to_owned())
+                .filter(|o| !o.is_empty())
+                .collect()
+        }),
+        embodiment: demonstrator.map(|d| match d {
+            DemonstratorArg::Human => DemoEmbodiment::Human,
+            DemonstratorArg::Finger => DemoEmbodiment::Finger,
+            DemonstratorArg::Vacuum => DemoEmbodiment::Vacuum,
+        }),
+    };
+    let report = nesy_import::import(&source, &out, &options)?;
+    if json {
+        outln!("{}", serde_json::to_string_pretty(&report)?)?;
+        return Ok(ExitCode::SUCCESS);
+    }
+    let times: Vec<String> = report
+        .keyframes
+        .iter()
+        .map(|k| format!("{:.2}", k.time))
+        .collect();
+    outln!(
+        "imported {} keyframe(s) of {} frame(s), views {}: {}\n  times (s)      {}\n  contact sheet  {}\n  adapt it with  nesy adapt --demo {} ...",
+        report.keyframes.len(),
+        report.frames,
+        report.views.join(", "),
+        report.out.display(),
+        times.join(" "),
+        report.contact_sheet.display(),
+        report.out.display()
+    )?;
+    Ok(ExitCode::SUCCESS)
+}

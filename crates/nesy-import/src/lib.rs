@@ -1,0 +1,433 @@
+//! # nesy-import
+//!
+//! Real-world demonstrations into nesy's demo folder layout (`nesy_sim::demo`), which
+//! `nesy adapt --demo` reads:
+//!
+//! - a **frames folder**: one view (`DIR/*.jpg`) or several (`DIR/<view>/*.png`, with
+//!   `<view>_marked/` for labelled frames), in time order;
+//! - the **authors' demo format**: `data.json` (instruction, objects and each keyframe's
+//!   symbolic state) and `frames/<view>/frame_<i>.jpg`.
+//!
+//! Keyframes are chosen by [`KeyframeMode`]: `auto` finds the frames at which the scene,
+//! having changed, has come to rest; `every:SECONDS` and `at:T1,T2,...` are the manual
+//! modes; `all` keeps every frame. Each import writes `contact_sheet.png` (the keyframes
+//! with their numbers and times) beside the demo's `manifest.json`, and records in the
+//! manifest what it read (`imported_from`).
+//!
+//! ```no_run
+//! use nesy_import::{ImportOptions, KeyframeMode, import};
+//!
+//! let options = ImportOptions {
+//!     keyframes: KeyframeMode::Auto,
+//!     fps: Some(30.0),
+//!     instruction: Some("Gather the screws on the tray.".into()),
+//!     objects: Some(vec!["black_screws".into(), "tray".into()]),
+//!     ..ImportOptions::default()
+//! };
+//! let report = import("frames/".as_ref(), "demos/screws".as_ref(), &options).unwrap();
+//! println!("{} keyframes", report.keyframes.len());
+//! ```
+
+mod authors;
+mod decode;
+mod error;
+mod frames;
+mod keyframes;
+mod sheet;
+
+use std::path::{Path, PathBuf};
+
+use nesy_sim::demo::{
+    CameraImages, Demo, DemoEmbodiment, DemoMetadata, Keyframe, KeyframeViews, NESY_VERSION, NamedView,
+    image_size,
+};
+use nesy_sim::perception::render::Image;
+use serde::Serialize;
+
+pub use authors::{AuthorsDemo, DATA_FILE, ViewFrames, read_authors_demo};
+pub use decode::{BLOCK, THUMBNAIL_WIDTH, Thumbnail, decode};
+pub use error::ImportError;
+pub use frames::{FrameFolder, ViewFiles, read_frame_folder};
+pub use keyframes::{KeyframeMode, MIN_MOTION, MIN_REST_S, MotionTrace, detect, select};
+pub use sheet::{CELL_WIDTH, COLUMNS, contact_sheet};
+
+/// The contact sheet's file name in the demo folder.
+pub const CONTACT_SHEET_FILE: &str = "contact_sheet.png";
+
+/// The view name of a frames folder that holds its frames directly.
+pub const DEFAULT_VIEW: &str = "camera";
+
+/// What an import is told besides its source.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImportOptions {
+    /// How keyframes are chosen (the authors' format holds keyframes only: `all`).
+    pub keyframes: KeyframeMode,
+    /// Frames per second of a frames folder (times are frame numbers without it, and only
+    /// `all` can be used).
+    pub fps: Option<f64>,
+    /// The view name of a folder that holds its frames directly.
+    pub view: String,
+    /// The instruction (required for a frames folder; replaces the authors' one).
+    pub instruction: Option<String>,
+    /// The object names (required for a frames folder; replace the authors' list).
+    pub objects: Option<Vec<String>>,
+    /// Who demonstrated (default: `human` for a frames folder, `finger` for the authors'
+    /// robot demos).
+    pub embodiment: Option<DemoEmbodiment>,
+}
+
+impl Default for ImportOptions {
+    fn default() -> Self {
+        ImportOptions {
+            keyframes: KeyframeMode::All,
+            fps: None,
+            view: DEFAULT_VIEW.into(),
+            instruction: None,
+            objects: None,
+            embodiment: None,
+        }
+    }
+}
+
+/// What an import read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SourceKind {
+    /// A folder of frames.
+    Frames,
+    /// The authors' demo format.
+    Authors,
+}
+
+/// One chosen keyframe: its frame in the source and its time.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ChosenKeyframe {
+    /// The frame's position in the source sequence, from 0.
+    pub frame: usize,
+    /// Its time in seconds (the frame number when the source has no frame rate).
+    pub time: f64,
+}
+
+/// What an import did.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ImportReport {
+    /// The source's kind.
+    pub kind: SourceKind,
+    /// The demo folder written.
+    pub out: PathBuf,
+    /// The view names, in prompt order.
+    pub views: Vec<String>,
+    /// Frames in the source.
+    pub frames: usize,
+    /// The keyframes, in order.
+    pub keyframes: Vec<ChosenKeyframe>,
+    /// The contact sheet written.
+    pub contact_sheet: PathBuf,
+    /// What `auto` measured, when it ran.
+    #[serde(skip)]
+    pub motion: Option<MotionTrace>,
+}
+
+/// One frame's files: per view, the plain frame and its labelled version.
+type FrameFiles = Vec<(PathBuf, Option<PathBuf>)>;
+
+/// Imports `source` (a frames folder, or a folder with the authors' `data.json`) into a new
+/// demo folder `out`, which must not exist or be empty.
+pub fn import(source: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, ImportError> {
+    if !source.is_dir() {
+        return Err(ImportError::invalid(
+            source,
+            "expected a folder of frames (one view, or one subfolder per view) or an authors' demo folder (data.json and frames/)",
+        ));
+    }
+    if std::fs::read_dir(out).is_ok_and(|mut entries| entries.next().is_some()) {
+        return Err(ImportError::invalid(
+            out,
+            "the output folder exists and is not empty; choose a new one",
+        ));
+    }
+    if source.join(DATA_FILE).is_file() {
+        import_authors(source, out, options)
+    } else {
+        import_frames(source, out, options)
+    }
+}
+
+fn import_frames(source: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, ImportError> {
+    let folder = read_frame_folder(source, &options.view)?;
+    let instruction = options.instruction.clone().ok_or_else(|| {
+        ImportError::invalid(
+            source,
+            "a frames folder says nothing of the task: give its instruction (--instruction)",
+        )
+    })?;
+    let objects = options.objects.clone().ok_or_else(|| {
+        ImportError::invalid(
+            source,
+            "a frames folder says nothing of the task: give its objects (--objects)",
+        )
+    })?;
+    let times: Vec<f64> = match options.fps {
+        Some(fps) if fps.is_finite() && fps > 0.0 => (0..folder.len()).map(|i| i as f64 / fps).collect(),
+        Some(fps) => {
+            return Err(ImportError::invalid(
+                source,
+                format!("--fps must be a positive number, got {fps}"),
+            ));
+        }
+        None if options.keyframes == KeyframeMode::All => (0..folder.len()).map(|i| i as f64).collect(),
+        None => {
+            return Err(ImportError::Keyframes {
+                path: source.to_owned(),
+                message: format!(
+                    "`{}` needs the frame rate (--fps); without it every frame is a keyframe (--keyframes all)",
+                    options.keyframes.label()
+                ),
+            });
+        }
+    };
+    let files: Vec<FrameFiles> = (0..folder.len())
+        .map(|i| {
+            folder
+                .views
+                .iter()
+                .map(|v| (v.frames[i].clone(), v.marked.as_ref().map(|m| m[i].clone())))
+                .collect()
+        })
+        .collect();
+    let mut pictures: Vec<Option<Vec<Image>>> = vec![None; files.len()];
+    let mut thumbnails = Vec::new();
+    if options.keyframes == KeyframeMode::Auto {
+        for (i, frame) in files.iter().enumerate() {
+            let decoded = decode_frame(frame)?;
+            thumbnails.push(decoded.iter().map(Thumbnail::of).collect());
+            pictures[i] = Some(decoded);
+        }
+    }
+    let (chosen, motion) = match &options.keyframes {
+        KeyframeMode::Auto => {
+            let (chosen, trace) = detect(&times, &thumbnails).map_err(|message| ImportError::Keyframes {
+                path: source.to_owned(),
+                message,
+            })?;
+            (chosen, Some(trace))
+        }
+        mode => (
+            select(mode, &times, &[]).map_err(|message| ImportError::Keyframes {
+                path: source.to_owned(),
+                message,
+            })?,
+            None,
+        ),
+    };
+    let views: Vec<String> = folder.views.iter().map(|v| v.name.clone()).collect();
+    let plan = Plan {
+        kind: SourceKind::Frames,
+        source,
+        out,
+        options,
+        instruction,
+        objects,
+        embodiment: options.embodiment.unwrap_or(DemoEmbodiment::Human),
+        views,
+        times: &times,
+        chosen: &chosen,
+        files: &files,
+        states: None,
+        context: None,
+    };
+    plan.write(&mut pictures, motion)
+}
+
+fn import_authors(source: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, ImportError> {
+    if options.keyframes != KeyframeMode::All {
+        return Err(ImportError::Keyframes {
+            path: source.to_owned(),
+            message: format!(
+                "the authors' format holds keyframes only, so every frame is one (--keyframes all), not `{}`",
+                options.keyframes.label()
+            ),
+        });
+    }
+    let demo = read_authors_demo(source)?;
+    let count = demo.states.len();
+    let times: Vec<f64> = (0..count).map(|i| i as f64).collect();
+    let chosen: Vec<usize> = (0..count).collect();
+    let files: Vec<FrameFiles> = (0..count)
+        .map(|i| demo.views.iter().map(|(_, frames)| frames[i].clone()).collect())
+        .collect();
+    let plan = Plan {
+        kind: SourceKind::Authors,
+        source,
+        out,
+        options,
+        instruction: options.instruction.clone().unwrap_or(demo.instruction),
+        objects: options.objects.clone().unwrap_or(demo.objects),
+        embodiment: options.embodiment.unwrap_or(DemoEmbodiment::Finger),
+        views: demo.views.iter().map(|(n, _)| n.clone()).collect(),
+        times: &times,
+        chosen: &chosen,
+        files: &files,
+        states: Some(demo.states),
+        context: demo.context,
+    };
+    plan.write(&mut vec![None; count], None)
+}
+
+/// Everything needed to write the demo folder.
+struct Plan<'a> {
+    kind: SourceKind,
+    source: &'a Path,
+    out: &'a Path,
+    options: &'a ImportOptions,
+    instruction: String,
+    objects: Vec<String>,
+    embodiment: DemoEmbodiment,
+    views: Vec<String>,
+    times: &'a [f64],
+    chosen: &'a [usize],
+    files: &'a [FrameFiles],
+    states: Option<Vec<nesy_core::State>>,
+    context: Option<String>,
+}
+
+impl Plan<'_> {
+    fn write(
+        self,
+        pictures: &mut [Option<Vec<Image>>],
+        motion: Option<MotionTrace>,
+    ) -> Result<ImportReport, ImportError> {
+        if self.chosen.len() < 2 {
+            return Err(ImportError::Keyframes {
+                path: self.source.to_owned(),
+                message: format!(
+                    "`{}` chose {} keyframe(s); a demo needs the initial state and at least one action{}",
+                    self.options.keyframes.label(),
+                    self.chosen.len(),
+                    if self.options.keyframes == KeyframeMode::Auto {
+                        " (no change in the pictures came to rest; try every:SECONDS or at:T1,T2,...)"
+                    } else {
+                        ""
+                    }
+                ),
+            });
+        }
+        let keyframes_chosen: Vec<ChosenKeyframe> = self
+            .chosen
+            .iter()
+            .map(|&frame| ChosenKeyframe {
+                frame,
+                time: self.times[frame],
+            })
+            .collect();
+        let mut sizes: Vec<Option<((u32, u32), PathBuf)>> = vec![None; self.views.len()];
+        let mut keyframes = Vec::with_capacity(self.chosen.len());
+        for (k, &frame) in self.chosen.iter().enumerate() {
+            let mut named = Vec::with_capacity(self.views.len());
+            for (v, (raw_path, marked_path)) in self.files[frame].iter().enumerate() {
+                let raw = read_image(raw_path, &mut sizes[v])?;
+                let marked = match marked_path {
+                    Some(p) => Some(read_image(p, &mut None)?),
+                    None => None,
+                };
+                named.push(NamedView {
+                    name: self.views[v].clone(),
+                    images: CameraImages { raw, marked },
+                });
+            }
+            keyframes.push(Keyframe {
+                index: k,
+                time: self.times[frame],
+                views: KeyframeViews::new(named),
+                state: self.states.as_ref().map(|s| s[frame].clone()),
+                action: None,
+            });
+        }
+        let (embodiment, demonstrator) = self.embodiment.split();
+        let imported_from = serde_json::json!({
+            "kind": self.kind,
+            "path": self.source,
+            "keyframes": self.options.keyframes.label(),
+            "fps": self.options.fps,
+            "frames": self.files.len(),
+            "chosen": keyframes_chosen,
+            "additional_context": self.context,
+        });
+        let demo = Demo {
+            metadata: DemoMetadata {
+                instruction: self.instruction,
+                objects: self.objects,
+                embodiment,
+                demonstrator,
+                imported_from: Some(imported_from),
+                scenario_id: None,
+                side: None,
+                nesy_version: Some(NESY_VERSION.to_owned()),
+                target_scene: None,
+            },
+            keyframes,
+        };
+        nesy_sim::demo::write_folder(&demo, self.out)?;
+        // Read back as `nesy adapt` will, so that a folder it would refuse is refused now.
+        nesy_sim::demo::read_folder(self.out)?;
+
+        let mut cells = Vec::with_capacity(self.chosen.len());
+        for (k, &frame) in self.chosen.iter().enumerate() {
+            let first_view = match pictures[frame].take() {
+                Some(mut decoded) => decoded.swap_remove(0),
+                None => decode_file(&self.files[frame][0].0)?,
+            };
+            cells.push((first_view, format!("#{k} {:.2} s", self.times[frame])));
+        }
+        let sheet_path = self.out.join(CONTACT_SHEET_FILE);
+        std::fs::write(&sheet_path, contact_sheet(&cells).to_png())
+            .map_err(|e| ImportError::io(&sheet_path, e))?;
+        Ok(ImportReport {
+            kind: self.kind,
+            out: self.out.to_owned(),
+            views: self.views,
+            frames: self.files.len(),
+            keyframes: keyframes_chosen,
+            contact_sheet: sheet_path,
+            motion,
+        })
+    }
+}
+
+/// A frame file's bytes, checked to be PNG or JPEG of its view's resolution (`size`, set by
+/// the view's first frame).
+fn read_image(path: &Path, size: &mut Option<((u32, u32), PathBuf)>) -> Result<Vec<u8>, ImportError> {
+    let bytes =
+        nesy_input::read_bytes(path, nesy_input::MAX_IMAGE_BYTES).map_err(|e| ImportError::io(path, e))?;
+    let found = image_size(&bytes)
+        .ok_or_else(|| ImportError::invalid(path, "expected a PNG or JPEG image with a readable header"))?;
+    match size {
+        Some((expected, first)) if *expected != found => Err(ImportError::invalid(
+            path,
+            format!(
+                "expected {}x{} pixels like this view's other frames ({}), found {}x{}",
+                expected.0,
+                expected.1,
+                first.display(),
+                found.0,
+                found.1
+            ),
+        )),
+        Some(_) => Ok(bytes),
+        None => {
+            *size = Some((found, path.to_owned()));
+            Ok(bytes)
+        }
+    }
+}
+
+fn decode_file(path: &Path) -> Result<Image, ImportError> {
+    let bytes =
+        nesy_input::read_bytes(path, nesy_input::MAX_IMAGE_BYTES).map_err(|e| ImportError::io(path, e))?;
+    decode(&bytes).map_err(|e| ImportError::invalid(path, e))
+}
+
+/// Every view of one frame, decoded.
+fn decode_frame(frame: &FrameFiles) -> Result<Vec<Image>, ImportError> {
+    frame.iter().map(|(raw, _)| decode_file(raw)).collect()
+}
