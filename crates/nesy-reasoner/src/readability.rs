@@ -109,10 +109,14 @@ impl Readability {
             let ms = timings["prompt_ms"].as_f64().unwrap_or(0.0)
                 + timings["predicted_ms"].as_f64().unwrap_or(0.0);
             counts.server_ms += ms.round() as u64;
-            let json_form = body.get("response_format").is_some() || body.get("format").is_some();
-            counts.constrained += u64::from(
-                json_form || body.get("grammar").is_some() || body.get("structured_outputs").is_some(),
-            );
+            // A JSON schema reaches llama.cpp as `json_schema`, vLLM inside `structured_outputs`,
+            // Ollama as `format` and OpenAI as `response_format`; a grammar is text.
+            let json_form = ["response_format", "format", "json_schema"]
+                .iter()
+                .any(|f| body.get(f).is_some())
+                || body["structured_outputs"].get("json").is_some();
+            counts.constrained +=
+                u64::from(nesy_vlm::CONSTRAINT_FIELDS.iter().any(|f| body.get(f).is_some()));
             let read = reads(purpose, text, json_form);
             if users <= 1 {
                 counts.first += 1;
@@ -160,5 +164,46 @@ pub fn reads(purpose: &str, text: &str, json_form: bool) -> bool {
         "patch" => parse_refinement_reply(&text).is_ok(),
         "translate" => parse_state_list(&text).is_ok(),
         _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One recorded induction first try whose body carries `field`, answered in JSON.
+    fn cassette_with(field: &str, value: Value) -> CassetteFile {
+        let mut body = serde_json::json!({"messages": [{"role": "user", "content": "the step"}]});
+        body[field] = value;
+        let reply = r#"{"rationale": ["The lid opened."], "action_semantic": "open the lid", "preconditions": [], "effects": ["(Open box)"]}"#;
+        let text = serde_json::json!({
+            "schema_version": 1,
+            "meta": {"recorder": "test", "created_at": "x", "updated_at": "x"},
+            "interactions": [{
+                "key": "0", "purpose": "induce", "recorded_at": "x", "latency_ms": 1.0,
+                "request": {"method": "POST", "path": "/chat/completions", "body": body},
+                "response": {"status": 200, "headers": {}, "body": {
+                    "choices": [{"index": 0, "message": {"role": "assistant", "content": reply}, "finish_reason": "stop"}]
+                }}
+            }]
+        })
+        .to_string();
+        CassetteFile::parse(std::path::Path::new("c.json"), &text).unwrap()
+    }
+
+    #[test]
+    fn a_json_schema_in_any_backend_field_is_a_constrained_json_reply() {
+        let schema = serde_json::json!({"type": "object"});
+        for (field, value) in [
+            ("json_schema", schema.clone()),
+            ("format", schema.clone()),
+            ("structured_outputs", serde_json::json!({"json": schema.clone()})),
+            ("response_format", serde_json::json!({"type": "json_schema", "json_schema": {"schema": schema}})),
+        ] {
+            let mut readability = Readability::default();
+            readability.add_cassette("m", &cassette_with(field, value));
+            let counts = &readability.by_purpose()["induce"];
+            assert_eq!((counts.constrained, counts.first, counts.first_read), (1, 1, 1), "{field}");
+        }
     }
 }

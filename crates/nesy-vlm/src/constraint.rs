@@ -121,6 +121,17 @@ pub(crate) fn form_for(
     }
 }
 
+/// Every body field a constraint travels in, whatever the backend: llama.cpp's `grammar`
+/// and `json_schema`, vLLM's `structured_outputs`, Ollama's `format`, and OpenAI's and
+/// Azure's `response_format`.
+pub const CONSTRAINT_FIELDS: [&str; 5] = [
+    "grammar",
+    "json_schema",
+    "structured_outputs",
+    "format",
+    "response_format",
+];
+
 /// The body fields that carry `constraint` to `backend` in `form`.
 pub(crate) fn body_fields(
     backend: BackendKind,

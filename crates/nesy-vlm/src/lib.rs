@@ -71,7 +71,7 @@ pub use config::{
     CASSETTE_USAGE_ENV, CassetteSettings, ConfigError, ConfigOverrides, DEFAULT_AZURE_API_VERSION,
     DEFAULT_CLOUD_OUTPUT_TOKENS, EnvSource, ProcessEnv, Timeouts, VlmConfig,
 };
-pub use constraint::{ConstrainMode, ReplyConstraint, ReplyForm, gbnf_literal};
+pub use constraint::{CONSTRAINT_FIELDS, ConstrainMode, ReplyConstraint, ReplyForm, gbnf_literal};
 pub use error::{Cutoff, ProviderError, TimeoutPhase, TransportError, VlmError};
 pub use profile::{BackendKind, BodyDefaults, Profile, ReasoningMode, ReplyCaps, TokenCapField};
 pub use request::{

@@ -6,7 +6,10 @@
 //! - `verify` checks that every blob exists and matches its hash, that stored keys match
 //!   their requests, and that every response decodes. Exit code 1 if anything is wrong;
 //! - `replies` counts how many induction, patch and translation replies nesy's parsers read,
-//!   on the first try and after a re-ask, per method of a benchmark run's cassettes.
+//!   on the first try and after a re-ask, per method of a benchmark run's cassettes;
+//! - `resend` sends recorded requests again to a live server (optionally without their reply
+//!   constraint) and records the answers in a new cassette: the same prompts answered again,
+//!   for a paired comparison.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -61,6 +64,35 @@ pub(crate) enum CassetteAction {
         #[arg(long)]
         json: bool,
     },
+    /// Send recorded requests again to the configured live server and record the answers in
+    /// a new cassette (resumable: what it already holds is not sent again). Read the result
+    /// with `nesy cassette replies`.
+    Resend {
+        /// Cassette files, or folders searched for them.
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// The cassette to record the answers in.
+        #[arg(long, value_name = "CASSETTE")]
+        out: PathBuf,
+        /// Only requests of these purposes, comma-separated (e.g. `induce,patch`).
+        #[arg(long, value_name = "LIST", value_delimiter = ',')]
+        purposes: Vec<String>,
+        /// Only the first request of each conversation (the model's first try).
+        #[arg(long)]
+        first_tries: bool,
+        /// At most this many requests of each purpose.
+        #[arg(long, value_name = "N")]
+        per_purpose: Option<usize>,
+        /// Send each prompt without its reply constraint (grammar or JSON schema).
+        #[arg(long)]
+        strip_constraints: bool,
+        /// Requests in flight at once (match the server's slots).
+        #[arg(long, value_name = "N", default_value_t = 1)]
+        jobs: usize,
+        /// VLM settings (also from the environment and `--vlm-config`).
+        #[command(flatten)]
+        vlm_config: Box<nesy_vlm::ConfigOverrides>,
+    },
     /// Check blobs, keys and response bodies; exit 1 if anything is wrong.
     Verify {
         /// Cassette files.
@@ -77,6 +109,24 @@ pub(crate) fn run(args: CassetteArgs) -> anyhow::Result<ExitCode> {
     match args.action {
         CassetteAction::Inspect { cassette, json } => inspect(&cassette, json),
         CassetteAction::Replies { paths, json } => replies(&paths, json),
+        CassetteAction::Resend {
+            paths,
+            out,
+            purposes,
+            first_tries,
+            per_purpose,
+            strip_constraints,
+            jobs,
+            vlm_config,
+        } => {
+            let plan = tools::ResendPlan {
+                purposes,
+                first_tries_only: first_tries,
+                per_purpose,
+                strip_constraints,
+            };
+            resend(&paths, &out, &plan, jobs, &vlm_config)
+        }
         CassetteAction::Prune {
             cassette,
             used,
@@ -234,6 +284,90 @@ fn cassette_files(path: &std::path::Path, out: &mut Vec<PathBuf>) -> anyhow::Res
         }
     }
     Ok(())
+}
+
+fn resend(
+    paths: &[PathBuf],
+    out: &std::path::Path,
+    plan: &tools::ResendPlan,
+    jobs: usize,
+    overrides: &nesy_vlm::ConfigOverrides,
+) -> anyhow::Result<ExitCode> {
+    use futures::StreamExt as _;
+    use nesy_vlm::Transport as _;
+    anyhow::ensure!(jobs >= 1, "--jobs must be at least 1");
+    let mut files = Vec::new();
+    for path in paths {
+        cassette_files(path, &mut files)?;
+    }
+    files.retain(|f| f != out);
+    anyhow::ensure!(!files.is_empty(), "no cassette (*.json) under {paths:?}");
+    let requests = tools::resend_selection(&files, plan)?;
+    anyhow::ensure!(!requests.is_empty(), "no recorded request matches the selection");
+    let config = nesy_vlm::VlmConfig::resolve(overrides, &nesy_vlm::ProcessEnv)
+        .context("the live server's settings")?;
+    let http = nesy_vlm::VlmClient::http_transport(&config)?;
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let cassette = nesy_vlm::CassetteTransport::open(
+        out,
+        nesy_vlm::CassetteMode::NewEpisodes,
+        Some(std::sync::Arc::new(http)),
+        nesy_vlm::CassetteOptions {
+            model: Some(config.model.clone()),
+            backend: Some(config.backend.as_str().to_owned()),
+            redact: config.api_key.iter().cloned().collect(),
+            constrain: if plan.strip_constraints {
+                nesy_vlm::ConstrainMode::Off
+            } else {
+                config.defaults.constrain
+            },
+            allow_playback_repeats: false,
+            ..nesy_vlm::CassetteOptions::default()
+        },
+    )?;
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .context("starting the async runtime")?;
+    let total = requests.len();
+    let failures = runtime.block_on(async {
+        let mut done = 0usize;
+        let mut failures = Vec::new();
+        let mut sends = futures::stream::iter(requests.iter().map(|r| cassette.send(r))).buffered(jobs);
+        while let Some(result) = sends.next().await {
+            done += 1;
+            match result {
+                Ok(response) if response.status == 200 => {}
+                Ok(response) => failures.push(format!("request {done}: HTTP {}", response.status)),
+                Err(e) => failures.push(format!("request {done}: {e}")),
+            }
+            eprintln!("resent {done}/{total}");
+        }
+        failures
+    });
+    nesy_vlm::Transport::finish(&cassette)?;
+    outln!(
+        "{}: {} request(s) answered, {} failed{}",
+        out.display(),
+        total - failures.len(),
+        failures.len(),
+        if plan.strip_constraints {
+            " (sent without their constraints)"
+        } else {
+            ""
+        }
+    )?;
+    for failure in &failures {
+        outln!("  {failure}")?;
+    }
+    Ok(if failures.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
 }
 
 fn replies(paths: &[PathBuf], json: bool) -> anyhow::Result<ExitCode> {

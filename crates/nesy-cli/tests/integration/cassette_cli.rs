@@ -120,3 +120,115 @@ fn replies_counts_first_tries_and_re_asks_per_method() {
     assert!(table.contains("1/2 (50.0 %)"), "{table}");
     assert!(table.contains("2 cassette(s)"), "{table}");
 }
+
+/// `resend` sends the picked first tries again without their grammar to a live server and
+/// records the answers; a second run sends nothing again; `replies` reads the new cassette.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn resend_asks_the_same_prompts_again_without_their_constraint() {
+    use wiremock::matchers::{method, path};
+    use wiremock::{Mock, MockServer, ResponseTemplate};
+
+    let scratch = common::scratch();
+    let source = scratch.path().join("nesycr.json");
+    let recorded = vec![
+        interaction("induce", 1, BLOCK, "stop", true),
+        interaction("induce", 2, BLOCK, "stop", true),
+        interaction("patch", 1, "no patch", "stop", true),
+        interaction("induce", 1, "Sure! The robot opened the lid.", "stop", true),
+    ];
+    std::fs::write(&source, cassette(recorded)).unwrap();
+    // Two different first tries: make the second distinct so that both are sent.
+    let mut file: Value = serde_json::from_str(&std::fs::read_to_string(&source).unwrap()).unwrap();
+    file["interactions"][3]["request"]["body"]["messages"][1]["content"] = json!("another scene");
+    std::fs::write(&source, serde_json::to_string_pretty(&file).unwrap()).unwrap();
+
+    let server = MockServer::start().await;
+    Mock::given(method("POST"))
+        .and(path("/v1/chat/completions"))
+        .respond_with(
+            ResponseTemplate::new(200).set_body_json(nesy_testkit::completion("The lid is open now.")),
+        )
+        .mount(&server)
+        .await;
+    let out = scratch.path().join("resent").join("free.json");
+    let args: Vec<String> = [
+        "cassette",
+        "resend",
+        &source.display().to_string(),
+        "--out",
+        &out.display().to_string(),
+        "--purposes",
+        "induce",
+        "--first-tries",
+        "--strip-constraints",
+        "--vlm-backend",
+        "llamacpp",
+        "--vlm-base-url",
+        &format!("{}/v1", server.uri()),
+        "--vlm-model",
+        "m",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let again = args.clone();
+    let output = tokio::task::spawn_blocking(move || common::nesy(&args))
+        .await
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert_eq!(
+        output.status.code(),
+        Some(0),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(
+        stdout.contains("2 request(s) answered, 0 failed (sent without their constraints)"),
+        "{stdout}"
+    );
+    let posted: Vec<Value> = server
+        .received_requests()
+        .await
+        .unwrap()
+        .iter()
+        .filter(|r| r.method == wiremock::http::Method::POST)
+        .map(|r| serde_json::from_slice(&r.body).unwrap())
+        .collect();
+    assert_eq!(
+        posted.len(),
+        2,
+        "the two induction first tries, not the re-ask or the patch"
+    );
+    assert!(
+        posted
+            .iter()
+            .all(|b| b.get("grammar").is_none() && b["max_tokens"] == 768)
+    );
+
+    // Resumable: a second run answers from the new cassette and sends nothing.
+    let output = tokio::task::spawn_blocking(move || common::nesy(&again))
+        .await
+        .unwrap();
+    assert_eq!(output.status.code(), Some(0));
+    let posts = server
+        .received_requests()
+        .await
+        .unwrap()
+        .iter()
+        .filter(|r| r.method == wiremock::http::Method::POST)
+        .count();
+    assert_eq!(posts, 2);
+
+    let (code, stdout, _) = common::run(&["cassette", "replies", &out.display().to_string(), "--json"]);
+    assert_eq!(code, Some(0));
+    let rows: Value = serde_json::from_str(&stdout).unwrap();
+    let counts = &rows[0]["counts"];
+    assert_eq!(
+        (
+            counts["first"].as_u64(),
+            counts["first_read"].as_u64(),
+            counts["constrained"].as_u64()
+        ),
+        (Some(2), Some(0), Some(0))
+    );
+}

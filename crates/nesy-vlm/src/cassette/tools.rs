@@ -1,4 +1,4 @@
-//! Library side of `nesy cassette inspect | prune | verify`.
+//! Library side of `nesy cassette inspect | prune | verify | resend`.
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::fs;
@@ -12,6 +12,7 @@ use super::canonical::{BLOB_SCHEME, hex, request_key};
 use super::format::{CassetteFile, blobs_dir, write_atomically};
 use super::{CassetteError, InteractionRef, UsageReport};
 use crate::error::truncate_chars;
+use crate::transport::WireRequest;
 
 /// One interaction as `inspect` lists it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -379,4 +380,74 @@ pub fn load_usage_report(path: &Path) -> Result<UsageReport, CassetteError> {
         column: err.column(),
         message: err.to_string(),
     })
+}
+
+/// Which recorded requests [`resend_selection`] picks to send again.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ResendPlan {
+    /// The purposes to pick (e.g. `induce`, `patch`); empty picks every purpose.
+    pub purposes: Vec<String>,
+    /// Only the first request of each conversation (one user turn): the model's first try.
+    pub first_tries_only: bool,
+    /// At most this many requests of each purpose, the first found in path order.
+    pub per_purpose: Option<usize>,
+    /// Remove the reply constraint from each body ([`crate::CONSTRAINT_FIELDS`]), so that
+    /// the same prompt is answered freely.
+    pub strip_constraints: bool,
+}
+
+/// The requests of `cassettes` (in the order given, each in recording order) that `plan`
+/// picks, ready to send: their recorded path, purpose and body, without the constraint when
+/// asked. A body holding an image reference is refused (its picture lives in the source's
+/// `blobs/`; resending covers text requests).
+///
+/// Sending each again, through a recording cassette, answers "what would the model have
+/// said to the same prompt without its grammar": a paired comparison on identical prompts.
+pub fn resend_selection(cassettes: &[PathBuf], plan: &ResendPlan) -> Result<Vec<WireRequest>, CassetteError> {
+    let mut picked: Vec<WireRequest> = Vec::new();
+    let mut counts: HashMap<String, usize> = HashMap::new();
+    for path in cassettes {
+        let file = CassetteFile::load(path)?;
+        for (index, interaction) in file.interactions.iter().enumerate() {
+            let purpose = interaction.purpose.clone().unwrap_or_default();
+            if !plan.purposes.is_empty() && !plan.purposes.contains(&purpose) {
+                continue;
+            }
+            let body = &interaction.request.body;
+            let users = body["messages"]
+                .as_array()
+                .map_or(0, |m| m.iter().filter(|m| m["role"] == "user").count());
+            if plan.first_tries_only && users > 1 {
+                continue;
+            }
+            let count = counts.entry(purpose.clone()).or_default();
+            if plan.per_purpose.is_some_and(|limit| *count >= limit) {
+                continue;
+            }
+            if body.to_string().contains(BLOB_SCHEME) {
+                return Err(CassetteError::Schema {
+                    path: path.clone(),
+                    message: format!(
+                        "interaction #{index} carries an image; resend covers requests of text only"
+                    ),
+                });
+            }
+            let mut body = body.clone();
+            if plan.strip_constraints
+                && let Some(fields) = body.as_object_mut()
+            {
+                for field in crate::CONSTRAINT_FIELDS {
+                    fields.remove(field);
+                }
+            }
+            *count += 1;
+            picked.push(WireRequest {
+                path: interaction.request.path.clone(),
+                body,
+                task: None,
+                purpose: interaction.purpose.clone(),
+            });
+        }
+    }
+    Ok(picked)
 }
