@@ -11,8 +11,9 @@
 #            files of each command and a /proc mount (needs root): `nesy run` on a fixture
 #            policy and scene; the quick-start job, `nesy adapt --execute` on the bundled demo
 #            with the model's answers replayed from its cassette (and the images it references);
-#            and `nesy verify` on a blocksworld domain and problem with a valid and an invalid
-#            plan. Each check prints `== chroot ...: ok`; the first that fails stops the script.
+#            `nesy verify` on a blocksworld domain and problem with a valid and an invalid
+#            plan; and `nesy demo import` of the authors'-format fixture. Each check prints
+#            `== chroot ...: ok`; the first that fails stops the script.
 #
 # Environment:
 #   NESY_STATIC_TARGET_DIR  cargo target dir for the static build (default: target/static).
@@ -98,6 +99,8 @@ if $run_test; then
   { grep -o 'blob:sha256:[0-9a-f]*\.[a-z]*' "$cassette" || true; } | sort -u | while read -r blob; do
     cp "fixtures/cassettes/blobs/${blob#blob:sha256:}" "$root/fixtures/cassettes/blobs/"
   done
+  # nesy demo import: the authors'-format demo (JPEG frames decoded in the binary).
+  cp -r fixtures/demos/authors-format "$root/fixtures/demos/"
   # nesy verify: blocksworld's Sussman anomaly with a valid plan and one that fails at step 1.
   mkdir -p "$root/pddl"
   cp fixtures/pddl/blocksworld/domain.pddl fixtures/pddl/blocksworld/sussman.pddl \
@@ -134,6 +137,13 @@ if $run_test; then
   [ "$status" -eq 0 ] || fail "adapt --execute (exit $status)"
   grep -q '^nesy adapt: SUCCEEDED' "$root/adapt.out" || fail "adapt --execute (no SUCCEEDED)"
   echo "== chroot adapt --execute: ok"
+
+  in_chroot import demo import fixtures/demos/authors-format/episode_0 --out /imported
+  [ "$status" -eq 0 ] || fail "demo import (exit $status)"
+  grep -qF 'imported 9 keyframe(s) of 9 frame(s), views top, front, back' "$root/import.out" ||
+    fail "demo import (unexpected report)"
+  [ -s "$root/imported/contact_sheet.png" ] || fail "demo import (no contact sheet)"
+  echo "== chroot demo import: ok"
 
   in_chroot verify-valid verify --domain /pddl/domain.pddl --problem /pddl/sussman.pddl \
     --plan /pddl/sussman.valid.plan
