@@ -12,7 +12,8 @@
 #            policy and scene; the quick-start job, `nesy adapt --execute` on the bundled demo
 #            with the model's answers replayed from its cassette (and the images it references);
 #            `nesy verify` on a blocksworld domain and problem with a valid and an invalid
-#            plan; and `nesy demo import` of the authors'-format fixture. Each check prints
+#            plan; and `nesy demo import` of the authors'-format fixture and of the bundled
+#            H.264 video (keyframes found automatically). Each check prints
 #            `== chroot ...: ok`; the first that fails stops the script.
 #
 # Environment:
@@ -100,7 +101,7 @@ if $run_test; then
     cp "fixtures/cassettes/blobs/${blob#blob:sha256:}" "$root/fixtures/cassettes/blobs/"
   done
   # nesy demo import: the authors'-format demo (JPEG frames decoded in the binary).
-  cp -r fixtures/demos/authors-format "$root/fixtures/demos/"
+  cp -r fixtures/demos/authors-format fixtures/demos/video "$root/fixtures/demos/"
   # nesy verify: blocksworld's Sussman anomaly with a valid plan and one that fails at step 1.
   mkdir -p "$root/pddl"
   cp fixtures/pddl/blocksworld/domain.pddl fixtures/pddl/blocksworld/sussman.pddl \
@@ -143,6 +144,12 @@ if $run_test; then
   grep -qF 'imported 9 keyframe(s) of 9 frame(s), views top, front, back' "$root/import.out" ||
     fail "demo import (unexpected report)"
   [ -s "$root/imported/contact_sheet.png" ] || fail "demo import (no contact sheet)"
+  in_chroot import-video demo import fixtures/demos/video/held-keyframes.mp4 --out /imported-video \
+    --keyframes auto --instruction "Place all cylinder blocks in the prismatic drawer." \
+    --objects red_cylinder,drawer_body
+  [ "$status" -eq 0 ] || fail "demo import, video (exit $status)"
+  grep -qF 'imported 9 keyframe(s) of 45 frame(s), views camera' "$root/import-video.out" ||
+    fail "demo import, video (unexpected report)"
   echo "== chroot demo import: ok"
 
   in_chroot verify-valid verify --domain /pddl/domain.pddl --problem /pddl/sussman.pddl \

@@ -3,6 +3,8 @@
 //! Real-world demonstrations into nesy's demo folder layout (`nesy_sim::demo`), which
 //! `nesy adapt --demo` reads:
 //!
+//! - a **video**: MP4 (`.mp4`, `.m4v`, `.mov`) with an H.264 track, read with the `mp4`
+//!   demuxer and Cisco's OpenH264 decoder (built from source into the binary);
 //! - a **frames folder**: one view (`DIR/*.jpg`) or several (`DIR/<view>/*.png`, with
 //!   `<view>_marked/` for labelled frames), in time order;
 //! - the **authors' demo format**: `data.json` (instruction, objects and each keyframe's
@@ -34,6 +36,7 @@ mod error;
 mod frames;
 mod keyframes;
 mod sheet;
+mod video;
 
 use std::path::{Path, PathBuf};
 
@@ -50,6 +53,7 @@ pub use error::ImportError;
 pub use frames::{FrameFolder, ViewFiles, read_frame_folder};
 pub use keyframes::{KeyframeMode, MIN_MOTION, MIN_REST_S, MotionTrace, detect, select};
 pub use sheet::{CELL_WIDTH, COLUMNS, contact_sheet};
+pub use video::{VIDEO_EXTENSIONS, VideoInfo, read_mp4, write_mp4};
 
 /// The contact sheet's file name in the demo folder.
 pub const CONTACT_SHEET_FILE: &str = "contact_sheet.png";
@@ -65,14 +69,15 @@ pub struct ImportOptions {
     /// Frames per second of a frames folder (times are frame numbers without it, and only
     /// `all` can be used).
     pub fps: Option<f64>,
-    /// The view name of a folder that holds its frames directly.
+    /// The view name of a video, or of a folder that holds its frames directly.
     pub view: String,
-    /// The instruction (required for a frames folder; replaces the authors' one).
+    /// The instruction (required for a video or a frames folder; replaces the authors' one).
     pub instruction: Option<String>,
-    /// The object names (required for a frames folder; replace the authors' list).
+    /// The object names (required for a video or a frames folder; replace the authors'
+    /// list).
     pub objects: Option<Vec<String>>,
-    /// Who demonstrated (default: `human` for a frames folder, `finger` for the authors'
-    /// robot demos).
+    /// Who demonstrated (default: `human` for a video or a frames folder, `finger` for the
+    /// authors' robot demos).
     pub embodiment: Option<DemoEmbodiment>,
 }
 
@@ -97,6 +102,8 @@ pub enum SourceKind {
     Frames,
     /// The authors' demo format.
     Authors,
+    /// A video file (MP4, H.264).
+    Video,
 }
 
 /// One chosen keyframe: its frame in the source and its time.
@@ -131,13 +138,17 @@ pub struct ImportReport {
 /// One frame's files: per view, the plain frame and its labelled version.
 type FrameFiles = Vec<(PathBuf, Option<PathBuf>)>;
 
-/// Imports `source` (a frames folder, or a folder with the authors' `data.json`) into a new
-/// demo folder `out`, which must not exist or be empty.
+/// Imports `source` (a video, a frames folder, or a folder with the authors' `data.json`)
+/// into a new demo folder `out`, which must not exist or be empty.
 pub fn import(source: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, ImportError> {
-    if !source.is_dir() {
+    let is_video = source
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| VIDEO_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()));
+    if !source.is_dir() && !is_video {
         return Err(ImportError::invalid(
             source,
-            "expected a folder of frames (one view, or one subfolder per view) or an authors' demo folder (data.json and frames/)",
+            "expected a video (.mp4, .m4v or .mov with H.264), a folder of frames (one view, or one subfolder per view) or an authors' demo folder (data.json and frames/)",
         ));
     }
     if std::fs::read_dir(out).is_ok_and(|mut entries| entries.next().is_some()) {
@@ -146,7 +157,9 @@ pub fn import(source: &Path, out: &Path, options: &ImportOptions) -> Result<Impo
             "the output folder exists and is not empty; choose a new one",
         ));
     }
-    if source.join(DATA_FILE).is_file() {
+    if is_video {
+        import_video(source, out, options)
+    } else if source.join(DATA_FILE).is_file() {
         import_authors(source, out, options)
     } else {
         import_frames(source, out, options)
@@ -155,18 +168,7 @@ pub fn import(source: &Path, out: &Path, options: &ImportOptions) -> Result<Impo
 
 fn import_frames(source: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, ImportError> {
     let folder = read_frame_folder(source, &options.view)?;
-    let instruction = options.instruction.clone().ok_or_else(|| {
-        ImportError::invalid(
-            source,
-            "a frames folder says nothing of the task: give its instruction (--instruction)",
-        )
-    })?;
-    let objects = options.objects.clone().ok_or_else(|| {
-        ImportError::invalid(
-            source,
-            "a frames folder says nothing of the task: give its objects (--objects)",
-        )
-    })?;
+    let (instruction, objects) = task_of(source, options, "a frames folder")?;
     let times: Vec<f64> = match options.fps {
         Some(fps) if fps.is_finite() && fps > 0.0 => (0..folder.len()).map(|i| i as f64 / fps).collect(),
         Some(fps) => {
@@ -204,22 +206,7 @@ fn import_frames(source: &Path, out: &Path, options: &ImportOptions) -> Result<I
             pictures[i] = Some(decoded);
         }
     }
-    let (chosen, motion) = match &options.keyframes {
-        KeyframeMode::Auto => {
-            let (chosen, trace) = detect(&times, &thumbnails).map_err(|message| ImportError::Keyframes {
-                path: source.to_owned(),
-                message,
-            })?;
-            (chosen, Some(trace))
-        }
-        mode => (
-            select(mode, &times, &[]).map_err(|message| ImportError::Keyframes {
-                path: source.to_owned(),
-                message,
-            })?,
-            None,
-        ),
-    };
+    let (chosen, motion) = choose(source, &options.keyframes, &times, &thumbnails)?;
     let views: Vec<String> = folder.views.iter().map(|v| v.name.clone()).collect();
     let plan = Plan {
         kind: SourceKind::Frames,
@@ -232,11 +219,86 @@ fn import_frames(source: &Path, out: &Path, options: &ImportOptions) -> Result<I
         views,
         times: &times,
         chosen: &chosen,
-        files: &files,
+        frames: Frames::Files(&files),
         states: None,
         context: None,
     };
     plan.write(&mut pictures, motion)
+}
+
+fn import_video(source: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, ImportError> {
+    let (instruction, objects) = task_of(source, options, "a video")?;
+    // Pass 1: the frame times, and the thumbnails `auto` compares.
+    let auto = options.keyframes == KeyframeMode::Auto;
+    let mut thumbnails = Vec::new();
+    let info = read_mp4(source, |_, image| {
+        if auto {
+            thumbnails.push(vec![Thumbnail::of(&image)]);
+        }
+        Ok(())
+    })?;
+    let (chosen, motion) = choose(source, &options.keyframes, &info.times, &thumbnails)?;
+    // Pass 2: the chosen frames themselves (a video is not held in memory whole).
+    let mut pictures = Vec::with_capacity(chosen.len());
+    read_mp4(source, |i, image| {
+        if chosen.binary_search(&i).is_ok() {
+            pictures.push(image);
+        }
+        Ok(())
+    })?;
+    let plan = Plan {
+        kind: SourceKind::Video,
+        source,
+        out,
+        options,
+        instruction,
+        objects,
+        embodiment: options.embodiment.unwrap_or(DemoEmbodiment::Human),
+        views: vec![options.view.clone()],
+        times: &info.times,
+        chosen: &chosen,
+        frames: Frames::Decoded(pictures),
+        states: None,
+        context: None,
+    };
+    plan.write(&mut [], motion)
+}
+
+/// The instruction and the objects a source without them needs from the options.
+fn task_of(source: &Path, options: &ImportOptions, what: &str) -> Result<(String, Vec<String>), ImportError> {
+    let instruction = options.instruction.clone().ok_or_else(|| {
+        ImportError::invalid(
+            source,
+            format!("{what} says nothing of the task: give its instruction (--instruction)"),
+        )
+    })?;
+    let objects = options.objects.clone().ok_or_else(|| {
+        ImportError::invalid(
+            source,
+            format!("{what} says nothing of the task: give its objects (--objects)"),
+        )
+    })?;
+    Ok((instruction, objects))
+}
+
+/// The keyframes `mode` chooses among frames at `times`, and what `auto` measured.
+fn choose(
+    source: &Path,
+    mode: &KeyframeMode,
+    times: &[f64],
+    thumbnails: &[Vec<Thumbnail>],
+) -> Result<(Vec<usize>, Option<MotionTrace>), ImportError> {
+    let refuse = |message| ImportError::Keyframes {
+        path: source.to_owned(),
+        message,
+    };
+    match mode {
+        KeyframeMode::Auto => {
+            let (chosen, trace) = detect(times, thumbnails).map_err(refuse)?;
+            Ok((chosen, Some(trace)))
+        }
+        mode => Ok((select(mode, times, &[]).map_err(refuse)?, None)),
+    }
 }
 
 fn import_authors(source: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, ImportError> {
@@ -267,7 +329,7 @@ fn import_authors(source: &Path, out: &Path, options: &ImportOptions) -> Result<
         views: demo.views.iter().map(|(n, _)| n.clone()).collect(),
         times: &times,
         chosen: &chosen,
-        files: &files,
+        frames: Frames::Files(&files),
         states: Some(demo.states),
         context: demo.context,
     };
@@ -286,9 +348,17 @@ struct Plan<'a> {
     views: Vec<String>,
     times: &'a [f64],
     chosen: &'a [usize],
-    files: &'a [FrameFiles],
+    frames: Frames<'a>,
     states: Option<Vec<nesy_core::State>>,
     context: Option<String>,
+}
+
+/// Where the chosen keyframes' pictures come from.
+enum Frames<'a> {
+    /// Files, per frame of the source: per view, the plain and the labelled frame.
+    Files(&'a [FrameFiles]),
+    /// A video's chosen frames, decoded (one view), in keyframe order.
+    Decoded(Vec<Image>),
 }
 
 impl Plan<'_> {
@@ -324,16 +394,27 @@ impl Plan<'_> {
         let mut keyframes = Vec::with_capacity(self.chosen.len());
         for (k, &frame) in self.chosen.iter().enumerate() {
             let mut named = Vec::with_capacity(self.views.len());
-            for (v, (raw_path, marked_path)) in self.files[frame].iter().enumerate() {
-                let raw = read_image(raw_path, &mut sizes[v])?;
-                let marked = match marked_path {
-                    Some(p) => Some(read_image(p, &mut None)?),
-                    None => None,
-                };
-                named.push(NamedView {
-                    name: self.views[v].clone(),
-                    images: CameraImages { raw, marked },
-                });
+            match &self.frames {
+                Frames::Files(files) => {
+                    for (v, (raw_path, marked_path)) in files[frame].iter().enumerate() {
+                        let raw = read_image(raw_path, &mut sizes[v])?;
+                        let marked = match marked_path {
+                            Some(p) => Some(read_image(p, &mut None)?),
+                            None => None,
+                        };
+                        named.push(NamedView {
+                            name: self.views[v].clone(),
+                            images: CameraImages { raw, marked },
+                        });
+                    }
+                }
+                Frames::Decoded(pictures) => named.push(NamedView {
+                    name: self.views[0].clone(),
+                    images: CameraImages {
+                        raw: pictures[k].to_png(),
+                        marked: None,
+                    },
+                }),
             }
             keyframes.push(Keyframe {
                 index: k,
@@ -349,7 +430,7 @@ impl Plan<'_> {
             "path": self.source,
             "keyframes": self.options.keyframes.label(),
             "fps": self.options.fps,
-            "frames": self.files.len(),
+            "frames": self.times.len(),
             "chosen": keyframes_chosen,
             "additional_context": self.context,
         });
@@ -373,9 +454,10 @@ impl Plan<'_> {
 
         let mut cells = Vec::with_capacity(self.chosen.len());
         for (k, &frame) in self.chosen.iter().enumerate() {
-            let first_view = match pictures[frame].take() {
-                Some(mut decoded) => decoded.swap_remove(0),
-                None => decode_file(&self.files[frame][0].0)?,
+            let first_view = match (&self.frames, pictures.get_mut(frame).and_then(Option::take)) {
+                (_, Some(mut decoded)) => decoded.swap_remove(0),
+                (Frames::Files(files), None) => decode_file(&files[frame][0].0)?,
+                (Frames::Decoded(chosen), None) => chosen[k].clone(),
             };
             cells.push((first_view, format!("#{k} {:.2} s", self.times[frame])));
         }
@@ -386,7 +468,7 @@ impl Plan<'_> {
             kind: self.kind,
             out: self.out.to_owned(),
             views: self.views,
-            frames: self.files.len(),
+            frames: self.times.len(),
             keyframes: keyframes_chosen,
             contact_sheet: sheet_path,
             motion,

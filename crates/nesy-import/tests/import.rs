@@ -266,3 +266,88 @@ fn the_authors_format_imports_with_its_states() {
         "{message}"
     );
 }
+
+/// The bundled video: the quick-start demo's front view at 10 fps, each keyframe held for
+/// half a second (written by `regenerate_the_video_fixture`).
+const VIDEO_FIXTURE: &str = "fixtures/demos/video/held-keyframes.mp4";
+
+/// The quick-start demo's front view, each keyframe held for `hold` frames.
+fn held_front_view(demo: &Demo, hold: usize) -> Vec<nesy_sim::perception::render::Image> {
+    let mut frames = Vec::new();
+    for keyframe in &demo.keyframes {
+        let picture = nesy_import::decode(&keyframe.views.get("front").unwrap().raw).unwrap();
+        for _ in 0..hold {
+            frames.push(picture.clone());
+        }
+    }
+    frames
+}
+
+/// Rewrites the bundled video fixture:
+/// `NESY_UPDATE_FIXTURES=1 cargo test -p nesy-import --test import -- --ignored`.
+#[test]
+#[ignore = "rewrites a committed fixture"]
+fn regenerate_the_video_fixture() {
+    if std::env::var_os("NESY_UPDATE_FIXTURES").is_none() {
+        return;
+    }
+    let path = nesy_testkit::workspace_root().join(VIDEO_FIXTURE);
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    nesy_import::write_mp4(&path, &held_front_view(&quickstart(), 5), 10.0).unwrap();
+}
+
+/// The bundled H.264 MP4 (the quick-start demo's front view at 10 fps, each keyframe held
+/// for half a second), imported with `auto`: every keyframe is found where its picture
+/// begins, through the encoder's and the decoder's losses. Written again here, the video
+/// imports the same way.
+#[test]
+fn a_video_imports_with_automatic_keyframes() {
+    let demo = quickstart();
+    let scratch = tempfile::tempdir().unwrap();
+    let frames = held_front_view(&demo, 5);
+    let written = scratch.path().join("demo.mp4");
+    nesy_import::write_mp4(&written, &frames, 10.0).unwrap();
+    let again = import(
+        &written,
+        &scratch.path().join("again"),
+        &options(KeyframeMode::Auto, None),
+    )
+    .unwrap();
+    let video = nesy_testkit::workspace_root().join(VIDEO_FIXTURE);
+
+    let out = scratch.path().join("imported");
+    let report = import(&video, &out, &options(KeyframeMode::Auto, None)).unwrap();
+    assert_eq!(report.kind, SourceKind::Video);
+    assert_eq!(report.frames, frames.len());
+    let times: Vec<f64> = report.keyframes.iter().map(|k| k.time).collect();
+    let expected: Vec<f64> = (0..demo.keyframes.len()).map(|k| 0.5 * k as f64).collect();
+    assert_eq!(times, expected);
+    assert_eq!(again.keyframes, report.keyframes);
+    let imported = read_folder(&out).unwrap();
+    assert_eq!(
+        imported.keyframes[0].views.names().collect::<Vec<_>>(),
+        ["camera"]
+    );
+    assert_eq!(
+        nesy_sim::demo::image_size(&imported.keyframes[3].views.get("camera").unwrap().raw),
+        Some((384, 384))
+    );
+
+    // A truncated file and a file that is no video are refused by name, without a panic.
+    let bytes = std::fs::read(&video).unwrap();
+    for (name, data) in [
+        ("cut.mp4", &bytes[..bytes.len() / 2]),
+        ("text.mp4", &b"not a video at all"[..]),
+    ] {
+        let path = scratch.path().join(name);
+        std::fs::write(&path, data).unwrap();
+        let message = import(
+            &path,
+            &scratch.path().join(format!("out-{name}")),
+            &options(KeyframeMode::All, None),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(message.contains(name), "{message}");
+    }
+}

@@ -198,12 +198,19 @@ mod tests {
             ("json_schema", schema.clone()),
             ("format", schema.clone()),
             ("structured_outputs", serde_json::json!({"json": schema.clone()})),
-            ("response_format", serde_json::json!({"type": "json_schema", "json_schema": {"schema": schema}})),
+            (
+                "response_format",
+                serde_json::json!({"type": "json_schema", "json_schema": {"schema": schema}}),
+            ),
         ] {
             let mut readability = Readability::default();
             readability.add_cassette("m", &cassette_with(field, value));
             let counts = &readability.by_purpose()["induce"];
-            assert_eq!((counts.constrained, counts.first, counts.first_read), (1, 1, 1), "{field}");
+            assert_eq!(
+                (counts.constrained, counts.first, counts.first_read),
+                (1, 1, 1),
+                "{field}"
+            );
         }
     }
 }

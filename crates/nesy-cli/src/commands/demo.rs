@@ -1,9 +1,9 @@
 //! `nesy demo`: bring a real-world demonstration into nesy.
 //!
-//! - `import SOURCE --out DIR` writes the demo folder `nesy adapt --demo` reads, from a
-//!   folder of frames (one view, or one subfolder per view) or the authors' demo format
-//!   (`data.json` and `frames/<view>/frame_<i>.jpg`), choosing keyframes and writing a
-//!   contact sheet of the choice.
+//! - `import SOURCE --out DIR` writes the demo folder `nesy adapt --demo` reads, from a video
+//!   (MP4 with H.264), a folder of frames (one view, or one subfolder per view) or the
+//!   authors' demo format (`data.json` and `frames/<view>/frame_<i>.jpg`), choosing keyframes
+//!   and writing a contact sheet of the choice.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -33,10 +33,10 @@ pub(crate) enum DemonstratorArg {
 /// The `nesy demo` actions.
 #[derive(Debug, clap::Subcommand)]
 pub(crate) enum DemoAction {
-    /// Write a demo folder from a frames folder or the authors' demo format.
+    /// Write a demo folder from a video, a frames folder or the authors' demo format.
     Import {
-        /// A folder of frames (`*.jpg`/`*.png`, or one subfolder per view), or a folder with
-        /// the authors' `data.json` and `frames/`.
+        /// A video (`.mp4`, `.m4v` or `.mov` with H.264), a folder of frames (`*.jpg`/`*.png`,
+        /// or one subfolder per view), or a folder with the authors' `data.json` and `frames/`.
         source: PathBuf,
         /// The demo folder to write (new, or empty).
         #[arg(long, value_name = "DIR")]
@@ -46,19 +46,21 @@ pub(crate) enum DemoAction {
         /// for the authors' format).
         #[arg(long, value_name = "MODE", default_value = "all", value_parser = parse_mode)]
         keyframes: KeyframeMode,
-        /// Frames per second of a frames folder (needed by auto, every: and at:).
+        /// Frames per second of a frames folder (needed by auto, every: and at:; a video
+        /// carries its own times).
         #[arg(long, value_name = "FPS")]
         fps: Option<f64>,
-        /// The view name of a folder holding its frames directly.
+        /// The view name of a video, or of a folder holding its frames directly.
         #[arg(long, value_name = "NAME", default_value = DEFAULT_VIEW)]
         view: String,
-        /// The task's instruction (required for a frames folder).
+        /// The task's instruction (required for a video or a frames folder).
         #[arg(long, value_name = "TEXT")]
         instruction: Option<String>,
-        /// The objects in the scene, comma-separated (required for a frames folder).
+        /// The objects in the scene, comma-separated (required for a video or a frames folder).
         #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
         objects: Option<Vec<String>>,
-        /// Who demonstrated (default: human for frames, finger for the authors' format).
+        /// Who demonstrated (default: human for a video or frames, finger for the authors'
+        /// format).
         #[arg(long, value_enum)]
         demonstrator: Option<DemonstratorArg>,
         /// Print the import report as JSON.

@@ -1,0 +1,263 @@
+//! MP4 files with an H.264 video track (what phones, webcams and RealSense recordings
+//! write): read frame by frame with the `mp4` demuxer and Cisco's OpenH264 decoder, and
+//! written the same way (the simulator's demonstration videos).
+
+use std::io::{BufReader, Cursor};
+use std::path::Path;
+
+use nesy_sim::perception::render::Image;
+use openh264::formats::YUVSource as _;
+
+use crate::error::ImportError;
+
+/// The file extensions read as video.
+pub const VIDEO_EXTENSIONS: [&str; 3] = ["mp4", "m4v", "mov"];
+
+/// An MP4 file's H.264 track: its size, and each frame's presentation time (seconds).
+#[derive(Debug, Clone, PartialEq)]
+pub struct VideoInfo {
+    /// Frame width in pixels.
+    pub width: u32,
+    /// Frame height in pixels.
+    pub height: u32,
+    /// Presentation time of each frame, in decoding order.
+    pub times: Vec<f64>,
+}
+
+/// Reads the H.264 track of an MP4 file, calling `frame` with each decoded frame (RGB) and
+/// its index, in order. A file that is not MP4, holds no H.264 track, is truncated or
+/// decodes to nothing is an error naming it.
+pub fn read_mp4(
+    path: &Path,
+    mut frame: impl FnMut(usize, Image) -> Result<(), ImportError>,
+) -> Result<VideoInfo, ImportError> {
+    let bad = |message: String| ImportError::invalid(path, message);
+    let bytes =
+        nesy_input::read_bytes(path, nesy_input::MAX_DEMO_BYTES).map_err(|e| ImportError::io(path, e))?;
+    let size = bytes.len() as u64;
+    // The demuxer is not hardened against every damaged file: a panic in it is a refusal.
+    let demuxed = std::panic::catch_unwind(|| demux(&bytes, size));
+    let (track, samples) = match demuxed {
+        Ok(result) => result.map_err(bad)?,
+        Err(_) => {
+            return Err(bad(
+                "a damaged MP4 container (the demuxer could not read it)".into()
+            ));
+        }
+    };
+    let mut decoder =
+        openh264::decoder::Decoder::new().map_err(|e| bad(format!("starting the H.264 decoder: {e}")))?;
+    let mut times = Vec::with_capacity(samples.len());
+    let mut rgb = Vec::new();
+    let (mut width, mut height) = (0u32, 0u32);
+    let mut stream = Vec::new();
+    for (i, sample) in samples.iter().enumerate() {
+        stream.clear();
+        if i == 0 {
+            for parameter_set in [&track.sps, &track.pps] {
+                stream.extend_from_slice(&[0, 0, 0, 1]);
+                stream.extend_from_slice(parameter_set);
+            }
+        }
+        annex_b(&sample.bytes, &mut stream).map_err(|m| bad(format!("frame {i}: {m}")))?;
+        let decoded = decoder
+            .decode(&stream)
+            .map_err(|e| bad(format!("frame {i}: H.264: {e}")))?;
+        let Some(yuv) = decoded else { continue };
+        let (w, h) = yuv.dimensions();
+        rgb.resize(w * h * 3, 0);
+        yuv.write_rgb8(&mut rgb);
+        width = w as u32;
+        height = h as u32;
+        times.push(sample.time);
+        frame(
+            times.len() - 1,
+            Image {
+                width,
+                height,
+                rgb: rgb.clone(),
+            },
+        )?;
+    }
+    if times.is_empty() {
+        return Err(bad("the video track decodes to no frame".into()));
+    }
+    Ok(VideoInfo { width, height, times })
+}
+
+/// What the demuxer found: the parameter sets and the samples with their times.
+struct Track {
+    sps: Vec<u8>,
+    pps: Vec<u8>,
+}
+
+struct Sample {
+    time: f64,
+    bytes: Vec<u8>,
+}
+
+fn demux(bytes: &[u8], size: u64) -> Result<(Track, Vec<Sample>), String> {
+    let reader = BufReader::new(Cursor::new(bytes));
+    let mut mp4 =
+        mp4::Mp4Reader::read_header(reader, size).map_err(|e| format!("not a readable MP4 file: {e}"))?;
+    let video = mp4
+        .tracks()
+        .iter()
+        .filter(|(_, t)| t.media_type().is_ok_and(|m| m == mp4::MediaType::H264))
+        .map(|(id, t)| {
+            (
+                *id,
+                t.timescale(),
+                t.sample_count(),
+                t.sequence_parameter_set().map(<[u8]>::to_vec),
+                t.picture_parameter_set().map(<[u8]>::to_vec),
+            )
+        })
+        .min_by_key(|(id, ..)| *id);
+    let Some((id, timescale, count, sps, pps)) = video else {
+        return Err("expected an H.264 video track, found none".into());
+    };
+    let sps = sps.map_err(|e| format!("the H.264 track has no sequence parameter set: {e}"))?;
+    let pps = pps.map_err(|e| format!("the H.264 track has no picture parameter set: {e}"))?;
+    if timescale == 0 {
+        return Err("the video track's timescale is 0".into());
+    }
+    let mut samples = Vec::with_capacity(count as usize);
+    for sample_id in 1..=count {
+        let sample = mp4
+            .read_sample(id, sample_id)
+            .map_err(|e| format!("frame {}: {e} (the file may be truncated)", sample_id - 1))?
+            .ok_or_else(|| format!("frame {}: missing (the file may be truncated)", sample_id - 1))?;
+        let time = (sample.start_time as f64 + f64::from(sample.rendering_offset)) / f64::from(timescale);
+        samples.push(Sample {
+            time,
+            bytes: sample.bytes.to_vec(),
+        });
+    }
+    Ok((Track { sps, pps }, samples))
+}
+
+/// Length-prefixed NAL units (4-byte lengths, as MP4 stores them) as an Annex B stream.
+fn annex_b(mut sample: &[u8], out: &mut Vec<u8>) -> Result<(), String> {
+    while !sample.is_empty() {
+        let Some(length) = sample
+            .get(..4)
+            .map(|b| u32::from_be_bytes([b[0], b[1], b[2], b[3]]) as usize)
+        else {
+            return Err("a NAL unit's length is cut off".into());
+        };
+        let Some(nal) = sample.get(4..4 + length) else {
+            return Err(format!("a NAL unit of {length} bytes runs past the sample's end"));
+        };
+        out.extend_from_slice(&[0, 0, 0, 1]);
+        out.extend_from_slice(nal);
+        sample = &sample[4 + length..];
+    }
+    Ok(())
+}
+
+/// Writes `frames` (all of one size, even width and height) as an MP4 file with one H.264
+/// track at `fps` frames per second.
+pub fn write_mp4(path: &Path, frames: &[Image], fps: f64) -> Result<(), ImportError> {
+    let fail = |message: String| ImportError::invalid(path, message);
+    let Some(first) = frames.first() else {
+        return Err(fail("no frame to write".into()));
+    };
+    let (width, height) = (first.width, first.height);
+    if width % 2 != 0 || height % 2 != 0 || width > u32::from(u16::MAX) || height > u32::from(u16::MAX) {
+        return Err(fail(format!(
+            "H.264 needs an even frame size, got {width}x{height}"
+        )));
+    }
+    if !(fps.is_finite() && fps > 0.0) {
+        return Err(fail(format!("the frame rate must be positive, got {fps}")));
+    }
+    let config = openh264::encoder::EncoderConfig::new()
+        .max_frame_rate(openh264::encoder::FrameRate::from_hz(fps as f32))
+        .bitrate(openh264::encoder::BitRate::from_bps(4_000_000));
+    let mut encoder =
+        openh264::encoder::Encoder::with_api_config(openh264::OpenH264API::from_source(), config)
+            .map_err(|e| fail(format!("starting the H.264 encoder: {e}")))?;
+    let timescale = 90_000u32;
+    let tick = (f64::from(timescale) / fps).round() as u32;
+    let mut samples = Vec::with_capacity(frames.len());
+    let (mut sps, mut pps) = (None, None);
+    for (i, image) in frames.iter().enumerate() {
+        if (image.width, image.height) != (width, height) {
+            return Err(fail(format!(
+                "frame {i} is {}x{}, the video {width}x{height}",
+                image.width, image.height
+            )));
+        }
+        let source = openh264::formats::RgbSliceU8::new(&image.rgb, (width as usize, height as usize));
+        let yuv = openh264::formats::YUVBuffer::from_rgb_source(source);
+        let encoded = encoder
+            .encode(&yuv)
+            .map_err(|e| fail(format!("frame {i}: H.264: {e}")))?;
+        let stream = encoded.to_vec();
+        let mut sample = Vec::with_capacity(stream.len());
+        let mut sync = false;
+        for nal in openh264::nal_units(&stream) {
+            let body = strip_start_code(nal);
+            match body.first().map(|b| b & 0x1f) {
+                Some(7) => sps = Some(body.to_vec()),
+                Some(8) => pps = Some(body.to_vec()),
+                Some(kind) => {
+                    sync |= kind == 5;
+                    sample.extend_from_slice(&(body.len() as u32).to_be_bytes());
+                    sample.extend_from_slice(body);
+                }
+                None => {}
+            }
+        }
+        samples.push(mp4::Mp4Sample {
+            start_time: i as u64 * u64::from(tick),
+            duration: tick,
+            rendering_offset: 0,
+            is_sync: sync,
+            bytes: sample.into(),
+        });
+    }
+    let (Some(sps), Some(pps)) = (sps, pps) else {
+        return Err(fail("the encoder gave no parameter sets".into()));
+    };
+    let file = std::fs::File::create(path).map_err(|e| ImportError::io(path, e))?;
+    let config = mp4::Mp4Config {
+        major_brand: "isom".parse().map_err(|e| fail(format!("{e}")))?,
+        minor_version: 512,
+        compatible_brands: ["isom", "iso2", "avc1", "mp41"]
+            .iter()
+            .filter_map(|b| b.parse().ok())
+            .collect(),
+        timescale: 1000,
+    };
+    let write = || -> Result<(), mp4::Error> {
+        let mut writer = mp4::Mp4Writer::write_start(std::io::BufWriter::new(file), &config)?;
+        writer.add_track(&mp4::TrackConfig {
+            track_type: mp4::TrackType::Video,
+            timescale,
+            language: "und".into(),
+            media_conf: mp4::MediaConfig::AvcConfig(mp4::AvcConfig {
+                width: width as u16,
+                height: height as u16,
+                seq_param_set: sps,
+                pic_param_set: pps,
+            }),
+        })?;
+        for sample in &samples {
+            writer.write_sample(1, sample)?;
+        }
+        writer.write_end()
+    };
+    write().map_err(|e| fail(format!("writing MP4: {e}")))
+}
+
+/// A NAL unit without its Annex B start code (`00 00 01` or `00 00 00 01`).
+fn strip_start_code(nal: &[u8]) -> &[u8] {
+    let zeros = nal.iter().take_while(|&&b| b == 0).count();
+    if zeros >= 2 && nal.get(zeros) == Some(&1) {
+        &nal[zeros + 1..]
+    } else {
+        nal
+    }
+}
