@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Installs what building nesy needs on a fresh Debian or Ubuntu machine, and nothing that is
-# already there: a C compiler and linker, curl and CA certificates (for rustup and cargo),
-# the system's CPython 3.11, 3.12 or 3.13 with its shared library (nesy-policy embeds it)
-# and pip, a Rust toolchain (rustup, with rustfmt and clippy), and the PyPI `mcap` reader
-# the MCAP cross-check test uses. Works with APT's Recommends off. Idempotent; safe to run on
+# already there: a C and a C++ compiler (OpenH264, the video decoder, is C++) and linker,
+# curl and CA certificates (for rustup and cargo), the system's CPython 3.11, 3.12 or 3.13
+# with its shared library (nesy-policy embeds it) and pip, a Rust toolchain (rustup, with
+# rustfmt and clippy), and the PyPI `mcap` reader the MCAP cross-check test uses. Works with APT's Recommends off. Idempotent; safe to run on
 # every CI start.
 set -euo pipefail
 
@@ -24,13 +24,15 @@ supported_python() {
 }
 
 if ! command -v apt-get >/dev/null 2>&1; then
-  echo "install-prereqs.sh supports Debian and Ubuntu (apt-get). Elsewhere install a C compiler, curl, CPython 3.11-3.13 with its shared library and pip, and rustup by hand." >&2
+  echo "install-prereqs.sh supports Debian and Ubuntu (apt-get). Elsewhere install a C and a C++ compiler, curl, CPython 3.11-3.13 with its shared library and pip, and rustup by hand." >&2
   exit 2
 fi
 
 log "system packages"
 need=()
 command -v cc >/dev/null 2>&1 || need+=(gcc libc6-dev)
+# OpenH264 (the video decoder nesy-import builds from source) is C++.
+command -v c++ >/dev/null 2>&1 || need+=(g++)
 command -v curl >/dev/null 2>&1 || need+=(curl)
 [ -e /etc/ssl/certs/ca-certificates.crt ] || need+=(ca-certificates)
 command -v git >/dev/null 2>&1 || need+=(git)
