@@ -3,8 +3,8 @@
 # already there: a C and a C++ compiler (OpenH264, the video decoder, is C++) and linker,
 # curl and CA certificates (for rustup and cargo), the system's CPython 3.11, 3.12 or 3.13
 # with its shared library (nesy-policy embeds it) and pip, a Rust toolchain (rustup, with
-# rustfmt and clippy), and the PyPI `mcap` reader the MCAP cross-check test uses. Works with APT's Recommends off. Idempotent; safe to run on
-# every CI start.
+# rustfmt and clippy), and the PyPI `mcap` reader the MCAP cross-check test uses. Works
+# with APT's Recommends off. Idempotent; safe to run on every CI start.
 set -euo pipefail
 
 log() { printf '\n==> %s\n' "$*"; }
