@@ -41,11 +41,11 @@ pub(crate) enum DemoAction {
         /// The demo folder to write (new, or empty).
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
-        /// Keyframes: `auto` (where the scene, having changed, comes to rest), `every:SECONDS`,
-        /// `at:T1,T2,...` (seconds), or `all` (every frame; the default, and the only choice
-        /// for the authors' format).
-        #[arg(long, value_name = "MODE", default_value = "all", value_parser = parse_mode)]
-        keyframes: KeyframeMode,
+        /// Keyframes: `auto` (where the scene, having changed, comes to rest; the default for
+        /// a video), `every:SECONDS`, `at:T1,T2,...` (seconds), or `all` (every frame; the
+        /// default for a folder, and the only choice for the authors' format).
+        #[arg(long, value_name = "MODE", value_parser = parse_mode)]
+        keyframes: Option<KeyframeMode>,
         /// Frames per second of a frames folder (needed by auto, every: and at:; a video
         /// carries its own times).
         #[arg(long, value_name = "FPS")]
@@ -86,6 +86,15 @@ pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         demonstrator,
         json,
     } = args.action;
+    let is_video = source
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| nesy_import::VIDEO_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()));
+    let keyframes = keyframes.unwrap_or(if is_video {
+        KeyframeMode::Auto
+    } else {
+        KeyframeMode::All
+    });
     let options = ImportOptions {
         keyframes,
         fps,

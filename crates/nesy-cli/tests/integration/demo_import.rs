@@ -108,3 +108,29 @@ fn a_frames_folder_imports_with_automatic_keyframes() {
     );
     assert_eq!(manifest["imported_from"]["keyframes"], "auto");
 }
+
+#[test]
+fn a_video_imports_with_automatic_keyframes_by_default() {
+    let scratch = common::scratch();
+    let out = scratch.path().join("imported").display().to_string();
+    let (code, stdout, stderr) = common::run(&[
+        "demo",
+        "import",
+        "fixtures/demos/video/held-keyframes.mp4",
+        "--out",
+        &out,
+        "--instruction",
+        "Place all cylinder blocks in the prismatic drawer.",
+        "--objects",
+        "red_cylinder,drawer_body",
+    ]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(
+        stdout.contains("imported 9 keyframe(s) of 45 frame(s), views camera"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("0.00 0.50 1.00 1.50 2.00 2.50 3.00 3.50 4.00"),
+        "{stdout}"
+    );
+}
