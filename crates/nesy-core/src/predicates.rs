@@ -24,7 +24,7 @@ use std::sync::Arc;
 use serde::{Deserialize, Serialize};
 
 use crate::symbol::Symbol;
-use crate::types::{PDDL_ROOT_TYPE, ROOT_TYPE, TypeHierarchy};
+use crate::types::{PDDL_ROOT_TYPE, ROOT_TYPE};
 
 /// Whether a predicate describes the world or the robot.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -505,14 +505,18 @@ impl Vocabulary {
         })
     }
 
-    /// The kinds as a type hierarchy (for subkind tests).
-    fn hierarchy(&self) -> TypeHierarchy {
-        let mut types = TypeHierarchy::new();
-        for kind in self.kinds.iter() {
-            // Parents are declared before their children, so this cannot fail.
-            let _ = types.declare(kind.name, kind.parent);
+    /// Whether `kind` is `of` or declared under it. Parents are declared before their
+    /// children, so the walk up ends at the root, which no declaration names.
+    fn is_subkind(&self, mut kind: Symbol, of: Symbol) -> bool {
+        loop {
+            if kind == of {
+                return true;
+            }
+            match self.kinds.iter().find(|k| k.name == kind) {
+                Some(declared) => kind = declared.parent,
+                None => return false,
+            }
         }
-        types
     }
 
     /// The parameter kind an argument of `predicate` at `index` fails, as (expected, found),
@@ -520,7 +524,7 @@ impl Vocabulary {
     pub fn kind_mismatch(&self, predicate: Symbol, index: usize, object: &str) -> Option<(Symbol, Symbol)> {
         let expected = self.get(predicate)?.kind_of_param(index)?;
         let found = self.kind_of(object)?;
-        (!self.hierarchy().is_subtype(found, expected)).then_some((expected, found))
+        (!self.is_subkind(found, expected)).then_some((expected, found))
     }
 
     /// Declares an extra predicate, e.g. `declare("Gathered", &["x"], Category::Physics,

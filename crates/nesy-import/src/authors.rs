@@ -21,7 +21,7 @@ use nesy_core::{Atom, State};
 use serde_json::Value;
 
 use crate::error::ImportError;
-use nesy_sim::demo::is_view_name;
+use nesy_sim::demo::{is_view_name, view_order_key};
 
 /// The data file's name.
 pub const DATA_FILE: &str = "data.json";
@@ -187,12 +187,7 @@ fn read_frames(
             "expected one folder of frames per view (top, front, back, ...)",
         ));
     }
-    views.sort_by_key(|(n, _)| {
-        (
-            ["top", "front", "back"].iter().position(|c| c == n).unwrap_or(3),
-            n.clone(),
-        )
-    });
+    views.sort_by_key(|(n, _)| view_order_key(n));
     Ok(views)
 }
 

@@ -29,8 +29,9 @@ pub enum ImportError {
         /// Why.
         message: String,
     },
-    /// Writing the demo folder failed.
-    #[error("writing the demo: {0}")]
+    /// A frame could not be read as one of its view's, or the demo folder could not be
+    /// written or read back (the error names the file).
+    #[error("{0}")]
     Demo(#[from] nesy_sim::demo::DemoError),
 }
 

@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use nesy_sim::demo::is_view_name;
+use nesy_sim::demo::{is_view_name, view_order_key};
 
 use crate::error::ImportError;
 
@@ -98,7 +98,7 @@ pub fn read_frame_folder(dir: &Path, single_view: &str) -> Result<FrameFolder, I
                 format!("labelled frames of a view `{orphan}` that has no folder of its own"),
             ));
         }
-        views.sort_by_key(|v| (sim_rank(&v.name), v.name.clone()));
+        views.sort_by_key(|v| view_order_key(&v.name));
     }
     let Some(first) = views.first() else {
         return Err(ImportError::invalid(
@@ -139,14 +139,6 @@ pub fn read_frame_folder(dir: &Path, single_view: &str) -> Result<FrameFolder, I
         }
     }
     Ok(FrameFolder { views })
-}
-
-/// The simulator's cameras first (top, front, back), then the rest by name.
-fn sim_rank(name: &str) -> usize {
-    ["top", "front", "back"]
-        .iter()
-        .position(|c| *c == name)
-        .unwrap_or(3)
 }
 
 /// The frame files (naturally sorted) and the subfolders of `dir`; other files (and hidden

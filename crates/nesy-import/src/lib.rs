@@ -42,7 +42,7 @@ use std::path::{Path, PathBuf};
 
 use nesy_sim::demo::{
     CameraImages, Demo, DemoEmbodiment, DemoMetadata, Keyframe, KeyframeViews, NESY_VERSION, NamedView,
-    image_size,
+    ViewResolution,
 };
 use nesy_sim::perception::render::Image;
 use serde::Serialize;
@@ -53,7 +53,7 @@ pub use error::ImportError;
 pub use frames::{FrameFolder, ViewFiles, read_frame_folder};
 pub use keyframes::{KeyframeMode, MIN_MOTION, MIN_REST_S, MotionTrace, detect, select};
 pub use sheet::{CELL_WIDTH, COLUMNS, contact_sheet};
-pub use video::{VIDEO_EXTENSIONS, VideoInfo, read_mp4, write_mp4};
+pub use video::{VIDEO_EXTENSIONS, VideoInfo, is_video, read_mp4, write_mp4};
 
 /// The contact sheet's file name in the demo folder.
 pub const CONTACT_SHEET_FILE: &str = "contact_sheet.png";
@@ -141,10 +141,7 @@ type FrameFiles = Vec<(PathBuf, Option<PathBuf>)>;
 /// Imports `source` (a video, a frames folder, or a folder with the authors' `data.json`)
 /// into a new demo folder `out`, which must not exist or be empty.
 pub fn import(source: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, ImportError> {
-    let is_video = source
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| VIDEO_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()));
+    let is_video = is_video(source);
     if !source.is_dir() && !is_video {
         return Err(ImportError::invalid(
             source,
@@ -197,13 +194,13 @@ fn import_frames(source: &Path, out: &Path, options: &ImportOptions) -> Result<I
                 .collect()
         })
         .collect();
-    let mut pictures: Vec<Option<Vec<Image>>> = vec![None; files.len()];
+    // `auto` compares thumbnails; the frames themselves are not kept (the contact sheet
+    // decodes the chosen ones again).
     let mut thumbnails = Vec::new();
     if options.keyframes == KeyframeMode::Auto {
-        for (i, frame) in files.iter().enumerate() {
+        for frame in &files {
             let decoded = decode_frame(frame)?;
             thumbnails.push(decoded.iter().map(Thumbnail::of).collect());
-            pictures[i] = Some(decoded);
         }
     }
     let (chosen, motion) = choose(source, &options.keyframes, &times, &thumbnails)?;
@@ -223,7 +220,7 @@ fn import_frames(source: &Path, out: &Path, options: &ImportOptions) -> Result<I
         states: None,
         context: None,
     };
-    plan.write(&mut pictures, motion)
+    plan.write(motion)
 }
 
 fn import_video(source: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, ImportError> {
@@ -261,7 +258,7 @@ fn import_video(source: &Path, out: &Path, options: &ImportOptions) -> Result<Im
         states: None,
         context: None,
     };
-    plan.write(&mut [], motion)
+    plan.write(motion)
 }
 
 /// The instruction and the objects a source without them needs from the options.
@@ -333,7 +330,7 @@ fn import_authors(source: &Path, out: &Path, options: &ImportOptions) -> Result<
         states: Some(demo.states),
         context: demo.context,
     };
-    plan.write(&mut vec![None; count], None)
+    plan.write(None)
 }
 
 /// Everything needed to write the demo folder.
@@ -362,11 +359,7 @@ enum Frames<'a> {
 }
 
 impl Plan<'_> {
-    fn write(
-        self,
-        pictures: &mut [Option<Vec<Image>>],
-        motion: Option<MotionTrace>,
-    ) -> Result<ImportReport, ImportError> {
+    fn write(self, motion: Option<MotionTrace>) -> Result<ImportReport, ImportError> {
         if self.chosen.len() < 2 {
             return Err(ImportError::Keyframes {
                 path: self.source.to_owned(),
@@ -390,16 +383,17 @@ impl Plan<'_> {
                 time: self.times[frame],
             })
             .collect();
-        let mut sizes: Vec<Option<((u32, u32), PathBuf)>> = vec![None; self.views.len()];
+        // Per view: the resolution of its plain frames and of its labelled ones.
+        let mut sizes = vec![(ViewResolution::default(), ViewResolution::default()); self.views.len()];
         let mut keyframes = Vec::with_capacity(self.chosen.len());
         for (k, &frame) in self.chosen.iter().enumerate() {
             let mut named = Vec::with_capacity(self.views.len());
             match &self.frames {
                 Frames::Files(files) => {
                     for (v, (raw_path, marked_path)) in files[frame].iter().enumerate() {
-                        let raw = read_image(raw_path, &mut sizes[v])?;
+                        let raw = sizes[v].0.read_frame(raw_path)?;
                         let marked = match marked_path {
-                            Some(p) => Some(read_image(p, &mut None)?),
+                            Some(p) => Some(sizes[v].1.read_frame(p)?),
                             None => None,
                         };
                         named.push(NamedView {
@@ -454,10 +448,9 @@ impl Plan<'_> {
 
         let mut cells = Vec::with_capacity(self.chosen.len());
         for (k, &frame) in self.chosen.iter().enumerate() {
-            let first_view = match (&self.frames, pictures.get_mut(frame).and_then(Option::take)) {
-                (_, Some(mut decoded)) => decoded.swap_remove(0),
-                (Frames::Files(files), None) => decode_file(&files[frame][0].0)?,
-                (Frames::Decoded(chosen), None) => chosen[k].clone(),
+            let first_view = match &self.frames {
+                Frames::Files(files) => decode_file(&files[frame][0].0)?,
+                Frames::Decoded(chosen) => chosen[k].clone(),
             };
             cells.push((first_view, format!("#{k} {:.2} s", self.times[frame])));
         }
@@ -473,33 +466,6 @@ impl Plan<'_> {
             contact_sheet: sheet_path,
             motion,
         })
-    }
-}
-
-/// A frame file's bytes, checked to be PNG or JPEG of its view's resolution (`size`, set by
-/// the view's first frame).
-fn read_image(path: &Path, size: &mut Option<((u32, u32), PathBuf)>) -> Result<Vec<u8>, ImportError> {
-    let bytes =
-        nesy_input::read_bytes(path, nesy_input::MAX_IMAGE_BYTES).map_err(|e| ImportError::io(path, e))?;
-    let found = image_size(&bytes)
-        .ok_or_else(|| ImportError::invalid(path, "expected a PNG or JPEG image with a readable header"))?;
-    match size {
-        Some((expected, first)) if *expected != found => Err(ImportError::invalid(
-            path,
-            format!(
-                "expected {}x{} pixels like this view's other frames ({}), found {}x{}",
-                expected.0,
-                expected.1,
-                first.display(),
-                found.0,
-                found.1
-            ),
-        )),
-        Some(_) => Ok(bytes),
-        None => {
-            *size = Some((found, path.to_owned()));
-            Ok(bytes)
-        }
     }
 }
 

@@ -13,6 +13,13 @@ use crate::error::ImportError;
 /// The file extensions read as video.
 pub const VIDEO_EXTENSIONS: [&str; 3] = ["mp4", "m4v", "mov"];
 
+/// Whether `path` names a video by its extension ([`VIDEO_EXTENSIONS`], any case).
+pub fn is_video(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| VIDEO_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
+}
+
 /// An MP4 file's H.264 track: its size, and each frame's presentation time (seconds).
 #[derive(Debug, Clone, PartialEq)]
 pub struct VideoInfo {

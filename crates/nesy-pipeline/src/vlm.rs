@@ -221,13 +221,7 @@ pub fn build_client(setup: &VlmSetup, demo: &DemoInput) -> Result<VlmClient, Pip
                     path,
                     CassetteMode::All,
                     Some(live),
-                    CassetteOptions {
-                        model: Some(config.model.clone()),
-                        backend: Some(config.backend.as_str().to_owned()),
-                        redact: config.api_key.iter().cloned().collect(),
-                        constrain: config.defaults.constrain,
-                        ..CassetteOptions::default()
-                    },
+                    CassetteOptions::recording(&config),
                 )
                 .map_err(|e| setup_error(format!("opening {} for recording: {e}", path.display())))?,
             )

@@ -94,9 +94,7 @@ impl Readability {
             let choice = &response["choices"][0];
             let text = choice["message"]["content"].as_str().unwrap_or("");
             let body = &interaction.request.body;
-            let users = body["messages"]
-                .as_array()
-                .map_or(0, |m| m.iter().filter(|m| m["role"] == "user").count());
+            let users = nesy_vlm::cassette_tools::user_turns(body);
             let counts = self
                 .groups
                 .entry((group.to_owned(), purpose.to_owned()))

@@ -145,11 +145,8 @@ impl VlmClient {
                     CassetteOptions {
                         strict: cassette.strict,
                         usage_report: cassette.usage_report.clone(),
-                        model: Some(config.model.clone()),
                         backend: backend_label,
-                        redact: config.api_key.iter().cloned().collect(),
-                        allow_playback_repeats: false,
-                        constrain: config.defaults.constrain,
+                        ..CassetteOptions::recording(&config)
                     },
                 )?;
                 // A pure replay builds its bodies as the recording did, so that they match.

@@ -229,13 +229,7 @@ pub(super) fn record_to(
         path,
         CassetteMode::NewEpisodes,
         Some(inner),
-        CassetteOptions {
-            model: Some(config.model.clone()),
-            backend: Some(config.backend.as_str().to_owned()),
-            redact: config.api_key.iter().cloned().collect(),
-            constrain: config.defaults.constrain,
-            ..CassetteOptions::default()
-        },
+        CassetteOptions::recording(config),
     )
     .map_err(|e| (UnitStatus::MethodError, e.to_string()))?;
     Ok(Arc::new(t))

@@ -315,16 +315,13 @@ fn resend(
         nesy_vlm::CassetteMode::NewEpisodes,
         Some(std::sync::Arc::new(http)),
         nesy_vlm::CassetteOptions {
-            model: Some(config.model.clone()),
-            backend: Some(config.backend.as_str().to_owned()),
-            redact: config.api_key.iter().cloned().collect(),
+            // The metadata says whether the resent prompts kept their constraints.
             constrain: if plan.strip_constraints {
                 nesy_vlm::ConstrainMode::Off
             } else {
                 config.defaults.constrain
             },
-            allow_playback_repeats: false,
-            ..nesy_vlm::CassetteOptions::default()
+            ..nesy_vlm::CassetteOptions::recording(&config)
         },
     )?;
     let runtime = tokio::runtime::Builder::new_multi_thread()

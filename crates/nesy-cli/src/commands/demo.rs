@@ -86,11 +86,7 @@ pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         demonstrator,
         json,
     } = args.action;
-    let is_video = source
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| nesy_import::VIDEO_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()));
-    let keyframes = keyframes.unwrap_or(if is_video {
+    let keyframes = keyframes.unwrap_or(if nesy_import::is_video(&source) {
         KeyframeMode::Auto
     } else {
         KeyframeMode::All

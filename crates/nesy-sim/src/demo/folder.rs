@@ -188,28 +188,37 @@ fn read_file(path: &Path) -> Result<Vec<u8>, DemoError> {
     nesy_input::read_bytes(path, nesy_input::MAX_IMAGE_BYTES).map_err(|e| DemoError::io(path, e))
 }
 
-/// The default prompt order of views: the simulator's cameras first, then by name.
+/// The key that sorts views into their default prompt order: the simulator's cameras first
+/// (top, front, back), then the others by name.
+pub fn view_order_key(name: &str) -> (usize, String) {
+    let rank = CameraName::from_name(name).map_or(CameraName::ALL.len(), |c| c as usize);
+    (rank, name.to_owned())
+}
+
+/// The default prompt order of views ([`view_order_key`]), each name once.
 fn default_view_order(names: impl IntoIterator<Item = String>) -> Vec<String> {
     let mut names: Vec<String> = names.into_iter().collect();
-    names.sort_by_key(|n| {
-        let rank = CameraName::from_name(n).map_or(CameraName::ALL.len(), |c| c as usize);
-        (rank, n.clone())
-    });
+    names.sort_by_key(|n| view_order_key(n));
     names.dedup();
     names
 }
 
-/// A view's resolution as set by its first frame, and that frame's file.
-type FirstFrame = Option<((u32, u32), PathBuf)>;
+/// The resolution one view keeps: set by its first frame, checked for every later one.
+#[derive(Debug, Clone, Default)]
+pub struct ViewResolution {
+    /// The first frame's size and file.
+    first: Option<((u32, u32), PathBuf)>,
+}
 
-/// A view's file of one keyframe, read and checked: PNG or JPEG, of the view's resolution
-/// (`size`, set by its first frame).
-fn read_view_image(path: &Path, size: &mut FirstFrame) -> Result<Vec<u8>, DemoError> {
-    let bytes = read_file(path)?;
-    let (_, found) = check_image(path, "frame", &bytes)?;
-    match size {
-        Some((expected, first)) if *expected != found => {
-            return Err(DemoError::invalid(
+impl ViewResolution {
+    /// Reads a frame file of the view: PNG or JPEG, with a readable header, of the size of
+    /// the view's first frame (the first call sets it). The error names the file, and the
+    /// first frame when the sizes differ.
+    pub fn read_frame(&mut self, path: &Path) -> Result<Vec<u8>, DemoError> {
+        let bytes = read_file(path)?;
+        let (_, found) = check_image(path, "frame", &bytes)?;
+        match &self.first {
+            Some((expected, first)) if *expected != found => Err(DemoError::invalid(
                 path,
                 "frame",
                 format!(
@@ -219,12 +228,14 @@ fn read_view_image(path: &Path, size: &mut FirstFrame) -> Result<Vec<u8>, DemoEr
                     first.display()
                 ),
                 format!("{}x{}", found.0, found.1),
-            ));
+            )),
+            Some(_) => Ok(bytes),
+            None => {
+                self.first = Some((found, path.to_owned()));
+                Ok(bytes)
+            }
         }
-        Some(_) => {}
-        None => *size = Some((found, path.to_owned())),
     }
-    Ok(bytes)
 }
 
 /// Reads a demo folder.
@@ -326,7 +337,7 @@ pub fn read_folder(dir: &Path) -> Result<Demo, DemoError> {
         ));
     }
 
-    let mut sizes: BTreeMap<(String, bool), FirstFrame> = BTreeMap::new();
+    let mut sizes: BTreeMap<(String, bool), ViewResolution> = BTreeMap::new();
     let mut keyframes = Vec::with_capacity(count);
     for k in 0..count {
         let files = found.get(&k);
@@ -356,12 +367,12 @@ pub fn read_folder(dir: &Path) -> Result<Demo, DemoError> {
                     "no such file",
                 )
             })?;
-            let raw = read_view_image(raw_path, sizes.entry((view.clone(), false)).or_default())?;
+            let raw = sizes
+                .entry((view.clone(), false))
+                .or_default()
+                .read_frame(raw_path)?;
             let marked = match files.and_then(|f| f.get(&(view.clone(), true))) {
-                Some(p) => Some(read_view_image(
-                    p,
-                    sizes.entry((view.clone(), true)).or_default(),
-                )?),
+                Some(p) => Some(sizes.entry((view.clone(), true)).or_default().read_frame(p)?),
                 None => None,
             };
             named.push(NamedView {

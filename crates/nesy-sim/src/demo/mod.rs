@@ -27,8 +27,8 @@ use crate::api::{Embodiment, TraceEntry};
 use crate::scene::SceneSpec;
 
 pub use folder::{
-    DemoEmbodiment, Manifest, ManifestKeyframe, frame_file_name, is_view_name, manifest_schema, read_folder,
-    write_folder,
+    DemoEmbodiment, Manifest, ManifestKeyframe, ViewResolution, frame_file_name, is_view_name,
+    manifest_schema, read_folder, view_order_key, write_folder,
 };
 pub use mcap_format::{read_mcap, read_mcap_bytes, write_mcap, write_mcap_file};
 pub use record::{ExpertRun, RecordError, RecordOptions, Recording, record_scene, run_expert};

@@ -190,6 +190,20 @@ pub struct CassetteOptions {
     pub constrain: ConstrainMode,
 }
 
+impl CassetteOptions {
+    /// The options of a cassette recording what `config`'s client sends: its model, backend
+    /// and constraint setting for the metadata, and its API key to blank out.
+    pub fn recording(config: &crate::config::VlmConfig) -> CassetteOptions {
+        CassetteOptions {
+            model: Some(config.model.clone()),
+            backend: Some(config.backend.as_str().to_owned()),
+            redact: config.api_key.iter().cloned().collect(),
+            constrain: config.defaults.constrain,
+            ..CassetteOptions::default()
+        }
+    }
+}
+
 struct Recorded {
     key: String,
     occurrence: usize,

@@ -382,6 +382,19 @@ pub fn load_usage_report(path: &Path) -> Result<UsageReport, CassetteError> {
     })
 }
 
+/// How many user turns a chat request body holds: 1 for a conversation's first request
+/// (the model's first try), more for a re-ask.
+///
+/// ```
+/// let ask = serde_json::json!({"messages": [{"role": "system"}, {"role": "user"}]});
+/// assert_eq!(nesy_vlm::cassette_tools::user_turns(&ask), 1);
+/// ```
+pub fn user_turns(body: &Value) -> usize {
+    body["messages"]
+        .as_array()
+        .map_or(0, |m| m.iter().filter(|m| m["role"] == "user").count())
+}
+
 /// Which recorded requests [`resend_selection`] picks to send again.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ResendPlan {
@@ -414,10 +427,7 @@ pub fn resend_selection(cassettes: &[PathBuf], plan: &ResendPlan) -> Result<Vec<
                 continue;
             }
             let body = &interaction.request.body;
-            let users = body["messages"]
-                .as_array()
-                .map_or(0, |m| m.iter().filter(|m| m["role"] == "user").count());
-            if plan.first_tries_only && users > 1 {
+            if plan.first_tries_only && user_turns(body) > 1 {
                 continue;
             }
             let count = counts.entry(purpose.clone()).or_default();
