@@ -87,15 +87,57 @@ impl FromStr for KeyframeMode {
     }
 }
 
-/// Luma difference (0–255, mean absolute over a thumbnail) below which two consecutive
-/// frames count as still, whatever the sequence's own noise.
-pub const MIN_MOTION: f32 = 0.75;
+/// Luma difference (0–255, over the thumbnail block where two consecutive frames differ
+/// most) below which they count as still, whatever the sequence's own noise. Chosen on
+/// simulated demonstration videos kept apart from the ones the keyframe figures are measured
+/// on: lower values take an object still settling in the gripper for motion and miss the
+/// rest that follows, higher ones miss small hand movements.
+pub const MIN_MOTION: f32 = 4.0;
 
 /// How long the pictures must stay still for the scene to count as at rest (seconds).
 pub const MIN_REST_S: f64 = 0.3;
 
+/// The two numbers `auto` is tuned by.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct AutoSettings {
+    /// The least luma difference that counts as motion, whatever the sequence's noise
+    /// ([`MIN_MOTION`] by default).
+    pub min_motion: f32,
+    /// Seconds the pictures must stay still for the scene to be at rest ([`MIN_REST_S`] by
+    /// default).
+    pub min_rest_s: f64,
+}
+
+impl Default for AutoSettings {
+    fn default() -> Self {
+        AutoSettings {
+            min_motion: MIN_MOTION,
+            min_rest_s: MIN_REST_S,
+        }
+    }
+}
+
+impl AutoSettings {
+    /// Checks both numbers, saying which is wrong.
+    pub fn check(&self) -> Result<(), String> {
+        if !(self.min_motion.is_finite() && (0.0..=255.0).contains(&self.min_motion)) {
+            return Err(format!(
+                "the least motion must be a luma difference from 0 to 255, got {}",
+                self.min_motion
+            ));
+        }
+        if !(self.min_rest_s.is_finite() && self.min_rest_s >= 0.0) {
+            return Err(format!(
+                "the rest must be 0 seconds or more, got {}",
+                self.min_rest_s
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// What `auto` measured: the threshold it used and each frame's difference to the one before.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct MotionTrace {
     /// Luma difference above which a frame counts as moving.
     pub threshold: f32,
@@ -109,6 +151,7 @@ pub fn select(
     mode: &KeyframeMode,
     times: &[f64],
     thumbnails: &[Vec<Thumbnail>],
+    settings: &AutoSettings,
 ) -> Result<Vec<usize>, String> {
     if times.is_empty() {
         return Err("the sequence has no frames".into());
@@ -142,7 +185,7 @@ pub fn select(
             }
             at.iter().map(|&t| nearest(t)).collect()
         }
-        KeyframeMode::Auto => detect(times, thumbnails)?.0,
+        KeyframeMode::Auto => detect(times, thumbnails, settings)?.0,
     };
     let mut unique: Vec<usize> = Vec::with_capacity(chosen.len());
     for i in chosen {
@@ -162,13 +205,18 @@ pub fn select(
 ///
 /// A frame moves when its difference to the frame before (the largest over its views)
 /// exceeds the threshold: three times the sequence's quiet level (its 20th-percentile
-/// difference, the sensor noise of a real camera) and at least [`MIN_MOTION`]. After motion,
-/// the first frame of a still stretch (frames that match the one before) lasting
-/// [`MIN_REST_S`] is a keyframe, when it differs
+/// difference, the sensor noise of a real camera) and at least `settings.min_motion`. After
+/// motion, the first frame of a still stretch (frames that match the one before) lasting
+/// `settings.min_rest_s` is a keyframe, when it differs
 /// from the keyframe before by more than the threshold (motion that put everything back, such
 /// as a hand passing through, is not an action). Motion still going at the end closes with
 /// the last frame.
-pub fn detect(times: &[f64], thumbnails: &[Vec<Thumbnail>]) -> Result<(Vec<usize>, MotionTrace), String> {
+pub fn detect(
+    times: &[f64],
+    thumbnails: &[Vec<Thumbnail>],
+    settings: &AutoSettings,
+) -> Result<(Vec<usize>, MotionTrace), String> {
+    settings.check()?;
     if thumbnails.len() != times.len() {
         return Err(format!(
             "{} frame times but {} pictures",
@@ -193,7 +241,7 @@ pub fn detect(times: &[f64], thumbnails: &[Vec<Thumbnail>]) -> Result<(Vec<usize
     let mut sorted: Vec<f32> = differences.iter().skip(1).copied().collect();
     sorted.sort_by(f32::total_cmp);
     let quiet = sorted.get(sorted.len() / 5).copied().unwrap_or(0.0);
-    let threshold = (3.0 * quiet).max(MIN_MOTION);
+    let threshold = (3.0 * quiet).max(settings.min_motion);
 
     let mut chosen = vec![0];
     let mut moved = false;
@@ -207,7 +255,7 @@ pub fn detect(times: &[f64], thumbnails: &[Vec<Thumbnail>]) -> Result<(Vec<usize
         // Frame i matches frame i - 1: the still stretch began at i - 1, the first frame that
         // shows the scene as it now rests.
         let first = *rest_start.get_or_insert(i - 1);
-        let rested = times[i] - times[first] >= MIN_REST_S - 1e-9;
+        let rested = times[i] - times[first] >= settings.min_rest_s - 1e-9;
         if moved && rested {
             let last = chosen[chosen.len() - 1];
             if compare(first, last)? > threshold {
@@ -265,7 +313,7 @@ mod tests {
     #[test]
     fn auto_finds_rest_after_change_and_ignores_a_passing_hand() {
         let (times, thumbnails) = sequence();
-        let (chosen, trace) = detect(&times, &thumbnails).unwrap();
+        let (chosen, trace) = detect(&times, &thumbnails, &AutoSettings::default()).unwrap();
         assert_eq!(chosen, [0, 14, 38]);
         assert!(trace.threshold >= MIN_MOTION);
     }
@@ -274,25 +322,53 @@ mod tests {
     fn manual_modes_pick_the_nearest_frames() {
         let (times, thumbnails) = sequence();
         assert_eq!(
-            select(&KeyframeMode::Every(1.0), &times, &thumbnails).unwrap(),
+            select(
+                &KeyframeMode::Every(1.0),
+                &times,
+                &thumbnails,
+                &AutoSettings::default()
+            )
+            .unwrap(),
             [0, 10, 20, 30]
         );
         assert_eq!(
-            select(&KeyframeMode::At(vec![0.0, 1.44, 2.0]), &times, &thumbnails).unwrap(),
+            select(
+                &KeyframeMode::At(vec![0.0, 1.44, 2.0]),
+                &times,
+                &thumbnails,
+                &AutoSettings::default()
+            )
+            .unwrap(),
             [0, 14, 20]
         );
         assert!(
-            select(&KeyframeMode::At(vec![0.0, 9.0]), &times, &thumbnails)
-                .unwrap_err()
-                .contains("after the end")
+            select(
+                &KeyframeMode::At(vec![0.0, 9.0]),
+                &times,
+                &thumbnails,
+                &AutoSettings::default()
+            )
+            .unwrap_err()
+            .contains("after the end")
         );
         assert!(
-            select(&KeyframeMode::At(vec![1.0, 1.01]), &times, &thumbnails)
-                .unwrap_err()
-                .contains("same frame")
+            select(
+                &KeyframeMode::At(vec![1.0, 1.01]),
+                &times,
+                &thumbnails,
+                &AutoSettings::default()
+            )
+            .unwrap_err()
+            .contains("same frame")
         );
         assert_eq!(
-            select(&KeyframeMode::All, &times[..3], &thumbnails[..3]).unwrap(),
+            select(
+                &KeyframeMode::All,
+                &times[..3],
+                &thumbnails[..3],
+                &AutoSettings::default()
+            )
+            .unwrap(),
             [0, 1, 2]
         );
     }
@@ -305,5 +381,78 @@ mod tests {
         for bad in ["sometimes", "every:0", "every:-1", "at:", "at:1,x", "every:nan"] {
             assert!(bad.parse::<KeyframeMode>().is_err(), "{bad}");
         }
+    }
+}
+
+/// Seconds within which a chosen keyframe counts as finding a true one.
+pub const MATCH_TOLERANCE_S: f64 = 0.5;
+
+/// How chosen keyframes compare with the true ones of a recording.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct KeyframeMatch {
+    /// Seconds within which a chosen keyframe finds a true one.
+    pub tolerance_s: f64,
+    /// True keyframes.
+    pub truth: usize,
+    /// Chosen keyframes.
+    pub chosen: usize,
+    /// Pairs matched one to one.
+    pub matched: usize,
+    /// The true keyframes' times that no chosen keyframe found.
+    pub missed: Vec<f64>,
+    /// The chosen keyframes' times that found no true one.
+    pub extra: Vec<f64>,
+    /// The matched pairs: (true keyframe, chosen keyframe), positions in the two lists.
+    pub pairs: Vec<(usize, usize)>,
+}
+
+impl KeyframeMatch {
+    /// Matched true keyframes over true keyframes.
+    pub fn recall(&self) -> f64 {
+        self.matched as f64 / self.truth.max(1) as f64
+    }
+
+    /// Matched chosen keyframes over chosen keyframes.
+    pub fn precision(&self) -> f64 {
+        self.matched as f64 / self.chosen.max(1) as f64
+    }
+}
+
+/// Matches `chosen` keyframe times with `truth` (both increasing) one to one within
+/// `tolerance` seconds, in time order: a chosen time too early for the next true one is
+/// extra, a true time that the next chosen one is too late for is missed.
+///
+/// ```
+/// use nesy_import::match_keyframes;
+///
+/// let m = match_keyframes(&[0.0, 2.0, 5.0], &[0.0, 2.3, 3.5], 0.5);
+/// assert_eq!((m.matched, m.missed.clone(), m.extra.clone()), (2, vec![5.0], vec![3.5]));
+/// ```
+pub fn match_keyframes(truth: &[f64], chosen: &[f64], tolerance: f64) -> KeyframeMatch {
+    let (mut i, mut j) = (0, 0);
+    let (mut missed, mut extra, mut pairs) = (Vec::new(), Vec::new(), Vec::new());
+    while i < truth.len() && j < chosen.len() {
+        if chosen[j] < truth[i] - tolerance {
+            extra.push(chosen[j]);
+            j += 1;
+        } else if chosen[j] > truth[i] + tolerance {
+            missed.push(truth[i]);
+            i += 1;
+        } else {
+            pairs.push((i, j));
+            i += 1;
+            j += 1;
+        }
+    }
+    missed.extend_from_slice(&truth[i..]);
+    extra.extend_from_slice(&chosen[j..]);
+    KeyframeMatch {
+        tolerance_s: tolerance,
+        truth: truth.len(),
+        chosen: chosen.len(),
+        matched: pairs.len(),
+        missed,
+        extra,
+        pairs,
     }
 }

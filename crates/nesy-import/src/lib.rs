@@ -10,6 +10,11 @@
 //! - the **authors' demo format**: `data.json` (instruction, objects and each keyframe's
 //!   symbolic state) and `frames/<view>/frame_<i>.jpg`.
 //!
+//! A simulated demonstration video (`nesy record --video`, written with [`VideoWriter`])
+//! comes with its ground truth (`demo.video.json`); given as [`ImportOptions::truth`], it
+//! puts the recording's states into the imported keyframes and scores the keyframe choice
+//! against the true keyframes ([`match_keyframes`]).
+//!
 //! Keyframes are chosen by [`KeyframeMode`]: `auto` finds the frames at which the scene,
 //! having changed, has come to rest; `every:SECONDS` and `at:T1,T2,...` are the manual
 //! modes; `all` keeps every frame. Each import writes `contact_sheet.png` (the keyframes
@@ -51,9 +56,12 @@ pub use authors::{AuthorsDemo, DATA_FILE, ViewFrames, read_authors_demo};
 pub use decode::{BLOCK, THUMBNAIL_WIDTH, Thumbnail, decode};
 pub use error::ImportError;
 pub use frames::{FrameFolder, ViewFiles, read_frame_folder};
-pub use keyframes::{KeyframeMode, MIN_MOTION, MIN_REST_S, MotionTrace, detect, select};
+pub use keyframes::{
+    AutoSettings, KeyframeMatch, KeyframeMode, MATCH_TOLERANCE_S, MIN_MOTION, MIN_REST_S, MotionTrace,
+    detect, match_keyframes, select,
+};
 pub use sheet::{CELL_WIDTH, COLUMNS, contact_sheet};
-pub use video::{VIDEO_EXTENSIONS, VideoInfo, is_video, read_mp4, write_mp4};
+pub use video::{VIDEO_EXTENSIONS, VideoInfo, VideoWriter, is_video, read_mp4, write_mp4};
 
 /// The contact sheet's file name in the demo folder.
 pub const CONTACT_SHEET_FILE: &str = "contact_sheet.png";
@@ -66,6 +74,8 @@ pub const DEFAULT_VIEW: &str = "camera";
 pub struct ImportOptions {
     /// How keyframes are chosen (the authors' format holds keyframes only: `all`).
     pub keyframes: KeyframeMode,
+    /// What `auto` counts as motion and as rest.
+    pub auto: AutoSettings,
     /// Frames per second of a frames folder (times are frame numbers without it, and only
     /// `all` can be used).
     pub fps: Option<f64>,
@@ -79,17 +89,25 @@ pub struct ImportOptions {
     /// Who demonstrated (default: `human` for a video or a frames folder, `finger` for the
     /// authors' robot demos).
     pub embodiment: Option<DemoEmbodiment>,
+    /// The ground truth of a simulated demonstration video (`demo.video.json`, written by
+    /// `nesy record --video`): each keyframe gets the recording's state at its frame (and,
+    /// when it lies within [`MATCH_TOLERANCE_S`] of a true keyframe, the call that led to
+    /// that one), the task and the robot come from it unless given, and the report compares
+    /// the chosen keyframes with the true ones.
+    pub truth: Option<PathBuf>,
 }
 
 impl Default for ImportOptions {
     fn default() -> Self {
         ImportOptions {
             keyframes: KeyframeMode::All,
+            auto: AutoSettings::default(),
             fps: None,
             view: DEFAULT_VIEW.into(),
             instruction: None,
             objects: None,
             embodiment: None,
+            truth: None,
         }
     }
 }
@@ -130,8 +148,11 @@ pub struct ImportReport {
     pub keyframes: Vec<ChosenKeyframe>,
     /// The contact sheet written.
     pub contact_sheet: PathBuf,
-    /// What `auto` measured, when it ran.
-    #[serde(skip)]
+    /// The chosen keyframes against the true ones, for a video with its ground truth.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub truth_match: Option<KeyframeMatch>,
+    /// What `auto` measured, when it ran (for a look at why a change was or was not taken).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub motion: Option<MotionTrace>,
 }
 
@@ -152,6 +173,12 @@ pub fn import(source: &Path, out: &Path, options: &ImportOptions) -> Result<Impo
         return Err(ImportError::invalid(
             out,
             "the output folder exists and is not empty; choose a new one",
+        ));
+    }
+    if let (Some(truth), false) = (&options.truth, is_video) {
+        return Err(ImportError::invalid(
+            truth,
+            "a recording's ground truth goes with its video; the source is not a video",
         ));
     }
     if is_video {
@@ -203,7 +230,7 @@ fn import_frames(source: &Path, out: &Path, options: &ImportOptions) -> Result<I
             thumbnails.push(decoded.iter().map(Thumbnail::of).collect());
         }
     }
-    let (chosen, motion) = choose(source, &options.keyframes, &times, &thumbnails)?;
+    let (chosen, motion) = choose(source, options, &times, &thumbnails)?;
     let views: Vec<String> = folder.views.iter().map(|v| v.name.clone()).collect();
     let plan = Plan {
         kind: SourceKind::Frames,
@@ -218,12 +245,39 @@ fn import_frames(source: &Path, out: &Path, options: &ImportOptions) -> Result<I
         chosen: &chosen,
         frames: Frames::Files(&files),
         states: None,
+        actions: None,
         context: None,
     };
     plan.write(motion)
 }
 
 fn import_video(source: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, ImportError> {
+    let truth = options
+        .truth
+        .as_deref()
+        .map(nesy_sim::demo::VideoTruth::read)
+        .transpose()?;
+    let told = match &truth {
+        Some(t) => ImportOptions {
+            instruction: options
+                .instruction
+                .clone()
+                .or_else(|| Some(t.instruction.clone())),
+            objects: options.objects.clone().or_else(|| Some(t.objects.clone())),
+            view: if options.view == DEFAULT_VIEW {
+                t.camera.clone()
+            } else {
+                options.view.clone()
+            },
+            embodiment: options.embodiment.or(Some(DemoEmbodiment::of(
+                t.embodiment,
+                nesy_sim::demo::Demonstrator::Robot,
+            ))),
+            ..options.clone()
+        },
+        None => options.clone(),
+    };
+    let options = &told;
     let (instruction, objects) = task_of(source, options, "a video")?;
     // Pass 1: the frame times, and the thumbnails `auto` compares.
     let auto = options.keyframes == KeyframeMode::Auto;
@@ -234,7 +288,40 @@ fn import_video(source: &Path, out: &Path, options: &ImportOptions) -> Result<Im
         }
         Ok(())
     })?;
-    let (chosen, motion) = choose(source, &options.keyframes, &info.times, &thumbnails)?;
+    let (chosen, motion) = choose(source, options, &info.times, &thumbnails)?;
+    let (states, actions, truth_match) = match (&truth, &options.truth) {
+        (Some(truth), Some(path)) => {
+            if truth.frames != info.times.len() {
+                return Err(ImportError::invalid(
+                    path,
+                    format!(
+                        "the ground truth describes {} frames, the video {} has {}",
+                        truth.frames,
+                        source.display(),
+                        info.times.len()
+                    ),
+                ));
+            }
+            let states = chosen
+                .iter()
+                .map(|&frame| truth.state_at(frame).cloned().unwrap_or_default())
+                .collect();
+            let true_times: Vec<f64> = truth
+                .keyframes
+                .iter()
+                .map(|k| truth.frame_time(k.frame))
+                .collect();
+            let chosen_times: Vec<f64> = chosen.iter().map(|&frame| info.times[frame]).collect();
+            let matched = match_keyframes(&true_times, &chosen_times, MATCH_TOLERANCE_S);
+            // A chosen keyframe that found a true one carries the call that led to it.
+            let mut actions = vec![None; chosen.len()];
+            for &(t, c) in &matched.pairs {
+                actions[c] = truth.keyframes[t].action.clone();
+            }
+            (Some(states), Some(actions), Some(matched))
+        }
+        _ => (None, None, None),
+    };
     // Pass 2: the chosen frames themselves (a video is not held in memory whole).
     let mut pictures = Vec::with_capacity(chosen.len());
     read_mp4(source, |i, image| {
@@ -255,10 +342,13 @@ fn import_video(source: &Path, out: &Path, options: &ImportOptions) -> Result<Im
         times: &info.times,
         chosen: &chosen,
         frames: Frames::Decoded(pictures),
-        states: None,
+        states,
+        actions,
         context: None,
     };
-    plan.write(motion)
+    let mut report = plan.write(motion)?;
+    report.truth_match = truth_match;
+    Ok(report)
 }
 
 /// The instruction and the objects a source without them needs from the options.
@@ -281,7 +371,7 @@ fn task_of(source: &Path, options: &ImportOptions, what: &str) -> Result<(String
 /// The keyframes `mode` chooses among frames at `times`, and what `auto` measured.
 fn choose(
     source: &Path,
-    mode: &KeyframeMode,
+    options: &ImportOptions,
     times: &[f64],
     thumbnails: &[Vec<Thumbnail>],
 ) -> Result<(Vec<usize>, Option<MotionTrace>), ImportError> {
@@ -289,12 +379,12 @@ fn choose(
         path: source.to_owned(),
         message,
     };
-    match mode {
+    match &options.keyframes {
         KeyframeMode::Auto => {
-            let (chosen, trace) = detect(times, thumbnails).map_err(refuse)?;
+            let (chosen, trace) = detect(times, thumbnails, &options.auto).map_err(refuse)?;
             Ok((chosen, Some(trace)))
         }
-        mode => Ok((select(mode, times, &[]).map_err(refuse)?, None)),
+        mode => Ok((select(mode, times, &[], &options.auto).map_err(refuse)?, None)),
     }
 }
 
@@ -328,6 +418,7 @@ fn import_authors(source: &Path, out: &Path, options: &ImportOptions) -> Result<
         chosen: &chosen,
         frames: Frames::Files(&files),
         states: Some(demo.states),
+        actions: None,
         context: demo.context,
     };
     plan.write(None)
@@ -346,7 +437,10 @@ struct Plan<'a> {
     times: &'a [f64],
     chosen: &'a [usize],
     frames: Frames<'a>,
+    /// The ground-truth state of each chosen keyframe, in keyframe order.
     states: Option<Vec<nesy_core::State>>,
+    /// The recorded call that led to each chosen keyframe, in keyframe order.
+    actions: Option<Vec<Option<nesy_sim::api::TraceEntry>>>,
     context: Option<String>,
 }
 
@@ -414,8 +508,8 @@ impl Plan<'_> {
                 index: k,
                 time: self.times[frame],
                 views: KeyframeViews::new(named),
-                state: self.states.as_ref().map(|s| s[frame].clone()),
-                action: None,
+                state: self.states.as_ref().map(|s| s[k].clone()),
+                action: self.actions.as_ref().and_then(|a| a[k].clone()),
             });
         }
         let (embodiment, demonstrator) = self.embodiment.split();
@@ -464,6 +558,7 @@ impl Plan<'_> {
             frames: self.times.len(),
             keyframes: keyframes_chosen,
             contact_sheet: sheet_path,
+            truth_match: None,
             motion,
         })
     }

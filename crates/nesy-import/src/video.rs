@@ -166,44 +166,93 @@ fn annex_b(mut sample: &[u8], out: &mut Vec<u8>) -> Result<(), String> {
 /// Writes `frames` (all of one size, even width and height) as an MP4 file with one H.264
 /// track at `fps` frames per second.
 pub fn write_mp4(path: &Path, frames: &[Image], fps: f64) -> Result<(), ImportError> {
-    let fail = |message: String| ImportError::invalid(path, message);
-    let Some(first) = frames.first() else {
-        return Err(fail("no frame to write".into()));
-    };
-    let (width, height) = (first.width, first.height);
-    if width % 2 != 0 || height % 2 != 0 || width > u32::from(u16::MAX) || height > u32::from(u16::MAX) {
-        return Err(fail(format!(
-            "H.264 needs an even frame size, got {width}x{height}"
-        )));
+    let mut writer = VideoWriter::create(path, fps)?;
+    for image in frames {
+        writer.push(image)?;
     }
-    if !(fps.is_finite() && fps > 0.0) {
-        return Err(fail(format!("the frame rate must be positive, got {fps}")));
-    }
-    let config = openh264::encoder::EncoderConfig::new()
-        .max_frame_rate(openh264::encoder::FrameRate::from_hz(fps as f32))
-        .bitrate(openh264::encoder::BitRate::from_bps(4_000_000));
-    let mut encoder =
-        openh264::encoder::Encoder::with_api_config(openh264::OpenH264API::from_source(), config)
-            .map_err(|e| fail(format!("starting the H.264 encoder: {e}")))?;
-    let timescale = 90_000u32;
-    let tick = (f64::from(timescale) / fps).round() as u32;
-    let mut samples = Vec::with_capacity(frames.len());
-    let (mut sps, mut pps) = (None, None);
-    for (i, image) in frames.iter().enumerate() {
-        if (image.width, image.height) != (width, height) {
+    writer.finish().map(|_| ())
+}
+
+/// The MP4 track's time units per second.
+const TIMESCALE: u32 = 90_000;
+
+/// An MP4 file with one H.264 track, written a frame at a time (a long video is never held
+/// in memory): [`VideoWriter::create`], [`VideoWriter::push`] each frame, then
+/// [`VideoWriter::finish`].
+pub struct VideoWriter {
+    path: std::path::PathBuf,
+    encoder: openh264::encoder::Encoder,
+    /// The file until the first frame gives the track its size and parameter sets.
+    file: Option<std::fs::File>,
+    writer: Option<mp4::Mp4Writer<std::io::BufWriter<std::fs::File>>>,
+    size: (u32, u32),
+    tick: u32,
+    frames: usize,
+}
+
+impl VideoWriter {
+    /// Creates `path` for a video at `fps` frames per second.
+    pub fn create(path: &Path, fps: f64) -> Result<VideoWriter, ImportError> {
+        let fail = |message: String| ImportError::invalid(path, message);
+        if !(fps.is_finite() && fps > 0.0 && fps <= 1000.0) {
             return Err(fail(format!(
-                "frame {i} is {}x{}, the video {width}x{height}",
-                image.width, image.height
+                "the frame rate must be positive and at most 1000, got {fps}"
+            )));
+        }
+        let config = openh264::encoder::EncoderConfig::new()
+            .max_frame_rate(openh264::encoder::FrameRate::from_hz(fps as f32))
+            .bitrate(openh264::encoder::BitRate::from_bps(4_000_000));
+        let encoder =
+            openh264::encoder::Encoder::with_api_config(openh264::OpenH264API::from_source(), config)
+                .map_err(|e| fail(format!("starting the H.264 encoder: {e}")))?;
+        let file = std::fs::File::create(path).map_err(|e| ImportError::io(path, e))?;
+        Ok(VideoWriter {
+            path: path.to_owned(),
+            encoder,
+            file: Some(file),
+            writer: None,
+            size: (0, 0),
+            tick: (f64::from(TIMESCALE) / fps).round() as u32,
+            frames: 0,
+        })
+    }
+
+    fn fail(&self, message: String) -> ImportError {
+        ImportError::invalid(&self.path, message)
+    }
+
+    /// Encodes and writes the next frame; every frame has the first one's size, which must
+    /// be even.
+    pub fn push(&mut self, image: &Image) -> Result<(), ImportError> {
+        let i = self.frames;
+        let (width, height) = (image.width, image.height);
+        if i == 0 {
+            if width == 0
+                || height == 0
+                || width % 2 != 0
+                || height % 2 != 0
+                || width > u32::from(u16::MAX)
+                || height > u32::from(u16::MAX)
+            {
+                return Err(self.fail(format!("H.264 needs an even frame size, got {width}x{height}")));
+            }
+            self.size = (width, height);
+        } else if (width, height) != self.size {
+            return Err(self.fail(format!(
+                "frame {i} is {width}x{height}, the video {}x{}",
+                self.size.0, self.size.1
             )));
         }
         let source = openh264::formats::RgbSliceU8::new(&image.rgb, (width as usize, height as usize));
         let yuv = openh264::formats::YUVBuffer::from_rgb_source(source);
-        let encoded = encoder
+        let stream = self
+            .encoder
             .encode(&yuv)
-            .map_err(|e| fail(format!("frame {i}: H.264: {e}")))?;
-        let stream = encoded.to_vec();
+            .map_err(|e| ImportError::invalid(&self.path, format!("frame {i}: H.264: {e}")))?
+            .to_vec();
         let mut sample = Vec::with_capacity(stream.len());
         let mut sync = false;
+        let (mut sps, mut pps) = (None, None);
         for nal in openh264::nal_units(&stream) {
             let body = strip_start_code(nal);
             match body.first().map(|b| b & 0x1f) {
@@ -217,46 +266,78 @@ pub fn write_mp4(path: &Path, frames: &[Image], fps: f64) -> Result<(), ImportEr
                 None => {}
             }
         }
-        samples.push(mp4::Mp4Sample {
-            start_time: i as u64 * u64::from(tick),
-            duration: tick,
+        if self.writer.is_none() {
+            let (Some(sps), Some(pps), Some(file)) = (sps, pps, self.file.take()) else {
+                return Err(self.fail("the encoder gave no parameter sets with the first frame".into()));
+            };
+            self.writer = Some(self.start(file, sps, pps)?);
+        }
+        let sample = mp4::Mp4Sample {
+            start_time: i as u64 * u64::from(self.tick),
+            duration: self.tick,
             rendering_offset: 0,
             is_sync: sync,
             bytes: sample.into(),
-        });
+        };
+        let written = match self.writer.as_mut() {
+            Some(writer) => writer.write_sample(1, &sample),
+            None => Ok(()),
+        };
+        written.map_err(|e| self.fail(format!("writing frame {i}: {e}")))?;
+        self.frames += 1;
+        Ok(())
     }
-    let (Some(sps), Some(pps)) = (sps, pps) else {
-        return Err(fail("the encoder gave no parameter sets".into()));
-    };
-    let file = std::fs::File::create(path).map_err(|e| ImportError::io(path, e))?;
-    let config = mp4::Mp4Config {
-        major_brand: "isom".parse().map_err(|e| fail(format!("{e}")))?,
-        minor_version: 512,
-        compatible_brands: ["isom", "iso2", "avc1", "mp41"]
-            .iter()
-            .filter_map(|b| b.parse().ok())
-            .collect(),
-        timescale: 1000,
-    };
-    let write = || -> Result<(), mp4::Error> {
-        let mut writer = mp4::Mp4Writer::write_start(std::io::BufWriter::new(file), &config)?;
-        writer.add_track(&mp4::TrackConfig {
-            track_type: mp4::TrackType::Video,
-            timescale,
-            language: "und".into(),
-            media_conf: mp4::MediaConfig::AvcConfig(mp4::AvcConfig {
-                width: width as u16,
-                height: height as u16,
-                seq_param_set: sps,
-                pic_param_set: pps,
-            }),
-        })?;
-        for sample in &samples {
-            writer.write_sample(1, sample)?;
-        }
-        writer.write_end()
-    };
-    write().map_err(|e| fail(format!("writing MP4: {e}")))
+
+    /// Starts the MP4 file with its one video track.
+    fn start(
+        &self,
+        file: std::fs::File,
+        sps: Vec<u8>,
+        pps: Vec<u8>,
+    ) -> Result<mp4::Mp4Writer<std::io::BufWriter<std::fs::File>>, ImportError> {
+        let config = mp4::Mp4Config {
+            major_brand: "isom".parse().map_err(|e| self.fail(format!("{e}")))?,
+            minor_version: 512,
+            compatible_brands: ["isom", "iso2", "avc1", "mp41"]
+                .iter()
+                .filter_map(|b| b.parse().ok())
+                .collect(),
+            timescale: 1000,
+        };
+        let (width, height) = self.size;
+        let start = || -> Result<_, mp4::Error> {
+            let mut writer = mp4::Mp4Writer::write_start(std::io::BufWriter::new(file), &config)?;
+            writer.add_track(&mp4::TrackConfig {
+                track_type: mp4::TrackType::Video,
+                timescale: TIMESCALE,
+                language: "und".into(),
+                media_conf: mp4::MediaConfig::AvcConfig(mp4::AvcConfig {
+                    width: width as u16,
+                    height: height as u16,
+                    seq_param_set: sps,
+                    pic_param_set: pps,
+                }),
+            })?;
+            Ok(writer)
+        };
+        start().map_err(|e| self.fail(format!("writing MP4: {e}")))
+    }
+
+    /// Finishes the file (its index goes at the end) and returns the number of frames.
+    pub fn finish(mut self) -> Result<usize, ImportError> {
+        let Some(mut writer) = self.writer.take() else {
+            return Err(self.fail("no frame to write".into()));
+        };
+        writer
+            .write_end()
+            .map_err(|e| self.fail(format!("writing MP4: {e}")))?;
+        use std::io::Write as _;
+        writer
+            .into_writer()
+            .flush()
+            .map_err(|e| ImportError::io(&self.path, e))?;
+        Ok(self.frames)
+    }
 }
 
 /// A NAL unit without its Annex B start code (`00 00 01` or `00 00 00 01`).

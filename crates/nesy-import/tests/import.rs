@@ -197,20 +197,7 @@ fn authors_folder(demo: &Demo, dir: &Path) -> PathBuf {
 }
 
 fn jpeg_of(png: &[u8]) -> Vec<u8> {
-    let image = nesy_import::decode(png).unwrap();
-    let (width, height) = (image.width / 3, image.height / 3);
-    let mut rgb = Vec::with_capacity((width * height * 3) as usize);
-    for y in 0..height {
-        for x in 0..width {
-            let i = ((3 * y * image.width + 3 * x) * 3) as usize;
-            rgb.extend_from_slice(&image.rgb[i..i + 3]);
-        }
-    }
-    let mut out = Vec::new();
-    jpeg_encoder::Encoder::new(&mut out, 85)
-        .encode(&rgb, width as u16, height as u16, jpeg_encoder::ColorType::Rgb)
-        .unwrap();
-    out
+    nesy_testkit::jpeg_from_png(png, 3, 85)
 }
 
 /// Rewrites the bundled authors'-format fixture from the quick-start demo:

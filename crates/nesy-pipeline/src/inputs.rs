@@ -1,8 +1,9 @@
 //! Step 1: the demo and the target scene.
 //!
 //! The demo is read with `nesy_sim::demo::read` (`demo.mcap`, a folder holding it, or a
-//! folder with `manifest.json`). The target scene is built in nesy-sim, which observes its
-//! ground-truth initial state and renders the three views (plain and marked).
+//! folder with `manifest.json`). A target scene is built in nesy-sim, which observes its
+//! ground-truth initial state and renders the three views (plain and marked); a camera target
+//! is a folder in the demo layout with one keyframe, whose state comes from the model.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -12,9 +13,9 @@ use nesy_core::State;
 use nesy_core::Vocabulary;
 use nesy_reasoner::{KeyframeImages, Views};
 use nesy_sim::api::ApiCall;
-use nesy_sim::demo::Demo;
+use nesy_sim::demo::{CameraImages, Demo, Demonstrator, NamedView};
 use nesy_sim::perception::observer::observe;
-use nesy_sim::perception::render::{self, View};
+use nesy_sim::perception::render;
 use nesy_sim::scene::{SceneSpec, parts};
 use nesy_sim::world::Sim;
 use nesy_vlm::Image;
@@ -170,7 +171,7 @@ pub fn load_vocabulary(path: &Path) -> Result<Vocabulary, PipelineError> {
 /// Checks that a simulated target's observed state is in the vocabulary: the simulator
 /// observes the built-in predicates, so a vocabulary without them cannot describe its scene.
 pub(crate) fn check_target_state(target: &TargetInput, vocabulary: &Vocabulary) -> Result<(), PipelineError> {
-    for atom in target.observed.iter() {
+    for atom in target.observed.iter().flat_map(|s| s.iter()) {
         if let Err(e) = vocabulary.check_use(atom.pred(), atom.args().len()) {
             return Err(PipelineError::Target {
                 path: target.path.clone(),
@@ -192,29 +193,47 @@ pub(crate) fn scene_objects(names: &[String]) -> Vec<String> {
         .collect()
 }
 
-/// The target scene, built, observed and rendered.
+/// The file beside a camera target's `manifest.json` that gives its simulated scene.
+pub const TARGET_SCENE_BESIDE: &str = "scene.json";
+
+/// The target: a simulated scene (built, observed and rendered), or what a camera sees at
+/// deployment (a folder in the demo layout with one keyframe: its frames, object list,
+/// instruction and robot), optionally with a simulated `scene.json` beside it to execute on.
 #[derive(Debug, Clone)]
 pub struct TargetInput {
-    /// Where the scene came from (`<demo>#target_scene` when the demo carried it).
+    /// Where the target came from (`<demo>#target_scene` when the demo carried it).
     pub path: PathBuf,
-    /// The scene as used (with `embodiment_in_state` set when the embodiment changed).
-    pub scene: SceneSpec,
-    /// The observed ground-truth initial state.
-    pub observed: State,
+    /// The simulated scene to execute on (with `embodiment_in_state` set when the embodiment
+    /// changed); `None` for a camera target without one.
+    pub scene: Option<SceneSpec>,
+    /// The simulator's ground-truth initial state, when there is a scene.
+    pub observed: Option<State>,
     /// Object names, without the robot's own, in scene order.
     pub objects: Vec<String>,
-    /// The rendered views (top, front, back; plain and marked).
-    pub views: Vec<View>,
+    /// Names the target's states may use besides the objects: the floor and the parts of
+    /// articulated objects.
+    pub scene_names: Vec<String>,
+    /// The robot that is to do the task.
+    pub embodiment: Embodiment,
+    /// The target's own instruction (empty: the demo's is used).
+    pub own_instruction: String,
+    /// Subtasks the target is to complete, when its scene says.
+    pub subtasks: Option<usize>,
+    /// The views, in prompt order: rendered (top, front, back) for a scene, the camera's
+    /// frames for a camera target; PNG or JPEG, plain and (when present) labelled.
+    pub views: Vec<NamedView>,
     /// Time spent building, observing and rendering.
     pub sim_time: Duration,
 }
 
 impl TargetInput {
-    /// Reads `path` (or, without one, the target scene recorded in the demo), builds it and
-    /// observes and renders it. Embodiment atoms go into the state when the target's end
-    /// effector differs from the demo's (the authors' `ee_set`).
+    /// Reads `path`: a scene file, or a camera target folder (`manifest.json` with one
+    /// keyframe, optionally `scene.json`); without a path, the target scene recorded in the
+    /// demo. A scene is built, observed and rendered. Embodiment atoms go into the state
+    /// when the target's end effector differs from the demo's (the authors' `ee_set`).
     pub fn load(path: Option<&Path>, demo: &DemoInput) -> Result<TargetInput, PipelineError> {
         let (path, scene) = match path {
+            Some(path) if path.is_dir() => return Self::from_camera(path, demo),
             Some(path) => {
                 let scene = SceneSpec::from_file(path).map_err(|e| PipelineError::Target {
                     path: path.to_owned(),
@@ -245,56 +264,128 @@ impl TargetInput {
     /// Builds, observes and renders a scene.
     pub fn from_scene(
         path: PathBuf,
-        mut scene: SceneSpec,
+        scene: SceneSpec,
         source: Embodiment,
     ) -> Result<TargetInput, PipelineError> {
         let started = Instant::now();
-        if scene.embodiment != source {
-            scene.embodiment_in_state = true;
-        }
-        if scene.goals.is_empty() {
-            return Err(PipelineError::Target {
-                path,
-                message: "at goals: expected at least one subtask goal (the target must say what success is), found none".into(),
-            });
-        }
-        let sim = match Sim::new(&scene) {
-            Ok(sim) => sim,
-            Err(e) => {
-                return Err(PipelineError::Target {
-                    path,
-                    message: format!("building the target scene: {e}"),
-                });
-            }
-        };
-        let observed = observe(&sim);
-        let objects = scene_objects(&sim.names());
-        let views = render::render_views(&sim, render::VIEW_SIZE, render::default_threads());
+        let built = BuiltScene::new(&path, scene, source)?;
+        let views = render::render_views(&built.sim, render::VIEW_SIZE, render::default_threads())
+            .into_iter()
+            .map(|v| NamedView {
+                name: v.camera.to_owned(),
+                images: CameraImages {
+                    raw: v.image.to_png(),
+                    marked: Some(v.marked.to_png()),
+                },
+            })
+            .collect();
         Ok(TargetInput {
             path,
-            scene,
-            observed,
-            objects,
+            objects: scene_objects(&built.sim.names()),
+            scene_names: built.scene_names(),
+            embodiment: built.scene.embodiment,
+            own_instruction: built.scene.instruction.clone(),
+            subtasks: Some(built.scene.goals.len()),
+            observed: Some(observe(&built.sim)),
+            scene: Some(built.scene),
             views,
             sim_time: started.elapsed(),
         })
     }
 
-    /// The target's instruction, falling back to the demo's when the scene has none.
+    /// Reads a camera target folder: the demo layout with exactly one keyframe, a robot as
+    /// its embodiment, and optionally `scene.json` (whose objects must include the listed
+    /// ones) to execute on.
+    pub fn from_camera(dir: &Path, demo: &DemoInput) -> Result<TargetInput, PipelineError> {
+        let started = Instant::now();
+        let bad = |message: String| PipelineError::Target {
+            path: dir.to_owned(),
+            message,
+        };
+        let frames =
+            nesy_sim::demo::read_folder(dir).map_err(|e| bad(format!("reading the camera target: {e}")))?;
+        if frames.keyframes.len() != 1 {
+            return Err(bad(format!(
+                "a camera target holds one keyframe (what the camera sees before the robot starts), found {}",
+                frames.keyframes.len()
+            )));
+        }
+        if frames.metadata.demonstrator == Demonstrator::Human {
+            return Err(bad(
+                "at embodiment: a target names the robot that is to do the task (`finger` or `vacuum`), not `human`"
+                    .into(),
+            ));
+        }
+        let Some(keyframe) = frames.keyframes.into_iter().next() else {
+            return Err(bad("the camera target holds no keyframe".into()));
+        };
+        let embodiment = frames.metadata.embodiment;
+        let objects = frames.metadata.objects;
+        let beside = dir.join(TARGET_SCENE_BESIDE);
+        let (scene, observed, scene_names, subtasks) = if beside.is_file() {
+            let scene = SceneSpec::from_file(&beside).map_err(|e| PipelineError::Target {
+                path: beside.clone(),
+                message: format!("reading the target scene: {e}"),
+            })?;
+            let built = BuiltScene::new(&beside, scene, demo.demo.metadata.embodiment)?;
+            let names = built.scene_names();
+            if let Some(missing) = objects.iter().find(|o| !names.contains(o)) {
+                return Err(PipelineError::Target {
+                    path: beside,
+                    message: format!(
+                        "the camera target lists `{missing}`, which this scene does not have (its objects: {})",
+                        scene_objects(&built.sim.names()).join(", ")
+                    ),
+                });
+            }
+            if built.scene.embodiment != embodiment {
+                return Err(PipelineError::Target {
+                    path: beside,
+                    message: format!(
+                        "at embodiment: the scene's robot is `{}`, the camera target's `{}`",
+                        built.scene.embodiment.as_str(),
+                        embodiment.as_str()
+                    ),
+                });
+            }
+            let observed = observe(&built.sim);
+            let subtasks = built.scene.goals.len();
+            (Some(built.scene), Some(observed), names, Some(subtasks))
+        } else {
+            let names = std::iter::once(parts::FLOOR.to_owned())
+                .chain(objects.iter().cloned())
+                .collect();
+            (None, None, names, None)
+        };
+        Ok(TargetInput {
+            path: dir.to_owned(),
+            scene,
+            observed,
+            objects,
+            scene_names,
+            embodiment,
+            own_instruction: frames.metadata.instruction,
+            subtasks,
+            views: keyframe.views.iter().cloned().collect(),
+            sim_time: started.elapsed(),
+        })
+    }
+
+    /// The target's instruction, falling back to the demo's when it has none.
     pub fn instruction(&self, demo: &DemoInput) -> String {
-        if self.scene.instruction.trim().is_empty() {
+        if self.own_instruction.trim().is_empty() {
             demo.demo.metadata.instruction.clone()
         } else {
-            self.scene.instruction.clone()
+            self.own_instruction.clone()
         }
     }
 
-    /// The marked views as the VLM sees them.
+    /// The marked views as the VLM sees them (plain where a view has no labelled version).
     pub fn marked_views(&self) -> Result<Views, PipelineError> {
         self.views_of(true)
     }
 
-    /// The views as rendered, without labels (the baselines show both).
+    /// The views without labels (the baselines show both).
     pub fn raw_views(&self) -> Result<Views, PipelineError> {
         self.views_of(false)
     }
@@ -302,14 +393,73 @@ impl TargetInput {
     fn views_of(&self, marked: bool) -> Result<Views, PipelineError> {
         let mut views = Vec::with_capacity(self.views.len());
         for view in &self.views {
-            let image = if marked { &view.marked } else { &view.image };
-            let image = Image::png(image.to_png()).map_err(|e| PipelineError::Target {
+            let bytes = if marked {
+                view.images.marked_or_raw()
+            } else {
+                &view.images.raw
+            };
+            let image = Image::from_encoded(bytes.to_vec()).map_err(|e| PipelineError::Target {
                 path: self.path.clone(),
-                message: format!("the {} view: {e}", view.camera),
+                message: format!("the {} view: {e}", view.name),
             })?;
-            views.push((view.camera.to_string(), image));
+            views.push((view.name.clone(), image));
         }
         Ok(Views::new(views))
+    }
+
+    /// The simulator's ground-truth initial state, or an error saying there is none (a
+    /// camera target without `scene.json`).
+    pub fn observed_state(&self) -> Result<&State, PipelineError> {
+        self.observed.as_ref().ok_or_else(|| PipelineError::Target {
+            path: self.path.clone(),
+            message: "a camera target without a simulated scene has no ground-truth state".into(),
+        })
+    }
+
+    /// The simulated scene, or an error saying there is none (a camera target without
+    /// `scene.json`).
+    pub fn sim_scene(&self) -> Result<&SceneSpec, PipelineError> {
+        self.scene.as_ref().ok_or_else(|| PipelineError::Target {
+            path: self.path.clone(),
+            message: format!(
+                "a camera target without a simulated scene: there is nothing to run the policy on (put a `{TARGET_SCENE_BESIDE}` beside its manifest to execute in simulation)"
+            ),
+        })
+    }
+}
+
+/// A target scene built in the simulator.
+struct BuiltScene {
+    scene: SceneSpec,
+    sim: Sim,
+}
+
+impl BuiltScene {
+    /// Builds `scene` (marking embodiment atoms when its robot differs from `source`), which
+    /// must have a goal.
+    fn new(path: &Path, mut scene: SceneSpec, source: Embodiment) -> Result<BuiltScene, PipelineError> {
+        if scene.embodiment != source {
+            scene.embodiment_in_state = true;
+        }
+        if scene.goals.is_empty() {
+            return Err(PipelineError::Target {
+                path: path.to_owned(),
+                message: "at goals: expected at least one subtask goal (the target must say what success is), found none".into(),
+            });
+        }
+        let sim = Sim::new(&scene).map_err(|e| PipelineError::Target {
+            path: path.to_owned(),
+            message: format!("building the target scene: {e}"),
+        })?;
+        Ok(BuiltScene { scene, sim })
+    }
+
+    /// The floor, the parts of the scene's objects, and the object names.
+    fn scene_names(&self) -> Vec<String> {
+        std::iter::once(parts::FLOOR.to_owned())
+            .chain(self.scene.part_names())
+            .chain(scene_objects(&self.sim.names()))
+            .collect()
     }
 }
 

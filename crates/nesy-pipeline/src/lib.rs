@@ -69,7 +69,7 @@ use states::{StateSource, StatesMode, SymbolicStates};
 use synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest, SynthesizedPolicy};
 
 pub use error::{PipelineError, StopReason};
-pub use inputs::{DemoInput, DemoKeyframes, TargetInput, load_vocabulary};
+pub use inputs::{DemoInput, DemoKeyframes, TARGET_SCENE_BESIDE, TargetInput, load_vocabulary};
 pub use progress::{LogProgress, NoProgress, Progress};
 pub use setting::{ImagesMode, Setting, derive_setting};
 pub use timing::TimeBreakdown;
@@ -150,6 +150,9 @@ impl RunStatus {
     }
 }
 
+/// What a run says when `--execute` meets a target with nothing to execute on.
+pub const NO_SCENE_TO_EXECUTE: &str = "nothing to execute on: the target is a camera's view without a simulated scene (scene.json beside its manifest), and no robot bridge is configured; the run ends with the verified procedure and the policy";
+
 /// Everything a run produced (what `--json` prints, minus bulky traces).
 #[derive(Debug, Clone, Serialize)]
 pub struct AdaptRun {
@@ -183,6 +186,9 @@ pub struct AdaptRun {
     /// The execution, when asked for.
     #[serde(skip)]
     pub execution: Option<ExecutionReport>,
+    /// Why execution was asked for and not done (a camera target without a simulated scene).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub not_executed: Option<String>,
     /// Time spent, by kind.
     pub timing: TimeBreakdown,
     /// Model calls, tokens, latency.
@@ -246,11 +252,7 @@ pub fn adaptation_inputs(
             tier: setting.tier,
             vocabulary: vocabulary.clone(),
         },
-        scene_names: std::iter::once(nesy_sim::scene::parts::FLOOR.to_string())
-            .chain(target.scene.part_names())
-            .chain(target.objects.iter().cloned())
-            .map(|n| Symbol::new(&n))
-            .collect(),
+        scene_names: target.scene_names.iter().map(|n| Symbol::new(n)).collect(),
         goal: None,
     };
     (demonstration, target_task)
@@ -396,14 +398,22 @@ pub async fn run(
     let run_dir = output::RunDir::create(&options.out_dir)?;
     let scene_path = run_dir.prepare(target, policy.as_ref().map(|p| p.code.as_str()))?;
     let mut execution = None;
+    let mut not_executed = None;
     if let (true, Some(p)) = (options.execute, &policy) {
-        progress.stage("executing the policy in the sandbox");
-        let report = execute_policy(&p.code, &scene_path, options).await?;
-        timing.sim_s += report.result.wall_time_s;
-        if !report.success() {
-            status = RunStatus::ExecutionFailed;
+        match &scene_path {
+            Some(scene_path) => {
+                progress.stage("executing the policy in the sandbox");
+                let report = execute_policy(&p.code, scene_path, options).await?;
+                timing.sim_s += report.result.wall_time_s;
+                if !report.success() {
+                    status = RunStatus::ExecutionFailed;
+                }
+                execution = Some(report);
+            }
+            None => {
+                not_executed = Some(NO_SCENE_TO_EXECUTE.to_owned());
+            }
         }
-        execution = Some(report);
     }
     timing.total_s = started.elapsed().as_secs_f64() + timing.load_s + target.sim_time.as_secs_f64();
 
@@ -421,6 +431,7 @@ pub async fn run(
         policy,
         codegen_error,
         execution,
+        not_executed,
         timing,
         usage,
         prompts,
@@ -505,7 +516,6 @@ async fn synthesize_adapted(
         procedure: procedure.clone(),
         source: inputs.setting.source_embodiment,
         target: inputs.setting.target_embodiment,
-        scene: &inputs.target.scene,
     };
     let synth_started = Instant::now();
     let result = synth::synthesize(reasoner, inputs.options.codegen, &request).await;

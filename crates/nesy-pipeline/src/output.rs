@@ -109,14 +109,27 @@ impl RunDir {
         self.write_text(name, &(text + "\n"))
     }
 
-    /// Writes what execution needs before it starts: the target scene as run and, when
-    /// there is one, the program. Returns the scene file's path.
-    pub fn prepare(&self, target: &TargetInput, program: Option<&str>) -> Result<PathBuf, PipelineError> {
-        let scene_path = self.write_text(TARGET_SCENE_FILE, &target.scene.to_json_pretty())?;
+    /// Writes what execution needs before it starts: the target scene as run (when the
+    /// target has one) and, when there is one, the program. Returns the scene file's path.
+    pub fn prepare(
+        &self,
+        target: &TargetInput,
+        program: Option<&str>,
+    ) -> Result<Option<PathBuf>, PipelineError> {
+        let scene_path = self.write_scene(target)?;
         if let Some(code) = program {
             self.write_text(POLICY_FILE, code)?;
         }
         Ok(scene_path)
+    }
+
+    /// Writes the target's simulated scene, when it has one.
+    fn write_scene(&self, target: &TargetInput) -> Result<Option<PathBuf>, PipelineError> {
+        target
+            .scene
+            .as_ref()
+            .map(|scene| self.write_text(TARGET_SCENE_FILE, &scene.to_json_pretty()))
+            .transpose()
     }
 
     /// Writes `failure.json` and the target scene for a run that stopped with `error`
@@ -133,7 +146,7 @@ impl RunDir {
         if error.is_bad_input() {
             return Ok(None);
         }
-        self.write_text(TARGET_SCENE_FILE, &target.scene.to_json_pretty())?;
+        self.write_scene(target)?;
         let path = self.write_json(
             FAILURE_FILE,
             &RunFailure {
@@ -189,9 +202,14 @@ impl RunDir {
             self.write_json(EXECUTION_FILE, execution)?;
         }
         for view in &target.views {
-            for (suffix, image) in [("", &view.image), ("_marked", &view.marked)] {
-                let path = self.file(&format!("target_{}{suffix}.png", view.camera));
-                std::fs::write(&path, image.to_png()).map_err(|e| PipelineError::write(&path, e))?;
+            let images = [
+                (false, Some(&view.images.raw)),
+                (true, view.images.marked.as_ref()),
+            ];
+            for (marked, bytes) in images {
+                let Some(bytes) = bytes else { continue };
+                let path = self.file(&target_view_file(&view.name, marked, bytes));
+                std::fs::write(&path, bytes).map_err(|e| PipelineError::write(&path, e))?;
             }
         }
         self.write_text(REPORT_FILE, &report_markdown(run, target))?;
@@ -461,12 +479,21 @@ fn write_run_header(md: &mut String, run: &AdaptRun) {
     let _ = writeln!(md, "- states: {states}\n");
 }
 
+/// The run directory's file for one of the target's views: `target_<view>[_marked].<png|jpg>`.
+fn target_view_file(view: &str, marked: bool, bytes: &[u8]) -> String {
+    let format = nesy_sim::demo::ImageFormat::of(bytes).unwrap_or(nesy_sim::demo::ImageFormat::Png);
+    let suffix = if marked { "_marked" } else { "" };
+    format!("target_{view}{suffix}.{}", format.extension())
+}
+
 /// The target's instruction, marked views and initial state.
 fn write_target(md: &mut String, run: &AdaptRun, target: &TargetInput) {
     let _ = writeln!(md, "## Target scene\n");
     let _ = writeln!(md, "Instruction: {}\n", run.instruction);
     for view in &target.views {
-        let _ = write!(md, "![{0} view](target_{0}_marked.png) ", view.camera);
+        let marked = view.images.marked.is_some();
+        let file = target_view_file(&view.name, marked, view.images.marked_or_raw());
+        let _ = write!(md, "![{} view]({file}) ", view.name);
     }
     let _ = writeln!(md, "\n\nInitial state:\n\n```\n{}\n```\n", run.target_state);
 }

@@ -75,7 +75,7 @@ pub struct Setting {
 /// Tier, embodiment atoms, factor, complexity and budget for a demo and a target.
 pub fn derive_setting(demo: &DemoInput, target: &TargetInput, options: &AdaptOptions) -> Setting {
     let source = demo.demo.metadata.embodiment;
-    let target_embodiment = target.scene.embodiment;
+    let target_embodiment = target.embodiment;
     let changed = source != target_embodiment;
     let tier = if changed || source == Embodiment::Vacuum || target_embodiment == Embodiment::Vacuum {
         Tier::Extended
@@ -95,9 +95,11 @@ pub fn derive_setting(demo: &DemoInput, target: &TargetInput, options: &AdaptOpt
             (Embodiment::Vacuum, Embodiment::Finger) => Factor::Vacu,
             _ => Factor::Obst,
         });
-    let complexity = from_id
-        .map(|(_, c)| c)
-        .unwrap_or(Complexity::of_subtask_count(target.scene.goals.len()));
+    let complexity = from_id.map(|(_, c)| c).unwrap_or(Complexity::of_subtask_count(
+        // A camera target does not say how many subtasks it holds: one, and the low
+        // complexity's budget, unless `--budget` says otherwise.
+        target.subtasks.unwrap_or(1),
+    ));
     let (budget, budget_origin) = match options.budget {
         Some(b) => (b, "flag"),
         None => (iteration_budget(factor, complexity), "scenario"),

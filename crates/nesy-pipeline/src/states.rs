@@ -116,14 +116,18 @@ pub async fn symbolic_states(
     let use_vlm = match mode {
         StatesMode::Observed => false,
         StatesMode::Vlm => true,
-        StatesMode::Auto => truth.is_none(),
+        StatesMode::Auto => truth.is_none() || target.observed.is_none(),
     };
     if !use_vlm {
         let demo_states = truth.ok_or_else(|| missing_ground_truth(demo))?;
+        let target_state = target.observed.clone().ok_or_else(|| PipelineError::Target {
+            path: target.path.clone(),
+            message: "a camera target without a simulated scene has no ground-truth state; its state comes from the model (--states vlm)".into(),
+        })?;
         progress.detail("ground-truth states");
         return Ok(SymbolicStates {
             demo_states,
-            target_state: target.observed.clone(),
+            target_state,
             source: StateSource::Observed,
             vlm_time: Duration::ZERO,
         });
@@ -238,7 +242,7 @@ fn translation_requests(
         vocabulary: vocabulary.clone(),
         known: target_known,
         views: target.marked_views()?,
-        ground_truth: Some(target.observed.clone()),
+        ground_truth: target.observed.clone(),
     });
     Ok(requests)
 }

@@ -14,7 +14,6 @@ use nesy_reasoner::codegen::{
     CheckUnavailable, CodeGenerationRequest, CodegenError, Finding, ProgramCheck, RejectedProgram,
 };
 use nesy_sim::codegen::compile_policy;
-use nesy_sim::scene::SceneSpec;
 use serde::Serialize;
 
 /// How code is synthesized (`--codegen`).
@@ -31,7 +30,7 @@ pub enum CodegenMode {
 
 /// What synthesis needs.
 #[derive(Debug, Clone)]
-pub struct SynthesisRequest<'a> {
+pub struct SynthesisRequest {
     /// The target's instruction.
     pub instruction: String,
     /// The target's objects.
@@ -42,8 +41,6 @@ pub struct SynthesisRequest<'a> {
     pub source: Embodiment,
     /// The target's end effector.
     pub target: Embodiment,
-    /// The target scene (for the template compiler).
-    pub scene: &'a SceneSpec,
 }
 
 /// A synthesized program and how it was obtained.
@@ -99,7 +96,7 @@ impl std::fmt::Display for SynthError {
 pub async fn synthesize(
     reasoner: &VlmReasoner,
     mode: CodegenMode,
-    request: &SynthesisRequest<'_>,
+    request: &SynthesisRequest,
 ) -> Result<SynthesizedPolicy, SynthError> {
     match mode {
         CodegenMode::Vlm => {
@@ -146,7 +143,7 @@ pub async fn synthesize(
     }
 }
 
-fn template(request: &SynthesisRequest<'_>) -> Result<SynthesizedPolicy, SynthError> {
+fn template(request: &SynthesisRequest) -> Result<SynthesizedPolicy, SynthError> {
     let compiled = compile_policy(&request.procedure, &request.objects, request.target).map_err(|e| {
         SynthError::NoProgram {
             message: e.to_string(),

@@ -112,6 +112,30 @@ pub fn png(size: u32, seed: u64) -> Vec<u8> {
     out
 }
 
+/// An 8-bit RGB PNG (as nesy renders them) as a JPEG at `quality`, keeping every `shrink`-th
+/// pixel in each direction: a photograph-like frame made from a rendered one.
+pub fn jpeg_from_png(png_bytes: &[u8], shrink: u32, quality: u8) -> Vec<u8> {
+    let decoder = png::Decoder::new(std::io::Cursor::new(png_bytes));
+    let mut reader = decoder.read_info().expect("a PNG");
+    let mut pixels = vec![0; reader.output_buffer_size().expect("a PNG of known size")];
+    let info = reader.next_frame(&mut pixels).expect("PNG pixels");
+    assert_eq!(info.color_type, png::ColorType::Rgb, "an RGB PNG");
+    let shrink = shrink.max(1);
+    let (width, height) = (info.width / shrink, info.height / shrink);
+    let mut rgb = Vec::with_capacity((width * height * 3) as usize);
+    for y in 0..height {
+        for x in 0..width {
+            let i = ((shrink * y * info.width + shrink * x) * 3) as usize;
+            rgb.extend_from_slice(&pixels[i..i + 3]);
+        }
+    }
+    let mut out = Vec::new();
+    jpeg_encoder::Encoder::new(&mut out, quality)
+        .encode(&rgb, width as u16, height as u16, jpeg_encoder::ColorType::Rgb)
+        .expect("JPEG encoding");
+    out
+}
+
 /// Wraps a transport and records the largest number of calls in flight at once, to test the
 /// client's concurrency cap.
 #[derive(Debug)]

@@ -264,7 +264,6 @@ pub(super) async fn make_code(
                 procedure,
                 source: inputs.setting.source_embodiment,
                 target: inputs.setting.target_embodiment,
-                scene: &target.scene,
             };
             let reasoner =
                 VlmReasoner::new(client.clone()).map_err(|e| (UnitStatus::MethodError, e.to_string()))?;
@@ -471,7 +470,8 @@ async fn execute_code(
     cpu(shared, move || {
         let scene = exec_dir
             .prepare(&target, Some(&code))
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| e.to_string())?
+            .ok_or_else(|| nesy_pipeline::NO_SCENE_TO_EXECUTE.to_owned())?;
         execute::execute(&worker, &code, &scene, &limits).map_err(|e| e.to_string())
     })
     .await

@@ -246,20 +246,21 @@ fn baseline_inputs(inputs: &UnitInputs, fidelity: Fidelity) -> Result<BaselineIn
         keyframes.push(Keyframe { state, observation });
     }
     let target = &inputs.target;
+    let target_state = target.observed_state().map_err(|e| fail(e.to_string()))?.clone();
     let target_observation = if pictures {
         SceneObservation::Images(SceneViews {
             raw: target.raw_views().map_err(|e| fail(e.to_string()))?,
             marked: target.marked_views().map_err(|e| fail(e.to_string()))?,
         })
     } else {
-        SceneObservation::StateText(target.observed.clone())
+        SceneObservation::StateText(target_state.clone())
     };
     Ok(BaselineInputs {
         instruction: target.instruction(&inputs.demo),
         source_objects: demo.metadata.objects.clone(),
         keyframes,
         target_objects: target.objects.clone(),
-        target_state: target.observed.clone(),
+        target_state,
         target_observation,
         vocabulary: Vocabulary::new(),
         end_effector_in_state: inputs.setting.embodiment_in_state

@@ -248,7 +248,7 @@ impl Method for NeSyCr {
             if settings.target_goal {
                 // The target task's goal as its scene states it: what the target instruction
                 // asks for, including subtasks the demonstration never shows.
-                target.goal = Some(super::replan::target_goal(inputs));
+                target.goal = Some(super::replan::target_goal(inputs)?);
             }
             let budget = settings.budget.unwrap_or(setting.budget);
             let config = AdaptConfig {

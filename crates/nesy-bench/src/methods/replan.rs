@@ -37,16 +37,14 @@ pub(super) fn planner_config() -> PlannerConfig {
 
 /// The target's goal as the planner takes it: every scene goal's atoms, and the end effector
 /// open with nothing held ([`nesy_sim::scene::SceneSpec::symbolic_goal`]).
-pub(super) fn target_goal(inputs: &UnitInputs) -> Formula {
-    Formula::And(
-        inputs
-            .target
-            .scene
-            .symbolic_goal()
-            .into_iter()
-            .map(Formula::atom)
-            .collect(),
-    )
+pub(super) fn target_goal(inputs: &UnitInputs) -> Result<Formula, MethodFailure> {
+    let scene = inputs
+        .target
+        .sim_scene()
+        .map_err(|e| MethodFailure::new(FailureKind::Method, e.to_string()))?;
+    Ok(Formula::And(
+        scene.symbolic_goal().into_iter().map(Formula::atom).collect(),
+    ))
 }
 
 impl Method for Replan {
@@ -80,18 +78,15 @@ impl Method for Replan {
         async move {
             let world =
                 WorldDomain::builtin().map_err(|e| MethodFailure::new(FailureKind::Method, e.to_string()))?;
-            let goal = target_goal(inputs);
+            let goal = target_goal(inputs)?;
+            let fail =
+                |e: nesy_pipeline::PipelineError| MethodFailure::new(FailureKind::Method, e.to_string());
+            let observed = inputs.target.observed_state().map_err(fail)?;
+            let embodiment = inputs.target.sim_scene().map_err(fail)?.embodiment;
             let objects: Vec<Symbol> = inputs.target.objects.iter().map(|o| Symbol::new(o)).collect();
             let started = std::time::Instant::now();
-            let procedure = plan_to_goal(
-                world,
-                &inputs.target.observed,
-                &goal,
-                inputs.target.scene.embodiment,
-                &objects,
-                &planner_config(),
-            )
-            .map_err(|e| MethodFailure::new(FailureKind::Unresolved, format!("no plan: {e}")))?;
+            let procedure = plan_to_goal(world, observed, &goal, embodiment, &objects, &planner_config())
+                .map_err(|e| MethodFailure::new(FailureKind::Unresolved, format!("no plan: {e}")))?;
             let symbolic = started.elapsed().as_secs_f64();
             Ok(Specified {
                 spec: Specification::Procedure {

@@ -28,8 +28,11 @@ pub(crate) struct AdaptArgs {
     /// The demonstration: `demo.mcap`, a folder holding it, or a folder with `manifest.json`.
     #[arg(long, value_name = "DIR")]
     pub demo: PathBuf,
-    /// The target scene (`scene.json`); defaults to the target scene recorded in the demo.
-    #[arg(long, value_name = "SCENE")]
+    /// The target: a simulated scene (`scene.json`), or a camera target folder (the demo
+    /// layout with one keyframe: the camera's frames, the object list, the instruction and
+    /// the robot; optionally `scene.json` beside its manifest to execute on). Defaults to the
+    /// target scene recorded in the demo.
+    #[arg(long, value_name = "SCENE|DIR")]
     pub target: Option<PathBuf>,
     /// The task's predicates and object kinds (a TOML vocabulary file); the default is the
     /// benchmark's fifteen predicates.
@@ -60,7 +63,8 @@ pub(crate) struct AdaptArgs {
     /// Code synthesis: the VLM's code-generation prompt, or the deterministic template compiler.
     #[arg(long, value_enum, default_value_t = CodegenMode::Vlm)]
     pub codegen: CodegenMode,
-    /// Run the policy in the sandbox against the target scene and score it.
+    /// Run the policy in the sandbox against the target scene and score it (a camera target
+    /// needs a `scene.json` beside its manifest for this).
     #[arg(long)]
     pub execute: bool,
     /// Output directory (default `runs/adapt/<demo name>`).
@@ -402,6 +406,9 @@ fn summarize_policy(out: &mut String, run: &AdaptRun) {
 
 /// The episode's outcome and goal checks, when the policy ran.
 fn summarize_execution(out: &mut String, run: &AdaptRun) {
+    if let Some(reason) = &run.not_executed {
+        let _ = writeln!(out, "  execute   {reason}");
+    }
     if let Some(x) = &run.execution {
         let r = &x.result;
         let _ = writeln!(

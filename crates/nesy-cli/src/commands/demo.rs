@@ -8,7 +8,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use nesy_import::{DEFAULT_VIEW, ImportOptions, KeyframeMode};
+use nesy_import::{AutoSettings, DEFAULT_VIEW, ImportOptions, KeyframeMode, MIN_MOTION, MIN_REST_S};
 use nesy_sim::demo::DemoEmbodiment;
 
 /// Arguments of `nesy demo`.
@@ -46,6 +46,14 @@ pub(crate) enum DemoAction {
         /// default for a folder, and the only choice for the authors' format).
         #[arg(long, value_name = "MODE", value_parser = parse_mode)]
         keyframes: Option<KeyframeMode>,
+        /// `auto`: the least luma difference (0-255, over the 4-pixel block of a 128-pixel
+        /// thumbnail where it is largest) that counts as motion; a noisy camera raises it by
+        /// itself to three times its quiet level.
+        #[arg(long, value_name = "LUMA", default_value_t = MIN_MOTION)]
+        min_motion: f32,
+        /// `auto`: seconds the pictures must stay still for the scene to be at rest.
+        #[arg(long, value_name = "SECONDS", default_value_t = MIN_REST_S)]
+        min_rest: f64,
         /// Frames per second of a frames folder (needed by auto, every: and at:; a video
         /// carries its own times).
         #[arg(long, value_name = "FPS")]
@@ -63,6 +71,12 @@ pub(crate) enum DemoAction {
         /// format).
         #[arg(long, value_enum)]
         demonstrator: Option<DemonstratorArg>,
+        /// The ground truth of a simulated demonstration video (`demo.video.json` from
+        /// `nesy record --video`): keyframes get the recording's states at their frames (and
+        /// the recorded calls of the true keyframes they match), the task and robot come from
+        /// it, and the chosen keyframes are scored against the true ones.
+        #[arg(long, value_name = "FILE")]
+        truth: Option<PathBuf>,
         /// Print the import report as JSON.
         #[arg(long)]
         json: bool,
@@ -79,11 +93,14 @@ pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         source,
         out,
         keyframes,
+        min_motion,
+        min_rest,
         fps,
         view,
         instruction,
         objects,
         demonstrator,
+        truth,
         json,
     } = args.action;
     let keyframes = keyframes.unwrap_or(if nesy_import::is_video(&source) {
@@ -93,6 +110,10 @@ pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     });
     let options = ImportOptions {
         keyframes,
+        auto: AutoSettings {
+            min_motion,
+            min_rest_s: min_rest,
+        },
         fps,
         view,
         instruction,
@@ -107,6 +128,7 @@ pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
             DemonstratorArg::Finger => DemoEmbodiment::Finger,
             DemonstratorArg::Vacuum => DemoEmbodiment::Vacuum,
         }),
+        truth,
     };
     let report = nesy_import::import(&source, &out, &options)?;
     if json {
@@ -128,5 +150,25 @@ pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         report.contact_sheet.display(),
         report.out.display()
     )?;
+    if let Some(m) = &report.truth_match {
+        let seconds = |times: &[f64]| {
+            times
+                .iter()
+                .map(|t| format!("{t:.2}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        outln!(
+            "  against the recording's {} true keyframes (within {} s): recall {:.1}% ({} found), precision {:.1}% ({} extra)\n  missed (s)     {}\n  extra (s)      {}",
+            m.truth,
+            m.tolerance_s,
+            100.0 * m.recall(),
+            m.matched,
+            100.0 * m.precision(),
+            m.extra.len(),
+            seconds(&m.missed),
+            seconds(&m.extra)
+        )?;
+    }
     Ok(ExitCode::SUCCESS)
 }

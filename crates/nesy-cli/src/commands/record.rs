@@ -1,13 +1,20 @@
 //! `nesy record`: run the scripted expert on one side of a benchmark scenario and write the
-//! demonstration as `DIR/demo.mcap`, with the scenario's target scene as `DIR/target.json`.
+//! demonstration as `DIR/demo.mcap`, with the scenario's target scene as `DIR/target.json`;
+//! with `--video`, also a continuous video of one camera (`DIR/demo.mp4`) and its ground truth
+//! (`DIR/demo.video.json`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
-use nesy_sim::demo::{RecordOptions, record_scene, write_mcap_file};
-use nesy_sim::perception::render::{MAX_RENDER_THREADS, VIEW_SIZE, default_threads};
+use nesy_sim::demo::{
+    RecordOptions, Recording, VIDEO_TRUTH_FILE, VideoOptions, VideoTruth, record_scene, record_scene_video,
+    write_mcap_file,
+};
+use nesy_sim::perception::render::{
+    CORNER_CAMERA, Camera, MAX_RENDER_THREADS, VIEW_SIZE, default_threads, filming_camera,
+};
 use nesy_sim::tasks::scenario::{self, Side};
 
 use super::scenarios::{SideArg, load_suite};
@@ -33,6 +40,81 @@ pub(crate) struct RecordArgs {
     /// Read the configurations from this directory instead of generating them.
     #[arg(long)]
     pub suite: Option<PathBuf>,
+    /// Also film the demonstration: `DIR/demo.mp4` (H.264, one camera, a fixed frame rate,
+    /// from the first keyframe to the end of the episode) and `DIR/demo.video.json` (the true
+    /// keyframe times and the state at every frame). The robot then holds still for `--hold`
+    /// seconds after each action.
+    #[arg(long)]
+    pub video: bool,
+    /// The camera filmed: `corner` (above the table's front-right corner, where a person
+    /// filming would stand; not a benchmark view) or one of the benchmark's three.
+    #[arg(long, value_enum, default_value = "corner")]
+    pub video_view: VideoViewArg,
+    /// Video frames per second (it must divide the simulator's 100 control steps per second).
+    #[arg(long, default_value_t = 10)]
+    pub video_fps: u32,
+    /// Video frame side in pixels (even).
+    #[arg(long, default_value_t = 256)]
+    pub video_size: u32,
+    /// Seconds the robot holds still after each action while filming.
+    #[arg(long, default_value_t = 0.5)]
+    pub hold: f64,
+}
+
+/// A camera to film, as the command line writes it.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub(crate) enum VideoViewArg {
+    /// Above and beyond the table's front-right corner.
+    Corner,
+    /// Looking down on the table.
+    Top,
+    /// Facing the robot from beyond the table.
+    Front,
+    /// From behind the robot.
+    Back,
+}
+
+impl VideoViewArg {
+    fn camera(self) -> Camera {
+        let name = match self {
+            VideoViewArg::Corner => CORNER_CAMERA.name,
+            VideoViewArg::Top => "top",
+            VideoViewArg::Front => "front",
+            VideoViewArg::Back => "back",
+        };
+        filming_camera(name).unwrap_or(CORNER_CAMERA)
+    }
+}
+
+/// Records `scene` while a second thread encodes the video's frames as they come.
+fn record_with_video(
+    scene: &nesy_sim::scene::SceneSpec,
+    options: &RecordOptions,
+    video: &VideoOptions,
+    path: &std::path::Path,
+) -> anyhow::Result<(Recording, VideoTruth)> {
+    // A few frames of slack keep the renderer and the encoder both busy.
+    let (frames, received) = std::sync::mpsc::sync_channel::<nesy_sim::demo::VideoFrame>(4);
+    let mut writer = nesy_import::VideoWriter::create(path, f64::from(video.fps))?;
+    let encoder = std::thread::spawn(move || -> Result<usize, nesy_import::ImportError> {
+        for frame in received {
+            writer.push(&frame.image)?;
+        }
+        writer.finish()
+    });
+    let recorded = record_scene_video(scene, options, video, frames);
+    let encoded = encoder
+        .join()
+        .map_err(|_| anyhow::anyhow!("the video encoder thread stopped unexpectedly"))?;
+    let recorded = recorded?;
+    let written = encoded?;
+    anyhow::ensure!(
+        written == recorded.1.frames,
+        "{}: {written} frame(s) written of {} rendered",
+        path.display(),
+        recorded.1.frames
+    );
+    Ok(recorded)
 }
 
 /// Runs `nesy record`. Exit 1 when the expert does not reach `full_success`, or knocks a
@@ -54,8 +136,27 @@ pub(crate) fn run(args: RecordArgs) -> anyhow::Result<ExitCode> {
         side: Some(side.as_str().to_owned()),
         target_scene: Some(target.clone()),
     };
+    let video = VideoOptions {
+        camera: args.video_view.camera(),
+        size: args.video_size,
+        fps: args.video_fps,
+        hold_seconds: args.hold,
+    };
+    if args.video {
+        video.check().map_err(anyhow::Error::msg)?;
+    }
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let started = Instant::now();
-    let recording = record_scene(&scene, &options).with_context(|| format!("recording {}", scenario.id))?;
+    let video_path = args.out.join("demo.mp4");
+    let (recording, truth) = if args.video {
+        let (recording, truth) = record_with_video(&scene, &options, &video, &video_path)
+            .with_context(|| format!("recording {} with a video", scenario.id))?;
+        (recording, Some(truth))
+    } else {
+        let recording =
+            record_scene(&scene, &options).with_context(|| format!("recording {}", scenario.id))?;
+        (recording, None)
+    };
     let mcap = args.out.join("demo.mcap");
     write_mcap_file(&recording.demo, &mcap)?;
     let target_path = args.out.join("target.json");
@@ -66,6 +167,22 @@ pub(crate) fn run(args: RecordArgs) -> anyhow::Result<ExitCode> {
     let size = std::fs::metadata(&mcap).map(|m| m.len()).unwrap_or(0);
     outln!("{}", mcap.display())?;
     outln!("{}", target_path.display())?;
+    if let Some(truth) = &truth {
+        let truth_path = args.out.join(VIDEO_TRUTH_FILE);
+        truth.write(&truth_path)?;
+        outln!("{}", video_path.display())?;
+        outln!("{}", truth_path.display())?;
+        eprintln!(
+            "video: {} frames at {} fps ({}, {}x{}), {} true keyframes, {} state changes",
+            truth.frames,
+            truth.fps,
+            truth.camera,
+            truth.width,
+            truth.height,
+            truth.keyframes.len(),
+            truth.states.len().saturating_sub(1)
+        );
+    }
     eprintln!(
         "{} {side}: {keyframes} keyframes, {:.1} simulated s; {}; {:.2} s wall ({:.2} s simulating, {:.2} s rendering; {:.0} ms simulating per keyframe); {:.2} MB",
         scenario.id,

@@ -15,6 +15,7 @@ mod adapt_realstyle;
 mod adapt_task_files;
 mod bench_baselines;
 mod bench_cli;
+mod camera_target;
 mod cassette_cli;
 mod demo_import;
 mod real_model;

@@ -16,6 +16,7 @@
 mod folder;
 pub mod mcap_format;
 mod record;
+mod video;
 
 use std::path::{Path, PathBuf};
 
@@ -31,7 +32,13 @@ pub use folder::{
     manifest_schema, read_folder, view_order_key, write_folder,
 };
 pub use mcap_format::{read_mcap, read_mcap_bytes, write_mcap, write_mcap_file};
-pub use record::{ExpertRun, RecordError, RecordOptions, Recording, record_scene, run_expert};
+pub use record::{
+    ExpertRun, RecordError, RecordOptions, Recording, record_scene, record_scene_video, run_expert,
+};
+pub use video::{
+    StateSpan, TrueKeyframe, VIDEO_TRUTH_FILE, VIDEO_TRUTH_VERSION, VideoFrame, VideoOptions, VideoTruth,
+    control_rate,
+};
 
 /// Version of nesy that wrote a demo (this build's crate version).
 pub const NESY_VERSION: &str = env!("CARGO_PKG_VERSION");

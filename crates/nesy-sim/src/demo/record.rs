@@ -1,15 +1,18 @@
 //! Recording a demo: the scripted expert runs in the simulator while a hook captures a
 //! keyframe (three views plain and labelled, the observer's state, the call) after every
-//! completed action call, plus the initial keyframe.
+//! completed action call, plus the initial keyframe. Optionally a second hook films one
+//! camera at a fixed frame rate throughout ([`record_scene_video`]).
 
+use std::sync::mpsc::SyncSender;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use super::video::{StateSpan, TrueKeyframe, VIDEO_TRUTH_VERSION, VideoFrame, VideoOptions, VideoTruth};
 use super::{
     CameraImages, CameraName, Demo, DemoMetadata, Demonstrator, Keyframe, KeyframeViews, NESY_VERSION,
 };
 use crate::api::{RobotApi, TraceEntry};
-use crate::perception::render::{View, render_views};
+use crate::perception::render::{Camera, View, render_camera, render_views};
 use crate::scene::{SceneError, SceneSpec};
 use crate::tasks::experts::{self, ExpertError};
 use crate::tasks::goal::{EpisodeOutcome, GoalError, GoalMonitor};
@@ -139,9 +142,123 @@ fn encode_views(views: &[View]) -> KeyframeViews {
     KeyframeViews::from_fn(images).unwrap_or_default()
 }
 
+/// What the video hook collects besides the frames it sends.
+#[derive(Default)]
+struct Filmed {
+    frames: usize,
+    states: Vec<StateSpan>,
+    /// The receiver hung up: frames are no longer rendered.
+    closed: bool,
+    render_wall: Duration,
+}
+
+/// The filming hook: one camera every `interval` control steps.
+struct VideoHook {
+    camera: Camera,
+    size: u32,
+    render_threads: usize,
+    interval: u64,
+    frames: SyncSender<VideoFrame>,
+    fps: u32,
+    filmed: Arc<Mutex<Filmed>>,
+}
+
+impl VideoHook {
+    fn film(&self, sim: &Sim) {
+        let mut filmed = self.filmed.lock().unwrap_or_else(|e| e.into_inner());
+        if filmed.closed {
+            return;
+        }
+        let started = Instant::now();
+        let image = render_camera(sim, &self.camera, self.size, self.size, self.render_threads);
+        let state = crate::perception::observer::observe(sim);
+        let index = filmed.frames;
+        if filmed.states.last().is_none_or(|s| s.state != state) {
+            filmed.states.push(StateSpan {
+                first_frame: index,
+                state,
+            });
+        }
+        filmed.frames += 1;
+        let frame = VideoFrame {
+            index,
+            time: index as f64 / f64::from(self.fps),
+            image,
+        };
+        if self.frames.send(frame).is_err() {
+            filmed.closed = true;
+        }
+        filmed.render_wall += started.elapsed();
+    }
+}
+
+impl SimHook for VideoHook {
+    fn step_interval(&self) -> Option<u64> {
+        Some(self.interval)
+    }
+
+    fn on_step(&mut self, sim: &Sim) {
+        self.film(sim);
+    }
+}
+
 /// Builds `scene`, runs the scripted expert on its goals while recording keyframes, and
 /// finishes the episode with the goal checker.
 pub fn record_scene(scene: &SceneSpec, options: &RecordOptions) -> Result<Recording, RecordError> {
+    record(scene, options, None).map(|(recording, _)| recording)
+}
+
+/// [`record_scene`] while filming `video.camera` at `video.fps` from the first keyframe to
+/// the end of the episode: each frame goes to `frames` as soon as it is rendered (a closed
+/// receiver stops the filming, not the recording), and the robot holds still for
+/// `video.hold_seconds` after each action. Returns the recording and the video's ground
+/// truth: the true keyframes' frames and the observer's state at every frame.
+pub fn record_scene_video(
+    scene: &SceneSpec,
+    options: &RecordOptions,
+    video: &VideoOptions,
+    frames: SyncSender<VideoFrame>,
+) -> Result<(Recording, VideoTruth), RecordError> {
+    let (recording, filmed) = record(scene, options, Some((video, frames)))?;
+    let truth = video_truth(&recording.demo, video, filmed);
+    Ok((recording, truth))
+}
+
+/// The ground truth of a filmed recording.
+fn video_truth(demo: &Demo, video: &VideoOptions, filmed: Filmed) -> VideoTruth {
+    VideoTruth {
+        format_version: VIDEO_TRUTH_VERSION,
+        instruction: demo.metadata.instruction.clone(),
+        objects: demo.metadata.objects.clone(),
+        embodiment: demo.metadata.embodiment,
+        scenario_id: demo.metadata.scenario_id.clone(),
+        side: demo.metadata.side.clone(),
+        camera: video.camera.name.to_owned(),
+        width: video.size,
+        height: video.size,
+        fps: video.fps,
+        hold_seconds: video.hold_seconds,
+        frames: filmed.frames,
+        keyframes: demo
+            .keyframes
+            .iter()
+            .map(|k| TrueKeyframe {
+                index: k.index,
+                time: k.time,
+                frame: ((k.time * f64::from(video.fps)).round() as usize)
+                    .min(filmed.frames.saturating_sub(1)),
+                action: k.action.clone(),
+            })
+            .collect(),
+        states: filmed.states,
+    }
+}
+
+fn record(
+    scene: &SceneSpec,
+    options: &RecordOptions,
+    video: Option<(&VideoOptions, SyncSender<VideoFrame>)>,
+) -> Result<(Recording, Filmed), RecordError> {
     let started = Instant::now();
     let mut sim = Sim::new(scene)?;
     let monitor = GoalMonitor::attach(&mut sim)?;
@@ -153,12 +270,29 @@ pub fn record_scene(scene: &SceneSpec, options: &RecordOptions) -> Result<Record
     };
     hook.capture(&sim, None);
     sim.add_hook(Box::new(hook));
+    let filmed = Arc::new(Mutex::new(Filmed::default()));
+    if let Some((video, frames)) = &video {
+        let hook = VideoHook {
+            camera: video.camera,
+            size: video.size,
+            render_threads: options.render_threads.max(1),
+            interval: video.step_interval(),
+            frames: frames.clone(),
+            fps: video.fps,
+            filmed: filmed.clone(),
+        };
+        hook.film(&sim);
+        sim.add_hook(Box::new(hook));
+        sim.set_action_pause(video.hold_steps());
+    }
     let expert_error = experts::run(&mut sim, scene).err();
     let outcome = monitor.finish(&mut sim);
     // The recorder is done: later calls (the object list below) add no keyframes.
     drop(sim.take_hooks());
     let objects = sim.get_obj_names();
-    let captured = std::mem::take(&mut *captured.lock().unwrap_or_else(|e| e.into_inner()));
+    let mut captured = std::mem::take(&mut *captured.lock().unwrap_or_else(|e| e.into_inner()));
+    let mut filmed = std::mem::take(&mut *filmed.lock().unwrap_or_else(|e| e.into_inner()));
+    captured.render_wall += std::mem::take(&mut filmed.render_wall);
     let sim_seconds = match (captured.keyframes.first(), captured.keyframes.last()) {
         (Some(a), Some(b)) => b.time - a.time,
         _ => 0.0,
@@ -177,14 +311,15 @@ pub fn record_scene(scene: &SceneSpec, options: &RecordOptions) -> Result<Record
         },
         keyframes: captured.keyframes,
     };
-    Ok(Recording {
+    let recording = Recording {
         demo,
         outcome,
         expert_error,
         sim_wall: started.elapsed().saturating_sub(captured.render_wall),
         render_wall: captured.render_wall,
         sim_seconds,
-    })
+    };
+    Ok((recording, filmed))
 }
 
 /// The outcome of running the expert on a scene without recording.

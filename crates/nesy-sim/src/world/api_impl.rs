@@ -132,7 +132,11 @@ impl Sim {
             hooks.append(&mut self.hooks);
             self.hooks = hooks;
         }
+        let pause = self.action_pause_steps > 0 && entry.call.is_action() && entry.result.is_ok();
         self.trace.push(entry);
+        if pause {
+            self.step_idle(self.action_pause_steps);
+        }
         result
     }
 

@@ -403,6 +403,7 @@ impl Sim {
             moved_since_reset: false,
             last_push: None,
             hooks: Vec::new(),
+            action_pause_steps: 0,
         };
         sim.check_interpenetration()?;
         for _ in 0..sim.config.settle_steps {

@@ -193,6 +193,9 @@ pub struct Sim {
     /// (a push), until the next `move_to_position` backs off from it.
     pub(crate) last_push: Option<[f64; 3]>,
     pub(crate) hooks: Vec<Box<dyn SimHook>>,
+    /// Control steps the robot holds still after each successful action (see
+    /// [`Sim::set_action_pause`]).
+    pub(crate) action_pause_steps: u32,
 }
 
 impl Sim {
@@ -337,6 +340,14 @@ impl Sim {
     /// Registers a hook; it runs until removed.
     pub fn add_hook(&mut self, hook: Box<dyn SimHook>) {
         self.hooks.push(hook);
+    }
+
+    /// Makes the robot hold still for `control_steps` after every successful action, the
+    /// world stepping on meanwhile: the pause a person makes between the steps of a
+    /// demonstration, so that a video of it shows each step's result at rest. Recording a
+    /// demonstration video sets it; it is 0 otherwise.
+    pub fn set_action_pause(&mut self, control_steps: u32) {
+        self.action_pause_steps = control_steps;
     }
 
     /// Removes and returns every hook.

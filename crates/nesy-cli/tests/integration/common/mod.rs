@@ -45,6 +45,27 @@ pub(crate) fn run(args: &[&str]) -> (Option<i32>, String, String) {
     )
 }
 
+/// Runs `nesy adapt --demo DEMO --target TARGET --vlm VLM --out OUT` followed by `more`: its
+/// exit code, stdout and stderr.
+pub(crate) fn adapt(
+    demo: &Path,
+    target: &Path,
+    vlm: &str,
+    out: &Path,
+    more: &[&str],
+) -> (Option<i32>, String, String) {
+    let (demo, target, out) = (
+        demo.display().to_string(),
+        target.display().to_string(),
+        out.display().to_string(),
+    );
+    let mut args = vec![
+        "adapt", "--demo", &demo, "--target", &target, "--vlm", vlm, "--out", &out,
+    ];
+    args.extend_from_slice(more);
+    run(&args)
+}
+
 /// Runs the `nesy` binary with `args` and only the VLM settings of `env` (`(name, value)`).
 pub(crate) fn nesy_with_env(args: &[String], env: &[(&str, &str)]) -> Output {
     let mut command = Command::new(env!("CARGO_BIN_EXE_nesy"));
