@@ -29,6 +29,7 @@ seed manifest seeds/manifest/*
 seed unit_records seeds/unit_records/*
 seed policy_source seeds/policy_source/*
 seed vocabulary_file ../fixtures/vocabulary/*.toml
+seed video_truth seeds/video_truth/*
 seed pddl ../fixtures/pddl/*/*.pddl ../assets/pddl/*.pddl ../fixtures/planning/*.pddl
 seed plan ../fixtures/pddl/*/*.plan
 

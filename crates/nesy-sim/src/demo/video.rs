@@ -185,7 +185,12 @@ impl VideoTruth {
     pub fn read(path: &Path) -> Result<VideoTruth, DemoError> {
         let bytes =
             nesy_input::read_bytes(path, nesy_input::MAX_JSON_BYTES).map_err(|e| DemoError::io(path, e))?;
-        let truth: VideoTruth = DemoError::parse_json(path, "video truth", &bytes)?;
+        Self::parse(path, &bytes)
+    }
+
+    /// [`VideoTruth::read`] on bytes already read; `path` names them in errors.
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<VideoTruth, DemoError> {
+        let truth: VideoTruth = DemoError::parse_json(path, "video truth", bytes)?;
         let bad = |field: &str, expected: &str, found: String| {
             Err(DemoError::invalid(
                 path,
@@ -301,6 +306,17 @@ mod tests {
             error.contains("field `states`") && error.contains("increasing"),
             "{error}"
         );
+    }
+
+    #[test]
+    fn every_truncation_is_refused_with_the_file_named() {
+        let text = serde_json::to_string_pretty(&truth()).unwrap();
+        let path = Path::new("demo.video.json");
+        assert_eq!(VideoTruth::parse(path, text.as_bytes()).unwrap(), truth());
+        for cut in 0..text.len() - 1 {
+            let error = VideoTruth::parse(path, &text.as_bytes()[..cut]).unwrap_err();
+            assert!(error.to_string().starts_with("demo.video.json"), "{error}");
+        }
     }
 
     #[test]
