@@ -255,10 +255,10 @@ fn import_video(source: &Path, out: &Path, options: &ImportOptions) -> Result<Im
     let truth = options
         .truth
         .as_deref()
-        .map(nesy_sim::demo::VideoTruth::read)
+        .map(|path| nesy_sim::demo::VideoTruth::read(path).map(|truth| (path, truth)))
         .transpose()?;
     let told = match &truth {
-        Some(t) => ImportOptions {
+        Some((_, t)) => ImportOptions {
             instruction: options
                 .instruction
                 .clone()
@@ -289,8 +289,8 @@ fn import_video(source: &Path, out: &Path, options: &ImportOptions) -> Result<Im
         Ok(())
     })?;
     let (chosen, motion) = choose(source, options, &info.times, &thumbnails)?;
-    let (states, actions, truth_match) = match (&truth, &options.truth) {
-        (Some(truth), Some(path)) => {
+    let (states, actions, truth_match) = match &truth {
+        Some((path, truth)) => {
             if truth.frames != info.times.len() {
                 return Err(ImportError::invalid(
                     path,
@@ -320,7 +320,7 @@ fn import_video(source: &Path, out: &Path, options: &ImportOptions) -> Result<Im
             }
             (Some(states), Some(actions), Some(matched))
         }
-        _ => (None, None, None),
+        None => (None, None, None),
     };
     // Pass 2: the chosen frames themselves (a video is not held in memory whole).
     let mut pictures = Vec::with_capacity(chosen.len());

@@ -304,21 +304,18 @@ impl TargetInput {
         };
         let frames =
             nesy_sim::demo::read_folder(dir).map_err(|e| bad(format!("reading the camera target: {e}")))?;
-        if frames.keyframes.len() != 1 {
-            return Err(bad(format!(
+        let [keyframe] = <[_; 1]>::try_from(frames.keyframes).map_err(|found: Vec<_>| {
+            bad(format!(
                 "a camera target holds one keyframe (what the camera sees before the robot starts), found {}",
-                frames.keyframes.len()
-            )));
-        }
+                found.len()
+            ))
+        })?;
         if frames.metadata.demonstrator == Demonstrator::Human {
             return Err(bad(
                 "at embodiment: a target names the robot that is to do the task (`finger` or `vacuum`), not `human`"
                     .into(),
             ));
         }
-        let Some(keyframe) = frames.keyframes.into_iter().next() else {
-            return Err(bad("the camera target holds no keyframe".into()));
-        };
         let embodiment = frames.metadata.embodiment;
         let objects = frames.metadata.objects;
         let beside = dir.join(TARGET_SCENE_BESIDE);

@@ -17,26 +17,17 @@ const VOCABULARY: &str = "fixtures/vocabulary/fine-parts.toml";
 
 /// The oracle run of the quick-start task, recording its calls to `cassette`.
 fn adapt(out: &Path, cassette: &Path, extra: &[&str]) -> (Option<i32>, String, String) {
-    let (out, cassette) = (out.display().to_string(), cassette.display().to_string());
-    let mut args = vec![
-        "adapt",
-        "--demo",
-        DEMO,
-        "--target",
-        TARGET,
-        "--vlm",
-        "oracle",
+    let cassette = cassette.display().to_string();
+    let mut more = vec![
         "--states",
         "observed",
         "--codegen",
         "template",
         "--record",
         &cassette,
-        "--out",
-        &out,
     ];
-    args.extend_from_slice(extra);
-    common::run(&args)
+    more.extend_from_slice(extra);
+    common::adapt(Path::new(DEMO), Path::new(TARGET), "oracle", out, &more)
 }
 
 fn keys(cassette: &Path) -> BTreeSet<String> {
@@ -179,38 +170,25 @@ fn a_vocabulary_file_admits_its_predicates_and_bad_ones_are_refused_by_line() {
     let scratch = common::scratch();
     let demo = scratch.path().join("demo");
     demo_with("(Gathered red_cylinder)", &demo);
-    let demo = demo.display().to_string();
-    let out = scratch.path().join("out").display().to_string();
-    let base = [
-        "adapt",
-        "--demo",
-        &demo,
-        "--target",
-        TARGET,
-        "--vlm",
-        "oracle",
-        "--states",
-        "observed",
-        "--codegen",
-        "template",
-        "--out",
-        &out,
-    ];
+    let out = scratch.path().join("out");
+    let adapt = |more: &[&str]| {
+        let mut args = vec!["--states", "observed", "--codegen", "template"];
+        args.extend_from_slice(more);
+        common::adapt(&demo, Path::new(TARGET), "oracle", &out, &args)
+    };
 
-    let (code, _, stderr) = common::run(&base);
+    let (code, _, stderr) = adapt(&[]);
     assert_eq!(code, Some(2));
     assert!(
         stderr.contains("`Gathered` is not one of the task's predicates"),
         "{stderr}"
     );
 
-    let mut with_vocabulary = base.to_vec();
-    with_vocabulary.extend(["--vocabulary", VOCABULARY]);
-    let (code, _, stderr) = common::run(&with_vocabulary);
+    let (code, _, stderr) = adapt(&["--vocabulary", VOCABULARY]);
     // red_cylinder has no declared kind, so it may be Gathered; the oracle's run goes on to
     // its own outcome.
     assert!(matches!(code, Some(0 | 1)), "{stderr}");
-    let declared = summary(Path::new(&out))["declared_predicates"].clone();
+    let declared = summary(&out)["declared_predicates"].clone();
     assert!(
         declared.to_string().contains("(Gathered ?x - parts)"),
         "{declared}"
@@ -223,10 +201,9 @@ fn a_vocabulary_file_admits_its_predicates_and_bad_ones_are_refused_by_line() {
         format!("{text}\n[[predicates]]\nname = \"Gathered\"\nparams = [\"x\"]\nmeaning = \"again\"\n"),
     )
     .unwrap();
-    let mut twice = base.to_vec();
     let bad_path = bad.display().to_string();
-    twice.extend(["--vocabulary", &bad_path]);
-    let (code, _, stderr) = common::run(&twice);
+    let twice = ["--vocabulary", bad_path.as_str()];
+    let (code, _, stderr) = adapt(&twice);
     assert_eq!(code, Some(2));
     assert!(stderr.contains("bad.toml"), "{stderr}");
     assert!(
@@ -243,7 +220,7 @@ fn a_vocabulary_file_admits_its_predicates_and_bad_ones_are_refused_by_line() {
         ),
     )
     .unwrap();
-    let (code, _, stderr) = common::run(&twice);
+    let (code, _, stderr) = adapt(&twice);
     assert_eq!(code, Some(2));
     assert!(stderr.contains("already exists with arity 2"), "{stderr}");
 }

@@ -25,24 +25,20 @@ fn an_authors_format_demo_imports_and_adapts() {
     );
     assert!(stdout.contains("contact_sheet.png"), "{stdout}");
 
-    let out = scratch.path().join("run").display().to_string();
-    let (code, stdout, stderr) = common::run(&[
-        "adapt",
-        "--demo",
-        &demo,
-        "--target",
-        "fixtures/demos/adapt-realstyle/target.json",
-        "--vlm",
+    let (code, stdout, stderr) = common::adapt(
+        Path::new(&demo),
+        Path::new("fixtures/demos/adapt-realstyle/target.json"),
         "oracle",
-        "--states",
-        "observed",
-        "--codegen",
-        "template",
-        "--execute",
-        "--out",
-        &out,
-        "--json",
-    ]);
+        &scratch.path().join("run"),
+        &[
+            "--states",
+            "observed",
+            "--codegen",
+            "template",
+            "--execute",
+            "--json",
+        ],
+    );
     assert_eq!(code, Some(0), "{stdout}\n{stderr}");
     let summary: Value = serde_json::from_str(&stdout).unwrap();
     assert_eq!(summary["status"], "succeeded", "{stdout}");
