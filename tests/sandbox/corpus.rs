@@ -235,7 +235,6 @@ fn worker_reports_setup_errors() {
     let spec = EpisodeSpec::Scene {
         path: "/nonexistent/scene.json".into(),
         embodiment: None,
-        render_every: 0,
     };
     let err = run_policy(&worker(), "pass", &spec, &limits()).unwrap_err();
     assert!(err.to_string().contains("/nonexistent/scene.json"), "{err}");
@@ -288,7 +287,6 @@ fn worker_overhead_figures() {
     let spec = EpisodeSpec::Scene {
         path: scene,
         embodiment: None,
-        render_every: 0,
     };
     let result = run_policy(&worker(), &source, &spec, &limits).unwrap();
     assert!(result.is_ok(), "{:?}", result.outcome);

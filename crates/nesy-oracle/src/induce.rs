@@ -52,23 +52,6 @@ fn schema_fits_call(schema: &str, embodiment: Embodiment, function: &str, tool_f
     own == Some(function) || tool_free && function == "move_to_position" && own == Some("move_gripper_to")
 }
 
-/// The object or handle a recorded call names (`obj_name` or `handle_name`), if any.
-fn call_object(call: &ApiCall) -> Option<&str> {
-    match call {
-        ApiCall::IsObjVisible { obj_name }
-        | ApiCall::GetObjPos { obj_name }
-        | ApiCall::GetObjBbox { obj_name }
-        | ApiCall::GetObjSize { obj_name }
-        | ApiCall::ObjInGripper { obj_name }
-        | ApiCall::GetEmptyFloorXy { obj_name }
-        | ApiCall::MoveGripperTo { obj_name, .. } => Some(obj_name),
-        ApiCall::GraspHandle { handle_name } | ApiCall::AttachVacuumHandle { handle_name } => {
-            Some(handle_name)
-        }
-        _ => None,
-    }
-}
-
 /// The oracle's answer for one transition.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct InducedAction {
@@ -89,6 +72,9 @@ pub struct InducedAction {
     pub unexpected: Vec<Atom>,
     /// Schema preconditions that do not hold in s_t (left out of the reply).
     pub dropped_preconditions: Vec<String>,
+    /// For a transition that holds two steps (a keyframe between them was not chosen), the
+    /// schema of the first, a tool step; `schema` and `args` then name both.
+    pub hidden_step: Option<String>,
 }
 
 /// Why the oracle could not answer a request.
@@ -130,7 +116,7 @@ fn focus_object(call: Option<&ApiCall>, prev: &State, next: &State) -> Option<Sy
     if let Some(c) = call
         && c.name() == "move_gripper_to"
     {
-        return call_object(c).map(Symbol::new);
+        return c.object().map(Symbol::new);
     }
     let find = |s: &State, preds: &[&str]| {
         s.iter()
@@ -176,14 +162,7 @@ fn evaluate(
     prev: &State,
     next: &State,
 ) -> Option<Candidate> {
-    let op = schema.instantiate(&args, universe).ok()?;
-    let unmet = match apply(prev, &op) {
-        Ok(_) => Vec::new(),
-        Err(ExecError::Violation(v)) => v.unmet.into_iter().map(|u| u.literal).collect(),
-        Err(ExecError::Ground(_)) => return None,
-    };
-    let unchecked = Operator::new(op.name.clone(), Vec::new(), op.eff.clone());
-    let produced = apply(prev, &unchecked).ok()?;
+    let (op, unmet, produced) = step(schema, &args, universe, prev)?;
     let d = produced.diff(next);
     Some(Candidate {
         schema: schema.name.clone(),
@@ -226,7 +205,7 @@ pub fn induce(
     names.extend(req.previous.objects());
     names.extend(req.next.objects());
     let universe = world.universe(names.iter().map(|s| s.as_str()));
-    let call_object = call.and_then(call_object);
+    let call_object = call.and_then(ApiCall::object);
     let tool_free = !req
         .previous
         .iter()
@@ -282,6 +261,12 @@ pub fn induce(
             embodiment: ctx.embodiment,
         });
     };
+    let single = best.mismatch + best.unmet.len();
+    if best.mismatch > 0
+        && let Some(action) = two_steps(world, ctx, &universe, call, &schemas, single)
+    {
+        return Ok(action);
+    }
     let exact = best.mismatch == 0;
     let pre: Vec<Formula> = best
         .op
@@ -306,7 +291,166 @@ pub fn induce(
         missing: best.missing,
         unexpected: best.unexpected,
         dropped_preconditions: best.unmet.iter().map(|f| f.to_string()).collect(),
+        hidden_step: None,
     })
+}
+
+/// Whether a schema only works the tool (closes or opens it, takes or lets go of a handle)
+/// without moving the arm.
+fn tool_step(schema: &str, embodiment: Embodiment) -> bool {
+    matches!(
+        api_function(schema, embodiment),
+        Some(
+            "close_gripper"
+                | "open_gripper"
+                | "activate_vacuum"
+                | "deactivate_vacuum"
+                | "grasp_handle"
+                | "attach_vacuum_handle"
+                | "release_handle"
+                | "detach_vacuum_handle"
+        )
+    )
+}
+
+/// A transition no one schema explains, read as two steps: a tool step, then a step that
+/// fits the recorded call (from `second`). Keyframes chosen from a video can miss a grasp or
+/// a release (the fingers close behind the object, suction shows nothing) but not an arm
+/// motion, so the hidden step is looked for among the tool steps only. The pair must
+/// reproduce s_{t+1} exactly and leave fewer preconditions unmet than `single` (the best one
+/// schema's observer mismatches and unmet preconditions); the best such pair is the answer.
+fn two_steps(
+    world: &WorldDomain,
+    ctx: &InductionContext,
+    universe: &Universe,
+    call: Option<&ApiCall>,
+    second: &[Operator],
+    single: usize,
+) -> Option<InducedAction> {
+    let (previous, next) = (&ctx.request.previous, &ctx.request.next);
+    let first_focus = focus_object(None, previous, next);
+    let mut best: Option<(usize, FirstStep, Candidate)> = None;
+    for first in world.schemas_for(ctx.embodiment, universe) {
+        if !tool_step(&first.name, ctx.embodiment) {
+            continue;
+        }
+        let item_first = first.params.first().is_some_and(|p| p.ty.as_str() == "item");
+        for first_args in bindings(&first, universe, first_focus.filter(|_| item_first)) {
+            let Some((op1, unmet1, middle)) = step(&first, &first_args, universe, previous) else {
+                continue;
+            };
+            if middle == *previous || unmet1.len() >= single {
+                continue;
+            }
+            let tool_free = !middle
+                .iter()
+                .any(|a| matches!(a.pred().as_str(), "GripperHolding" | "VacuumAttached"));
+            let focus = focus_object(call, &middle, next);
+            for schema in second {
+                if call.is_some_and(|c| !schema_fits_call(&schema.name, ctx.embodiment, c.name(), tool_free))
+                {
+                    continue;
+                }
+                let item_first = schema.params.first().is_some_and(|p| p.ty.as_str() == "item");
+                for args in bindings(schema, universe, focus.filter(|_| item_first)) {
+                    let Some(c) = evaluate(schema, args, universe, &middle, next) else {
+                        continue;
+                    };
+                    let score = unmet1.len() + c.unmet.len();
+                    if c.mismatch == 0 && score < single && best.as_ref().is_none_or(|b| score < b.0) {
+                        let step = FirstStep {
+                            schema: first.name.clone(),
+                            args: first_args.clone(),
+                            op: op1.clone(),
+                            unmet: unmet1.clone(),
+                        };
+                        best = Some((score, step, c));
+                    }
+                }
+            }
+        }
+    }
+    let (_, first, second) = best?;
+    Some(joined(previous, next, first, second))
+}
+
+/// The hidden tool step of a two-step transition, grounded.
+struct FirstStep {
+    schema: String,
+    args: Vec<Symbol>,
+    op: Operator,
+    /// Its preconditions that do not hold before it.
+    unmet: Vec<Formula>,
+}
+
+/// A schema grounded on `args`, the preconditions it leaves unmet in `from`, and the state
+/// its effects make of `from` (applied whether or not the preconditions hold).
+fn step(
+    schema: &Operator,
+    args: &[Symbol],
+    universe: &Universe,
+    from: &State,
+) -> Option<(Operator, Vec<Formula>, State)> {
+    let op = schema.instantiate(args, universe).ok()?;
+    let unmet = match apply(from, &op) {
+        Ok(_) => Vec::new(),
+        Err(ExecError::Violation(v)) => v.unmet.into_iter().map(|u| u.literal).collect(),
+        Err(ExecError::Ground(_)) => return None,
+    };
+    let unchecked = Operator::new(op.name.clone(), Vec::new(), op.eff.clone());
+    let produced = apply(from, &unchecked).ok()?;
+    Some((op, unmet, produced))
+}
+
+/// The one action two steps make: named by both semantics joined by `then`, holding the
+/// first's preconditions and those of the second that already hold before it (unmet ones
+/// left out, as for one schema), with both steps' effects (or the observed changes, should
+/// the joined effects not reproduce them).
+fn joined(previous: &State, next: &State, first: FirstStep, second: Candidate) -> InducedAction {
+    let FirstStep {
+        schema: first_schema,
+        args: first_args,
+        op: op1,
+        unmet: unmet1,
+    } = first;
+    let mut pre: Vec<Formula> = op1.pre.iter().filter(|f| !unmet1.contains(f)).cloned().collect();
+    for f in second.op.pre.iter() {
+        let holds = apply(previous, &Operator::new("check", vec![f.clone()], Vec::new())).is_ok();
+        if holds && !pre.contains(f) {
+            pre.push(f.clone());
+        }
+    }
+    let mut eff: Vec<Effect> = op1.eff.to_vec();
+    eff.extend(second.op.eff.iter().cloned());
+    let together = Operator::new("together", Vec::new(), eff.clone());
+    if apply(previous, &together).ok().as_ref() != Some(next) {
+        eff = observed_changes(previous, next);
+    }
+    let text = format!(
+        "{} then {}",
+        semantic(&first_schema, &first_args),
+        semantic(&second.schema, &second.args)
+    );
+    let name =
+        normalize_action_name(&text).unwrap_or_else(|| format!("{first_schema}-then-{}", second.schema));
+    let mut args = first_args;
+    args.extend(second.args);
+    let dropped = unmet1
+        .iter()
+        .chain(&second.unmet)
+        .map(|f| f.to_string())
+        .collect();
+    InducedAction {
+        schema: format!("{first_schema} then {}", second.schema),
+        args,
+        semantic: text,
+        operator: Operator::new(name, pre, eff),
+        exact: true,
+        missing: Vec::new(),
+        unexpected: Vec::new(),
+        dropped_preconditions: dropped,
+        hidden_step: Some(first_schema),
+    }
 }
 
 /// The observed changes as effects; an unchanged state is restated by one of its atoms (an
@@ -331,12 +475,14 @@ pub(crate) fn observed_changes(prev: &State, next: &State) -> Vec<Effect> {
 pub(crate) fn format_reply(action: &InducedAction, call: Option<&ApiCall>) -> String {
     let call_text = call.map_or_else(
         || "no recorded call".to_owned(),
-        |c| match call_object(c) {
+        |c| match c.object() {
             Some(o) => format!("{}({o})", c.name()),
             None => format!("{}()", c.name()),
         },
     );
-    let fit = if action.exact {
+    let fit = if action.hidden_step.is_some() {
+        "the transition holds two steps (no keyframe between them), a tool step and then the recorded call, and together they reproduce the current state exactly".to_owned()
+    } else if action.exact {
         "its effects reproduce the current state exactly".to_owned()
     } else {
         format!(

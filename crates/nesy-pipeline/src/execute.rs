@@ -122,7 +122,6 @@ pub fn execute(
     let spec = EpisodeSpec::Scene {
         path: std::path::absolute(scene_path).unwrap_or_else(|_| scene_path.to_owned()),
         embodiment: None,
-        render_every: 0,
     };
     let result = run_policy(worker, code, &spec, limits).map_err(|e| PipelineError::Execute {
         scene: scene_path.to_owned(),

@@ -37,8 +37,6 @@ pub enum EpisodeSpec {
         path: PathBuf,
         /// Overrides the scene's embodiment.
         embodiment: Option<Embodiment>,
-        /// Render every N simulation steps (0 = never).
-        render_every: u32,
     },
     /// The recording test double of [`RecordingRobot`](crate::RecordingRobot): records calls, moves nothing.
     /// For sandbox tests, which exercise the interpreter and the worker, not the robot.
@@ -73,11 +71,5 @@ pub enum EpisodeBuildError {
         path: PathBuf,
         /// Why.
         message: String,
-    },
-    /// The episode asks for something this build does not do.
-    #[error("cannot build the episode: {feature} is not implemented yet")]
-    Unsupported {
-        /// What was asked for.
-        feature: String,
     },
 }

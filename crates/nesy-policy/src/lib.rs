@@ -22,7 +22,6 @@
 //! let spec = EpisodeSpec::Scene {
 //!     path: "scene.json".into(),
 //!     embodiment: None,
-//!     render_every: 0,
 //! };
 //! let result = run_policy(&worker, "open_gripper()\n", &spec, &Limits::default()).unwrap();
 //! println!("{:?}: {} API calls", result.outcome, result.trace.len());

@@ -52,16 +52,7 @@ pub struct SimEpisodes;
 impl EpisodeFactory for SimEpisodes {
     fn build(&self, spec: &EpisodeSpec) -> Result<Box<dyn Episode>, EpisodeBuildError> {
         match spec {
-            EpisodeSpec::Scene {
-                path,
-                embodiment,
-                render_every,
-            } => {
-                if *render_every != 0 {
-                    return Err(EpisodeBuildError::Unsupported {
-                        feature: "rendering during a policy run (--render-every)".to_owned(),
-                    });
-                }
+            EpisodeSpec::Scene { path, embodiment } => {
                 let mut scene =
                     nesy_sim::scene::SceneSpec::from_file(path).map_err(|e| scene_error(path, e))?;
                 if let Some(embodiment) = embodiment {

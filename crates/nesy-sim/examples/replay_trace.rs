@@ -13,7 +13,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use nesy_sim::api::{ApiCall, ApiValue, RobotApi, TraceEntry};
+use nesy_sim::api::TraceEntry;
 use nesy_sim::world::{Sim, SimHook};
 
 /// Watches objects every few control steps and prints each step at which one moved.
@@ -60,45 +60,6 @@ impl SimHook for Watch {
     }
 }
 
-/// Replays one call; returns what the simulation answered.
-fn replay(sim: &mut Sim, call: &ApiCall) -> Result<ApiValue, nesy_sim::api::ApiError> {
-    let none = |r: Result<(), nesy_sim::api::ApiError>| r.map(|()| ApiValue::None);
-    match call {
-        ApiCall::IsObjVisible { obj_name } => Ok(ApiValue::Bool(sim.is_obj_visible(obj_name))),
-        ApiCall::GetObjNames => Ok(ApiValue::Names(sim.get_obj_names())),
-        ApiCall::GetObjPos { obj_name } => sim.get_obj_pos(obj_name).map(ApiValue::Vec3),
-        ApiCall::GetObjBbox { obj_name } => sim.get_obj_bbox(obj_name).map(ApiValue::Bbox),
-        ApiCall::GetObjSize { obj_name } => sim.get_obj_size(obj_name).map(ApiValue::Vec3),
-        ApiCall::GripperIsOpen => Ok(ApiValue::Bool(sim.gripper_is_open())),
-        ApiCall::ObjInGripper { obj_name } => sim.obj_in_gripper(obj_name).map(ApiValue::Bool),
-        ApiCall::GetEmptyFloorXy { obj_name } => sim.get_empty_floor_xy(obj_name).map(ApiValue::Xy),
-        ApiCall::MoveGripperTo {
-            obj_name,
-            pointing_to,
-            depth,
-        } => none(sim.move_gripper_to(obj_name, *pointing_to, *depth)),
-        ApiCall::MoveToPosition {
-            pos,
-            pointing_to,
-            lift_clearance,
-            angle,
-        } => none(sim.move_to_position(*pos, *pointing_to, *lift_clearance, *angle)),
-        ApiCall::MoveParallel {
-            move_dir,
-            offset,
-            pointing_to,
-        } => none(sim.move_parallel(*move_dir, *offset, *pointing_to)),
-        ApiCall::GraspHandle { handle_name } => none(sim.grasp_handle(handle_name)),
-        ApiCall::ReleaseHandle => none(sim.release_handle()),
-        ApiCall::OpenGripper => none(sim.open_gripper()),
-        ApiCall::CloseGripper => none(sim.close_gripper()),
-        ApiCall::AttachVacuumHandle { handle_name } => none(sim.attach_vacuum_handle(handle_name)),
-        ApiCall::DetachVacuumHandle => none(sim.detach_vacuum_handle()),
-        ApiCall::ActivateVacuum => none(sim.activate_vacuum()),
-        ApiCall::DeactivateVacuum => none(sim.deactivate_vacuum()),
-    }
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.len() < 3 {
@@ -132,7 +93,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if let Ok(mut c) = current.lock() {
             *c = format!("#{} {}", entry.index, entry.call.name());
         }
-        let got = replay(&mut sim, &entry.call);
+        let got = entry.call.perform(&mut sim);
         if entry.call.is_action() {
             let tool = sim.tool_pose().translation.vector;
             println!(

@@ -161,6 +161,74 @@ impl ApiCall {
         }
     }
 
+    /// The object or handle the call names (`obj_name` or `handle_name`), if any.
+    pub fn object(&self) -> Option<&str> {
+        match self {
+            ApiCall::IsObjVisible { obj_name }
+            | ApiCall::GetObjPos { obj_name }
+            | ApiCall::GetObjBbox { obj_name }
+            | ApiCall::GetObjSize { obj_name }
+            | ApiCall::ObjInGripper { obj_name }
+            | ApiCall::GetEmptyFloorXy { obj_name }
+            | ApiCall::MoveGripperTo { obj_name, .. } => Some(obj_name),
+            ApiCall::GraspHandle { handle_name } | ApiCall::AttachVacuumHandle { handle_name } => {
+                Some(handle_name)
+            }
+            _ => None,
+        }
+    }
+
+    /// The call as a short caption: the function and its object, handle or target
+    /// (`move_gripper_to(red_cube)`, `move_to_position(0.65, -0.24, 0.67)`, `close_gripper()`).
+    pub fn label(&self) -> String {
+        let argument = match self {
+            ApiCall::MoveToPosition { pos, .. } => format!("{:.2}, {:.2}, {:.2}", pos[0], pos[1], pos[2]),
+            ApiCall::MoveParallel { move_dir, offset, .. } => format!("{}, {offset:.2}", move_dir.as_str()),
+            other => other.object().unwrap_or_default().to_owned(),
+        };
+        format!("{}({argument})", self.name())
+    }
+
+    /// Makes the call on `robot` with its recorded arguments, returning what the robot
+    /// returned: how a recorded trace is replayed.
+    pub fn perform(&self, robot: &mut dyn RobotApi) -> Result<ApiValue, ApiError> {
+        let done = |r: Result<(), ApiError>| r.map(|()| ApiValue::None);
+        match self {
+            ApiCall::IsObjVisible { obj_name } => Ok(ApiValue::Bool(robot.is_obj_visible(obj_name))),
+            ApiCall::GetObjNames => Ok(ApiValue::Names(robot.get_obj_names())),
+            ApiCall::GetObjPos { obj_name } => robot.get_obj_pos(obj_name).map(ApiValue::Vec3),
+            ApiCall::GetObjBbox { obj_name } => robot.get_obj_bbox(obj_name).map(ApiValue::Bbox),
+            ApiCall::GetObjSize { obj_name } => robot.get_obj_size(obj_name).map(ApiValue::Vec3),
+            ApiCall::GripperIsOpen => Ok(ApiValue::Bool(robot.gripper_is_open())),
+            ApiCall::ObjInGripper { obj_name } => robot.obj_in_gripper(obj_name).map(ApiValue::Bool),
+            ApiCall::GetEmptyFloorXy { obj_name } => robot.get_empty_floor_xy(obj_name).map(ApiValue::Xy),
+            ApiCall::MoveGripperTo {
+                obj_name,
+                pointing_to,
+                depth,
+            } => done(robot.move_gripper_to(obj_name, *pointing_to, *depth)),
+            ApiCall::MoveToPosition {
+                pos,
+                pointing_to,
+                lift_clearance,
+                angle,
+            } => done(robot.move_to_position(*pos, *pointing_to, *lift_clearance, *angle)),
+            ApiCall::MoveParallel {
+                move_dir,
+                offset,
+                pointing_to,
+            } => done(robot.move_parallel(*move_dir, *offset, *pointing_to)),
+            ApiCall::GraspHandle { handle_name } => done(robot.grasp_handle(handle_name)),
+            ApiCall::ReleaseHandle => done(robot.release_handle()),
+            ApiCall::OpenGripper => done(robot.open_gripper()),
+            ApiCall::CloseGripper => done(robot.close_gripper()),
+            ApiCall::AttachVacuumHandle { handle_name } => done(robot.attach_vacuum_handle(handle_name)),
+            ApiCall::DetachVacuumHandle => done(robot.detach_vacuum_handle()),
+            ApiCall::ActivateVacuum => done(robot.activate_vacuum()),
+            ApiCall::DeactivateVacuum => done(robot.deactivate_vacuum()),
+        }
+    }
+
     /// True for calls that move the robot or change the gripper (they count against the
     /// action budget and, when they succeed, produce a keyframe); false for perception.
     pub fn is_action(&self) -> bool {

@@ -67,6 +67,12 @@ pub(crate) struct AdaptArgs {
     /// needs a `scene.json` beside its manifest for this).
     #[arg(long)]
     pub execute: bool,
+    /// With `--execute`, record the execution into the output directory: its calls replayed
+    /// on a fresh copy of the target scene give `execution.mcap` (a keyframe after every
+    /// action) and `rollout.mp4` (a frame every N control steps; N divides 100). 0 records
+    /// nothing.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub render_every: u32,
     /// Output directory (default `runs/adapt/<demo name>`).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -131,6 +137,13 @@ fn stopped(
 /// 2 on bad input.
 pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     let options = options(&args)?;
+    if args.render_every != 0 {
+        anyhow::ensure!(
+            args.execute,
+            "--render-every records an execution: it needs --execute"
+        );
+        super::rollout::rollout_fps(args.render_every)?;
+    }
     let setup = VlmSetup {
         source: match &args.vlm {
             Some(text) => VlmSource::parse(text, args.vlm_config.clone(), args.oracle_noise.clone())?,
@@ -170,6 +183,16 @@ pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
         outln!("{}", serde_json::to_string_pretty(&run)?)?;
     } else {
         out!("{}", summary(&run))?;
+    }
+    if let Some(execution) = run.execution.as_ref().filter(|_| args.render_every != 0) {
+        let rollout = super::rollout::record_rollout(
+            &execution.scene_path,
+            None,
+            &execution.result.trace,
+            &run.out_dir,
+            args.render_every,
+        )?;
+        super::rollout::announce(&rollout, "  recording ", args.json)?;
     }
     if let Some(error @ pipeline::synth::SynthError::Call { .. }) = &run.codegen_error {
         eprintln!("error: {error} (outputs written to {})", run.out_dir.display());

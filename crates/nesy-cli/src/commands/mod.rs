@@ -7,6 +7,7 @@ pub(crate) mod demo;
 pub(crate) mod prompts;
 pub(crate) mod record;
 pub(crate) mod render;
+pub(crate) mod rollout;
 pub(crate) mod run;
 pub(crate) mod scenarios;
 pub(crate) mod verify;

@@ -93,21 +93,10 @@ fn record_with_video(
     video: &VideoOptions,
     path: &std::path::Path,
 ) -> anyhow::Result<(Recording, VideoTruth)> {
-    // A few frames of slack keep the renderer and the encoder both busy.
-    let (frames, received) = std::sync::mpsc::sync_channel::<nesy_sim::demo::VideoFrame>(4);
-    let mut writer = nesy_import::VideoWriter::create(path, f64::from(video.fps))?;
-    let encoder = std::thread::spawn(move || -> Result<usize, nesy_import::ImportError> {
-        for frame in received {
-            writer.push(&frame.image)?;
-        }
-        writer.finish()
-    });
-    let recorded = record_scene_video(scene, options, video, frames);
-    let encoded = encoder
-        .join()
-        .map_err(|_| anyhow::anyhow!("the video encoder thread stopped unexpectedly"))?;
+    let (recorded, written) = super::rollout::with_video_encoder(path, video.fps, |frames| {
+        record_scene_video(scene, options, video, frames)
+    })?;
     let recorded = recorded?;
-    let written = encoded?;
     anyhow::ensure!(
         written == recorded.1.frames,
         "{}: {written} frame(s) written of {} rendered",

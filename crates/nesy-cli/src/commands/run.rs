@@ -22,9 +22,14 @@ pub(crate) struct RunArgs {
     /// Print the full execution result as JSON.
     #[arg(long)]
     pub json: bool,
-    /// Render views every N simulation steps (not implemented yet; 0 = never).
-    #[arg(long, default_value_t = 0)]
+    /// Record the execution into `--out`: its calls replayed on a fresh copy of the scene
+    /// give `execution.mcap` (a keyframe after every action) and `rollout.mp4` (a frame every
+    /// N control steps; N divides 100). 0 records nothing.
+    #[arg(long, value_name = "N", default_value_t = 0)]
     pub render_every: u32,
+    /// Where `--render-every` writes its files.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
     /// Wall-clock budget of the policy in seconds.
     #[arg(long, default_value_t = 120.0)]
     pub timeout: f64,
@@ -57,10 +62,17 @@ pub(crate) fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         action_calls: args.max_actions,
         ..Limits::default()
     };
+    let rollout_dir = match (args.render_every, &args.out) {
+        (0, _) => None,
+        (n, Some(out)) => {
+            super::rollout::rollout_fps(n)?;
+            Some(out.clone())
+        }
+        (_, None) => anyhow::bail!("--render-every needs --out DIR, where execution.mcap and rollout.mp4 go"),
+    };
     let spec = EpisodeSpec::Scene {
         path: std::path::absolute(&args.scene).unwrap_or(args.scene.clone()),
         embodiment: args.embodiment,
-        render_every: args.render_every,
     };
     let worker = WorkerCommand::current_exe().context("locating the nesy executable")?;
     let mut result = run_policy(&worker, &source, &spec, &limits)
@@ -71,6 +83,18 @@ pub(crate) fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         outln!("{}", serde_json::to_string_pretty(&result)?)?;
     } else {
         print_summary(&result, &policy_file)?;
+    }
+    if let Some(dir) = rollout_dir
+        && !matches!(result.outcome, Outcome::Rejected { .. })
+    {
+        let rollout = super::rollout::record_rollout(
+            &args.scene,
+            args.embodiment,
+            &result.trace,
+            &dir,
+            args.render_every,
+        )?;
+        super::rollout::announce(&rollout, "recording: ", args.json)?;
     }
     Ok(if result.is_ok() {
         ExitCode::SUCCESS

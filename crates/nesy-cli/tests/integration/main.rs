@@ -18,6 +18,7 @@ mod bench_cli;
 mod camera_target;
 mod cassette_cli;
 mod demo_import;
+mod execution_recording;
 mod real_model;
 mod run_cli;
 mod scenarios_cli;

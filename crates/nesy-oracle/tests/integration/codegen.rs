@@ -2,7 +2,9 @@
 //! the oracle's symbolic actions (one per recorded call), compiled by nesy-sim's template
 //! compiler for the same end effector, and run by nesy-policy in a fresh copy of the scene;
 //! every subtask must end in full success. The light cases run by default; every subtask
-//! on both end effectors runs with `--ignored`.
+//! on both end effectors runs with `--ignored`. A variant hides the keyframes after the
+//! grasps and releases, as keyframes chosen from a video can: each hidden step arrives joined
+//! to the motion after it.
 
 use nesy_core::Embodiment;
 use nesy_core::Operator;
@@ -23,6 +25,18 @@ use nesy_sim::world::Sim;
 use crate::common::Keyframes;
 
 fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodiment) {
+    compiled_plan_succeeds(kind, obst, embodiment, &[]);
+}
+
+/// Runs the expert, induces one action per transition between the keyframes left after the
+/// calls named in `hidden` lose theirs (a hidden call's change arrives with the next call),
+/// compiles the procedure and runs it; returns the procedure.
+fn compiled_plan_succeeds(
+    kind: SubtaskKind,
+    obst: u8,
+    embodiment: Embodiment,
+    hidden: &[&str],
+) -> Vec<Operator> {
     let scene = TaskConfig::single(kind, 2, obst, 1, embodiment)
         .generate()
         .unwrap()
@@ -44,7 +58,12 @@ fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodi
         vocabulary: Vocabulary::default(),
     };
     let mut procedure: Vec<Operator> = Vec::new();
-    for (t, (call, next)) in sim.hook::<Keyframes>().unwrap().calls.iter().enumerate() {
+    let calls = &sim.hook::<Keyframes>().unwrap().calls;
+    let shown = calls
+        .iter()
+        .enumerate()
+        .filter(|(i, (call, _))| *i + 1 == calls.len() || !hidden.contains(&call.name()));
+    for (t, (_, (call, next))) in shown.enumerate() {
         let ctx = InductionContext {
             request: InductionRequest {
                 step: t,
@@ -66,7 +85,7 @@ fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodi
     // approach to a handle changes no relation, like a retreat (the grasp that follows
     // approaches by itself); a carry whose put-down follows may not state the surface.
     use nesy_sim::domain::Motion;
-    for op in &procedure {
+    for op in procedure.iter().filter(|_| hidden.is_empty()) {
         let by_name = nesy_sim::codegen::resolve_action(&op.name, &names).unwrap();
         let by_effects = nesy_sim::codegen::resolve_by_effects(op, &names).unwrap_or_else(|| panic!("{op}"));
         match (by_name.motion, by_effects.motion) {
@@ -104,11 +123,41 @@ fn compiled_expert_plan_succeeds(kind: SubtaskKind, obst: u8, embodiment: Embodi
         "{kind} obst {obst} on {embodiment}:\n{}",
         policy.code
     );
+    procedure
 }
 
 #[test]
 fn pick_place_with_a_stack_on_the_finger_robot() {
     compiled_expert_plan_succeeds(SubtaskKind::PickPlace, 1, Embodiment::Finger);
+}
+
+#[test]
+fn hidden_grasps_and_releases_arrive_joined_to_the_next_motion_and_still_compile() {
+    let procedure = compiled_plan_succeeds(
+        SubtaskKind::PickPlace,
+        1,
+        Embodiment::Finger,
+        &["close_gripper", "open_gripper"],
+    );
+    let names: Vec<&str> = procedure.iter().map(|op| op.name.as_str()).collect();
+    assert!(
+        names
+            .iter()
+            .any(|n| n.starts_with("Grasp") && n.contains("ThenCarry")),
+        "{names:?}"
+    );
+    assert!(
+        names
+            .iter()
+            .any(|n| (n.starts_with("PutDown") || n.starts_with("ReleaseInto")) && n.contains("ThenMoveTo")),
+        "{names:?}"
+    );
+    assert!(
+        names
+            .iter()
+            .all(|n| !n.starts_with("Grasp") || n.contains("Then")),
+        "{names:?}"
+    );
 }
 
 #[test]

@@ -16,7 +16,6 @@ fn run_example(policy: &str, scene: &str, embodiment: Embodiment, expected: &[&s
     let spec = EpisodeSpec::Scene {
         path: root().join("fixtures/scenes").join(scene),
         embodiment: Some(embodiment),
-        render_every: 0,
     };
     let episode = SimEpisodes.build(&spec).unwrap();
     let result = run_in_process(&source, episode, &Limits::default(), None).unwrap();

@@ -198,7 +198,6 @@ fn run_code_example(embodiment: Embodiment) {
         let spec = EpisodeSpec::Scene {
             path: scene_path(&example.scene),
             embodiment: Some(embodiment),
-            render_every: 0,
         };
         let episode = SimEpisodes.build(&spec).unwrap();
         let result = run_in_process(&example.code, episode, &Limits::default(), None).unwrap();

@@ -6,7 +6,9 @@
 //! Actions are recognised by name: the CamelCase form of a schema name followed by the
 //! CamelCase forms of its arguments, e.g. `MoveToSurroundRedCube` is `move-to-surround`
 //! bound to `red_cube` and `CarryIntoBlueCubeToyBox` is `carry-into` bound to
-//! `(blue_cube, toy_box)` (the names the reference responder writes). An action whose name
+//! `(blue_cube, toy_box)` (the names the reference responder writes). Names joined by `Then`
+//! (`GraspRedCubeThenCarryIntoRedCubeToyBox`, a transition that held two steps because no
+//! keyframe was chosen between them) compile to each step in order. An action whose name
 //! names no schema (a model naming its operators freely) is recognised by its effects and
 //! preconditions instead ([`resolve_by_effects`]). A finger schema on the
 //! vacuum robot, or the reverse, compiles to the same motion with the other end effector's
@@ -90,7 +92,7 @@ def clear_angle(name):
 /// One action recognised in a procedure.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ResolvedAction {
-    /// The action's name as given.
+    /// The action's name as given (for one step of a joined action, the part naming it).
     pub name: String,
     /// The schema it names.
     pub schema: String,
@@ -175,6 +177,22 @@ pub fn resolve_action(name: &str, objects: &[String]) -> Option<ResolvedAction> 
     })
 }
 
+/// Recognises an action name as one schema ([`resolve_action`]) or as several joined by
+/// `Then` (`GraspRedCubeThenCarryIntoRedCubeToyBox`: a transition that held two steps, named
+/// by both), in order. Each part keeps its own name.
+pub fn resolve_steps(name: &str, objects: &[String]) -> Option<Vec<ResolvedAction>> {
+    if let Some(action) = resolve_action(name, objects) {
+        return Some(vec![action]);
+    }
+    let key = camel(name);
+    key.match_indices("Then").find_map(|(i, joint)| {
+        let first = resolve_action(&key[..i], objects)?;
+        let mut steps = resolve_steps(&key[i + joint.len()..], objects)?;
+        steps.insert(0, first);
+        Some(steps)
+    })
+}
+
 /// Recognises an action by its effects and preconditions (the `effects` module) when its name
 /// names no schema: how operators named freely by a model are compiled.
 pub fn resolve_by_effects(op: &Operator, objects: &[String]) -> Option<ResolvedAction> {
@@ -194,18 +212,21 @@ pub fn compile_policy(
     objects: &[String],
     embodiment: Embodiment,
 ) -> Result<CompiledPolicy, CodegenError> {
-    let actions = procedure
+    let actions: Vec<ResolvedAction> = procedure
         .iter()
         .enumerate()
         .map(|(i, op)| {
-            resolve_action(&op.name, objects)
-                .or_else(|| resolve_by_effects(op, objects))
+            resolve_steps(&op.name, objects)
+                .or_else(|| resolve_by_effects(op, objects).map(|a| vec![a]))
                 .ok_or_else(|| CodegenError::UnknownAction {
                     index: i + 1,
                     name: op.name.clone(),
                 })
         })
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .flatten()
+        .collect();
     let code = emit(&actions, embodiment);
     Ok(CompiledPolicy {
         code,
@@ -632,6 +653,39 @@ mod tests {
             "left_chess_box",
             "hinge_handle",
         ])
+    }
+
+    #[test]
+    fn joined_names_resolve_to_their_steps_in_order() {
+        let o = objects();
+        let steps = resolve_steps("GraspRedCubeThenCarryIntoRedCubeToyBox", &o).unwrap();
+        let parts: Vec<(&str, &str, Vec<String>)> = steps
+            .iter()
+            .map(|a| (a.name.as_str(), a.schema.as_str(), a.args.clone()))
+            .collect();
+        assert_eq!(
+            parts,
+            [
+                ("GraspRedCube", "grasp", names(&["red_cube"])),
+                (
+                    "CarryIntoRedCubeToyBox",
+                    "carry-into",
+                    names(&["red_cube", "toy_box"])
+                ),
+            ]
+        );
+        assert_eq!(resolve_steps("MoveToSurroundRedCube", &o).unwrap().len(), 1);
+        assert!(resolve_steps("GraspRedCubeThen", &o).is_none());
+        assert!(resolve_steps("GraspRedCubeThenFly", &o).is_none());
+        let procedure = [Operator::new(
+            "grasp red cube then carry into red cube toy box",
+            Vec::new(),
+            Vec::new(),
+        )];
+        let policy = compile_policy(&procedure, &o, Embodiment::Finger).unwrap();
+        let close = policy.code.find("close_gripper()").unwrap();
+        let carry = policy.code.find("move_to_position(").unwrap();
+        assert!(close < carry, "{}", policy.code);
     }
 
     #[test]

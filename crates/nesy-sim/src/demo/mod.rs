@@ -33,7 +33,8 @@ pub use folder::{
 };
 pub use mcap_format::{read_mcap, read_mcap_bytes, write_mcap, write_mcap_file};
 pub use record::{
-    ExpertRun, RecordError, RecordOptions, Recording, record_scene, record_scene_video, run_expert,
+    ExecutionRecording, ExpertRun, RecordError, RecordOptions, Recording, ReplayDivergence, record_scene,
+    record_scene_video, replay_execution, run_expert,
 };
 pub use video::{
     StateSpan, TrueKeyframe, VIDEO_TRUTH_FILE, VIDEO_TRUTH_VERSION, VideoFrame, VideoOptions, VideoTruth,

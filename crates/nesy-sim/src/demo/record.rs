@@ -7,12 +7,14 @@ use std::sync::mpsc::SyncSender;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use serde::Serialize;
+
 use super::video::{StateSpan, TrueKeyframe, VIDEO_TRUTH_VERSION, VideoFrame, VideoOptions, VideoTruth};
 use super::{
     CameraImages, CameraName, Demo, DemoMetadata, Demonstrator, Keyframe, KeyframeViews, NESY_VERSION,
 };
-use crate::api::{RobotApi, TraceEntry};
-use crate::perception::render::{Camera, View, render_camera, render_views};
+use crate::api::{ApiError, ApiValue, RobotApi, TraceEntry};
+use crate::perception::render::{Camera, Image, View, draw_label, render_camera, render_views};
 use crate::scene::{SceneError, SceneSpec};
 use crate::tasks::experts::{self, ExpertError};
 use crate::tasks::goal::{EpisodeOutcome, GoalError, GoalMonitor};
@@ -161,6 +163,9 @@ struct VideoHook {
     frames: SyncSender<VideoFrame>,
     fps: u32,
     filmed: Arc<Mutex<Filmed>>,
+    /// Text written along each frame's bottom edge (a rollout's current call); `None` films
+    /// the picture alone, as a demonstration's keyframe detection must see it.
+    caption: Option<Arc<Mutex<String>>>,
 }
 
 impl VideoHook {
@@ -170,7 +175,11 @@ impl VideoHook {
             return;
         }
         let started = Instant::now();
-        let image = render_camera(sim, &self.camera, self.size, self.size, self.render_threads);
+        let mut image = render_camera(sim, &self.camera, self.size, self.size, self.render_threads);
+        if let Some(caption) = &self.caption {
+            let text = caption.lock().unwrap_or_else(|e| e.into_inner()).clone();
+            write_caption(&mut image, &text);
+        }
         let state = crate::perception::observer::observe(sim);
         let index = filmed.frames;
         if filmed.states.last().is_none_or(|s| s.state != state) {
@@ -191,6 +200,30 @@ impl VideoHook {
         filmed.render_wall += started.elapsed();
     }
 }
+
+/// Writes `text` centred along the bottom edge of `image`, cut to the width with `...`.
+fn write_caption(image: &mut Image, text: &str) {
+    if text.is_empty() {
+        return;
+    }
+    let fits = (image.width as usize).saturating_sub(8) / CAPTION_ADVANCE;
+    let shown: String = if text.chars().count() > fits {
+        let mut cut: String = text.chars().take(fits.saturating_sub(3)).collect();
+        cut.push_str("...");
+        cut
+    } else {
+        text.to_owned()
+    };
+    draw_label(
+        image,
+        &shown,
+        i64::from(image.width) / 2,
+        i64::from(image.height) - 8,
+    );
+}
+
+/// Pixels per caption character ([`draw_label`]'s glyph advance).
+const CAPTION_ADVANCE: usize = 7;
 
 impl SimHook for VideoHook {
     fn step_interval(&self) -> Option<u64> {
@@ -259,9 +292,64 @@ fn record(
     options: &RecordOptions,
     video: Option<(&VideoOptions, SyncSender<VideoFrame>)>,
 ) -> Result<(Recording, Filmed), RecordError> {
+    let film = video.map(|(video, frames)| Film {
+        video,
+        frames,
+        caption: None,
+        hold: true,
+    });
+    let driven = drive(scene, options, film, |sim| experts::run(sim, scene).err())?;
+    // A demonstration is of a task: a scene without goals was refused by the goal monitor.
+    let outcome = driven.outcome.ok_or(RecordError::Goal(GoalError::NoGoals))?;
+    let recording = Recording {
+        demo: driven.demo,
+        outcome,
+        expert_error: driven.driver,
+        sim_wall: driven.sim_wall,
+        render_wall: driven.render_wall,
+        sim_seconds: driven.sim_seconds,
+    };
+    Ok((recording, driven.filmed))
+}
+
+/// How to film while a driver works the robot.
+struct Film<'a> {
+    video: &'a VideoOptions,
+    frames: SyncSender<VideoFrame>,
+    /// The caption written on every frame, which the driver updates.
+    caption: Option<Arc<Mutex<String>>>,
+    /// Whether the robot holds still after each action (a demonstration's pauses).
+    hold: bool,
+}
+
+/// What [`drive`] collected.
+struct Driven<T> {
+    demo: Demo,
+    /// The goal checker's verdict (`None` for a scene without goals).
+    outcome: Option<EpisodeOutcome>,
+    filmed: Filmed,
+    driver: T,
+    sim_wall: Duration,
+    render_wall: Duration,
+    sim_seconds: f64,
+}
+
+/// Builds `scene`, lets `driver` work the robot while keyframes are captured (and a camera
+/// films, with `film`), and finishes the episode with the goal checker (or the settle steps,
+/// for a scene without goals).
+fn drive<T>(
+    scene: &SceneSpec,
+    options: &RecordOptions,
+    film: Option<Film<'_>>,
+    driver: impl FnOnce(&mut Sim) -> T,
+) -> Result<Driven<T>, RecordError> {
     let started = Instant::now();
     let mut sim = Sim::new(scene)?;
-    let monitor = GoalMonitor::attach(&mut sim)?;
+    let monitor = if scene.goals.is_empty() {
+        None
+    } else {
+        Some(GoalMonitor::attach(&mut sim)?)
+    };
     let captured = Arc::new(Mutex::new(Captured::default()));
     let hook = KeyframeHook {
         captured: captured.clone(),
@@ -271,22 +359,31 @@ fn record(
     hook.capture(&sim, None);
     sim.add_hook(Box::new(hook));
     let filmed = Arc::new(Mutex::new(Filmed::default()));
-    if let Some((video, frames)) = &video {
+    if let Some(film) = film {
         let hook = VideoHook {
-            camera: video.camera,
-            size: video.size,
+            camera: film.video.camera,
+            size: film.video.size,
             render_threads: options.render_threads.max(1),
-            interval: video.step_interval(),
-            frames: frames.clone(),
-            fps: video.fps,
+            interval: film.video.step_interval(),
+            frames: film.frames,
+            fps: film.video.fps,
             filmed: filmed.clone(),
+            caption: film.caption,
         };
         hook.film(&sim);
         sim.add_hook(Box::new(hook));
-        sim.set_action_pause(video.hold_steps());
+        if film.hold {
+            sim.set_action_pause(film.video.hold_steps());
+        }
     }
-    let expert_error = experts::run(&mut sim, scene).err();
-    let outcome = monitor.finish(&mut sim);
+    let driver = driver(&mut sim);
+    let outcome = match monitor {
+        Some(monitor) => Some(monitor.finish(&mut sim)),
+        None => {
+            sim.step_idle(crate::tasks::goal::POST_RUN_SETTLE_STEPS);
+            None
+        }
+    };
     // The recorder is done: later calls (the object list below) add no keyframes.
     drop(sim.take_hooks());
     let objects = sim.get_obj_names();
@@ -311,15 +408,128 @@ fn record(
         },
         keyframes: captured.keyframes,
     };
-    let recording = Recording {
+    Ok(Driven {
         demo,
         outcome,
-        expert_error,
+        filmed,
+        driver,
         sim_wall: started.elapsed().saturating_sub(captured.render_wall),
         render_wall: captured.render_wall,
         sim_seconds,
-    };
-    Ok((recording, filmed))
+    })
+}
+
+/// Where a replayed trace first did something else than the recorded run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ReplayDivergence {
+    /// Position of the call in the trace, from 0.
+    pub index: usize,
+    /// The call.
+    pub call: String,
+    /// What the recorded run got.
+    pub recorded: String,
+    /// What the replay got.
+    pub replayed: String,
+}
+
+/// A policy's execution replayed and recorded ([`replay_execution`]).
+#[derive(Clone, Debug)]
+pub struct ExecutionRecording {
+    /// A keyframe (three views, the observer's state, the call) before the first call and
+    /// after every successful action, in the demo layout.
+    pub demo: Demo,
+    /// The goal checker's verdict after the settle steps (`None` for a scene without goals).
+    pub outcome: Option<EpisodeOutcome>,
+    /// The first call whose result differed from the recorded one; the replay stops there.
+    pub divergence: Option<ReplayDivergence>,
+    /// Frames filmed for the rollout video.
+    pub frames: usize,
+    /// Wall time spent rendering and encoding.
+    pub render_wall: Duration,
+}
+
+/// Replays a policy's recorded robot API calls, in order and with their recorded arguments,
+/// on a fresh copy of `scene` while recording it: the keyframes of [`record_scene`] and, with
+/// `video`, a rollout filmed at `video.fps` with each frame captioned by the call under way
+/// (no pause after actions: the rollout runs as the policy ran). The simulator is
+/// deterministic, so the replay is the execution; every call's result is compared with the
+/// recorded one and the first difference is reported (and ends the replay). Recording this
+/// way keeps the untrusted policy's sandbox free of any file it could write.
+pub fn replay_execution(
+    scene: &SceneSpec,
+    trace: &[TraceEntry],
+    options: &RecordOptions,
+    video: Option<(&VideoOptions, SyncSender<VideoFrame>)>,
+) -> Result<ExecutionRecording, RecordError> {
+    let caption = Arc::new(Mutex::new(String::new()));
+    let film = video.map(|(video, frames)| Film {
+        video,
+        frames,
+        caption: Some(caption.clone()),
+        hold: false,
+    });
+    let driven = drive(scene, options, film, |sim| {
+        for entry in trace {
+            *caption.lock().unwrap_or_else(|e| e.into_inner()) =
+                format!("{} {}", entry.index + 1, entry.call.label());
+            let replayed = entry.call.perform(sim);
+            if !same_result(&replayed, &entry.result) {
+                return Some(ReplayDivergence {
+                    index: entry.index,
+                    call: entry.call.label(),
+                    recorded: describe(&entry.result),
+                    replayed: describe(&replayed),
+                });
+            }
+        }
+        caption.lock().unwrap_or_else(|e| e.into_inner()).clear();
+        None
+    })?;
+    Ok(ExecutionRecording {
+        demo: driven.demo,
+        outcome: driven.outcome,
+        divergence: driven.driver,
+        frames: driven.filmed.frames,
+        render_wall: driven.render_wall,
+    })
+}
+
+/// Whether two results agree: the same value (positions within 1 µm, as a JSON round trip
+/// keeps them) or the same refusal.
+fn same_result(a: &Result<ApiValue, ApiError>, b: &Result<ApiValue, ApiError>) -> bool {
+    match (a, b) {
+        (Ok(x), Ok(y)) => {
+            let (x, y) = (serde_json::to_value(x).ok(), serde_json::to_value(y).ok());
+            match (x, y) {
+                (Some(x), Some(y)) => close(&x, &y),
+                _ => false,
+            }
+        }
+        (Err(x), Err(y)) => x.to_string() == y.to_string(),
+        _ => false,
+    }
+}
+
+fn close(a: &serde_json::Value, b: &serde_json::Value) -> bool {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => match (x.as_f64(), y.as_f64()) {
+            (Some(x), Some(y)) => (x - y).abs() <= 1e-6,
+            _ => x == y,
+        },
+        (Value::Array(x), Value::Array(y)) => x.len() == y.len() && x.iter().zip(y).all(|(x, y)| close(x, y)),
+        (Value::Object(x), Value::Object(y)) => {
+            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| close(v, w)))
+        }
+        _ => a == b,
+    }
+}
+
+fn describe(result: &Result<ApiValue, ApiError>) -> String {
+    match result {
+        Ok(value) => serde_json::to_string(value).unwrap_or_else(|_| format!("{value:?}")),
+        Err(error) => format!("error: {error}"),
+    }
 }
 
 /// The outcome of running the expert on a scene without recording.

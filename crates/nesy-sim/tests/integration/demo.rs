@@ -477,22 +477,17 @@ fn python_with_mcap() -> Option<String> {
     })
 }
 
-#[test]
-fn python_mcap_reads_every_channel() {
+/// What the PyPI `mcap` reader finds in the file at `path`: per topic the message count,
+/// the PNG images and the metadata records. `None` (after saying so) where no interpreter
+/// has the package outside CI; in CI its absence fails the test.
+fn python_mcap_report(path: &Path) -> Option<serde_json::Value> {
     let Some(python) = python_with_mcap() else {
         if std::env::var_os("CI").is_some() || std::env::var_os("NESY_CI").is_some() {
             panic!("CI must provide the PyPI mcap package (scripts/install-prereqs.sh installs it)");
         }
-        eprintln!(
-            "SKIPPED python_mcap_reads_every_channel: no PYO3_PYTHON or python3 with the PyPI `mcap` package"
-        );
-        return;
+        eprintln!("SKIPPED: no PYO3_PYTHON or python3 with the PyPI `mcap` package");
+        return None;
     };
-    let config = small_task(SubtaskKind::PickPlace, 0, Embodiment::Vacuum);
-    let (bytes, recording) = record_bytes(&config);
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("demo.mcap");
-    std::fs::write(&path, &bytes).unwrap();
     let script = r#"
 import base64, json, sys
 from mcap.reader import make_reader
@@ -514,7 +509,19 @@ print(json.dumps({"counts": counts, "pngs": pngs, "metadata": {m.name: m.metadat
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    Some(serde_json::from_slice(&out.stdout).unwrap())
+}
+
+#[test]
+fn python_mcap_reads_every_channel() {
+    let config = small_task(SubtaskKind::PickPlace, 0, Embodiment::Vacuum);
+    let (bytes, recording) = record_bytes(&config);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("demo.mcap");
+    std::fs::write(&path, &bytes).unwrap();
+    let Some(report) = python_mcap_report(&path) else {
+        return;
+    };
     let n = recording.demo.keyframes.len() as u64;
     for topic in topics() {
         assert_eq!(report["counts"][&topic], n, "{topic}: {report}");
@@ -525,6 +532,117 @@ print(json.dumps({"counts": counts, "pngs": pngs, "metadata": {m.name: m.metadat
     assert_eq!(meta["keyframes"], n.to_string());
     assert!(meta["instruction"].as_str().unwrap().contains("cube"));
     let _ = (ACTION_TOPIC, STATE_TOPIC);
+}
+
+/// Runs the expert on `scene` as a policy would run: the goal monitor attached, the episode
+/// finished by it. Returns the trace and the verdict.
+fn expert_execution(
+    scene: &nesy_sim::scene::SceneSpec,
+) -> (Vec<TraceEntry>, nesy_sim::tasks::goal::EpisodeOutcome) {
+    let mut sim = nesy_sim::world::Sim::new(scene).unwrap();
+    let monitor = nesy_sim::tasks::goal::GoalMonitor::attach(&mut sim).unwrap();
+    nesy_sim::tasks::experts::run(&mut sim, scene).unwrap();
+    let outcome = monitor.finish(&mut sim);
+    (nesy_sim::api::RobotApi::trace(&sim).to_vec(), outcome)
+}
+
+/// Replays `trace` filming a 64-pixel rollout at 10 fps; returns the recording and the frames.
+fn replay(
+    scene: &nesy_sim::scene::SceneSpec,
+    trace: &[TraceEntry],
+) -> (nesy_sim::demo::ExecutionRecording, Vec<Image>) {
+    let options = RecordOptions {
+        image_size: 48,
+        render_threads: 1,
+        ..RecordOptions::default()
+    };
+    let video = nesy_sim::demo::VideoOptions {
+        size: 64,
+        hold_seconds: 0.0,
+        ..nesy_sim::demo::VideoOptions::default()
+    };
+    let (frames, received) = std::sync::mpsc::sync_channel::<nesy_sim::demo::VideoFrame>(8);
+    let collector = std::thread::spawn(move || received.into_iter().map(|f| f.image).collect::<Vec<_>>());
+    let recording = nesy_sim::demo::replay_execution(scene, trace, &options, Some((&video, frames))).unwrap();
+    (recording, collector.join().unwrap())
+}
+
+/// Whether the caption strip along the bottom of a frame holds the caption's red text.
+fn captioned(image: &Image) -> bool {
+    let rows = image.height.saturating_sub(14)..image.height;
+    rows.flat_map(|y| (0..image.width).map(move |x| (x, y)))
+        .any(|(x, y)| {
+            let i = ((y * image.width + x) * 3) as usize;
+            image.rgb[i..i + 3] == [255, 0, 0]
+        })
+}
+
+#[test]
+fn a_replayed_execution_is_the_execution_and_records_like_a_demo() {
+    let scene = small_task(SubtaskKind::PickPlace, 0, Embodiment::Finger)
+        .generate()
+        .unwrap()
+        .scene;
+    let (trace, outcome) = expert_execution(&scene);
+    let (recording, frames) = replay(&scene, &trace);
+    assert_eq!(recording.divergence, None);
+    let replayed = recording.outcome.expect("the scene has goals");
+    assert_eq!(replayed.achieved_sequence, outcome.achieved_sequence);
+    let results =
+        |o: &nesy_sim::tasks::goal::EpisodeOutcome| o.subtasks.iter().map(|s| s.result).collect::<Vec<_>>();
+    assert_eq!(results(&replayed), results(&outcome));
+    let actions = trace
+        .iter()
+        .filter(|e| e.call.is_action() && e.result.is_ok())
+        .count();
+    assert_eq!(recording.demo.keyframes.len(), actions + 1);
+    assert_eq!(recording.frames, frames.len());
+    // Every frame filmed while a call was under way carries its caption; the settle after the
+    // last call carries none.
+    assert!(frames.len() > 20);
+    assert!(captioned(&frames[frames.len() / 2]));
+    assert!(!captioned(frames.last().unwrap()));
+
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("execution.mcap");
+    nesy_sim::demo::write_mcap_file(&recording.demo, &path).unwrap();
+    let back = nesy_sim::demo::read_mcap(&path).unwrap();
+    assert_eq!(back.keyframes.len(), recording.demo.keyframes.len());
+    assert_eq!(back.metadata.side, None);
+    if let Some(report) = python_mcap_report(&path) {
+        let n = recording.demo.keyframes.len() as u64;
+        for topic in topics() {
+            assert_eq!(report["counts"][&topic], n, "{topic}: {report}");
+        }
+    }
+}
+
+#[test]
+fn a_replay_that_gets_another_result_says_where_and_stops() {
+    let scene = small_task(SubtaskKind::PickPlace, 0, Embodiment::Finger)
+        .generate()
+        .unwrap()
+        .scene;
+    let (mut trace, _) = expert_execution(&scene);
+    let at = trace
+        .iter()
+        .position(|e| e.call.name() == "close_gripper")
+        .unwrap();
+    trace[at].result = Err(nesy_sim::api::ApiError::InvalidArgument {
+        call: "close_gripper".into(),
+        message: "recorded as refused".into(),
+    });
+    let (recording, _) = replay(&scene, &trace);
+    let divergence = recording.divergence.expect("the replay differs");
+    assert_eq!(
+        (divergence.index, divergence.call.as_str()),
+        (at, "close_gripper()")
+    );
+    assert!(
+        divergence.recorded.contains("recorded as refused"),
+        "{divergence:?}"
+    );
+    assert_eq!(divergence.replayed, r#"{"type":"none"}"#);
 }
 
 /// The committed fixture demos: name, source task, target task (see fixtures/demos/README.md).
