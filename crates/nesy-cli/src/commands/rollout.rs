@@ -10,9 +10,7 @@ use std::sync::mpsc::SyncSender;
 use anyhow::Context;
 use nesy_core::Embodiment;
 use nesy_sim::api::TraceEntry;
-use nesy_sim::demo::{
-    ExecutionRecording, RecordOptions, VideoFrame, VideoOptions, replay_execution, write_mcap_file,
-};
+use nesy_sim::demo::{ExecutionRecording, RecordOptions, VideoFrame, VideoOptions, replay_execution};
 use nesy_sim::scene::SceneSpec;
 
 /// The execution recording's file name in the output folder.
@@ -113,7 +111,9 @@ pub(crate) fn record_rollout(
         recording.frames
     );
     let mcap = out_dir.join(EXECUTION_MCAP);
-    write_mcap_file(&recording.demo, &mcap).with_context(|| format!("writing {}", mcap.display()))?;
+    recording
+        .write_mcap_file(&mcap)
+        .with_context(|| format!("writing {}", mcap.display()))?;
     Ok(Rollout {
         mcap,
         video: video_path,

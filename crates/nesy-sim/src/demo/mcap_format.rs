@@ -36,6 +36,11 @@ use crate::scene::SceneSpec;
 
 /// Name of the metadata record.
 pub const METADATA_NAME: &str = "nesy.demo";
+
+/// Name of the metadata record an execution recording adds: `outcome` (the goal checker's
+/// verdict as JSON, `null` for a scene without goals) and, when the replay parted from the
+/// recorded run, `divergence` (JSON).
+pub const EXECUTION_METADATA_NAME: &str = "nesy.execution";
 /// Version of this layout, stored under `format_version` in the metadata.
 pub const FORMAT_VERSION: u32 = 1;
 /// Topic of the ground-truth states.
@@ -225,6 +230,16 @@ fn time_ns(seconds: f64) -> u64 {
 
 /// Writes `demo` as MCAP into `w` and returns the writer.
 pub fn write_mcap<W: Write + Seek>(demo: &Demo, w: W) -> Result<W, mcap::McapError> {
+    write_mcap_with(demo, &[], w)
+}
+
+/// [`write_mcap`] with further metadata records after the demo's own (readers of the demo
+/// format skip them).
+pub(crate) fn write_mcap_with<W: Write + Seek>(
+    demo: &Demo,
+    extra: &[Metadata],
+    w: W,
+) -> Result<W, mcap::McapError> {
     let options = mcap::WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))
         .profile("")
@@ -290,6 +305,9 @@ pub fn write_mcap<W: Write + Seek>(demo: &Demo, w: W) -> Result<W, mcap::McapErr
         name: METADATA_NAME.to_owned(),
         metadata: metadata_map(&demo.metadata, demo.keyframes.len()),
     })?;
+    for record in extra {
+        out.write_metadata(record)?;
+    }
     out.finish()?;
     Ok(out.into_inner())
 }
@@ -332,13 +350,19 @@ fn metadata_map(meta: &DemoMetadata, keyframes: usize) -> BTreeMap<String, Strin
 
 /// Writes `demo` to `path` (creating parent folders).
 pub fn write_mcap_file(demo: &Demo, path: &Path) -> Result<(), DemoError> {
+    write_mcap_file_with(demo, &[], path)
+}
+
+/// [`write_mcap_file`] with further metadata records.
+pub(crate) fn write_mcap_file_with(demo: &Demo, extra: &[Metadata], path: &Path) -> Result<(), DemoError> {
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).map_err(|e| DemoError::io(parent, e))?;
     }
-    let buffer = write_mcap(demo, std::io::Cursor::new(Vec::new())).map_err(|source| DemoError::Mcap {
-        path: path.to_owned(),
-        source,
-    })?;
+    let buffer =
+        write_mcap_with(demo, extra, std::io::Cursor::new(Vec::new())).map_err(|source| DemoError::Mcap {
+            path: path.to_owned(),
+            source,
+        })?;
     std::fs::write(path, buffer.into_inner()).map_err(|e| DemoError::io(path, e))
 }
 

@@ -448,6 +448,25 @@ pub struct ExecutionRecording {
     pub render_wall: Duration,
 }
 
+impl ExecutionRecording {
+    /// Writes the recording to `path` in the `demo.mcap` format, with the goal checks and
+    /// any divergence in a second metadata record
+    /// ([`EXECUTION_METADATA_NAME`](super::mcap_format::EXECUTION_METADATA_NAME)).
+    pub fn write_mcap_file(&self, path: &std::path::Path) -> Result<(), super::DemoError> {
+        let mut metadata = std::collections::BTreeMap::new();
+        let json = |value: serde_json::Result<String>| value.unwrap_or_else(|_| "null".to_owned());
+        metadata.insert("outcome".to_owned(), json(serde_json::to_string(&self.outcome)));
+        if let Some(divergence) = &self.divergence {
+            metadata.insert("divergence".to_owned(), json(serde_json::to_string(divergence)));
+        }
+        let record = mcap::records::Metadata {
+            name: super::mcap_format::EXECUTION_METADATA_NAME.to_owned(),
+            metadata,
+        };
+        super::mcap_format::write_mcap_file_with(&self.demo, &[record], path)
+    }
+}
+
 /// Replays a policy's recorded robot API calls, in order and with their recorded arguments,
 /// on a fresh copy of `scene` while recording it: the keyframes of [`record_scene`] and, with
 /// `video`, a rollout filmed at `video.fps` with each frame captioned by the call under way

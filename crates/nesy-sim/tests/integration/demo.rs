@@ -586,11 +586,11 @@ fn a_replayed_execution_is_the_execution_and_records_like_a_demo() {
     let (trace, outcome) = expert_execution(&scene);
     let (recording, frames) = replay(&scene, &trace);
     assert_eq!(recording.divergence, None);
-    let replayed = recording.outcome.expect("the scene has goals");
+    let replayed = recording.outcome.as_ref().expect("the scene has goals");
     assert_eq!(replayed.achieved_sequence, outcome.achieved_sequence);
     let results =
         |o: &nesy_sim::tasks::goal::EpisodeOutcome| o.subtasks.iter().map(|s| s.result).collect::<Vec<_>>();
-    assert_eq!(results(&replayed), results(&outcome));
+    assert_eq!(results(replayed), results(&outcome));
     let actions = trace
         .iter()
         .filter(|e| e.call.is_action() && e.result.is_ok())
@@ -605,7 +605,7 @@ fn a_replayed_execution_is_the_execution_and_records_like_a_demo() {
 
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("execution.mcap");
-    nesy_sim::demo::write_mcap_file(&recording.demo, &path).unwrap();
+    recording.write_mcap_file(&path).unwrap();
     let back = nesy_sim::demo::read_mcap(&path).unwrap();
     assert_eq!(back.keyframes.len(), recording.demo.keyframes.len());
     assert_eq!(back.metadata.side, None);
@@ -614,6 +614,13 @@ fn a_replayed_execution_is_the_execution_and_records_like_a_demo() {
         for topic in topics() {
             assert_eq!(report["counts"][&topic], n, "{topic}: {report}");
         }
+        let execution = &report["metadata"][mcap_format::EXECUTION_METADATA_NAME];
+        let goals: serde_json::Value = serde_json::from_str(execution["outcome"].as_str().unwrap()).unwrap();
+        assert_eq!(
+            goals["achieved_sequence"],
+            serde_json::json!(outcome.achieved_sequence)
+        );
+        assert!(execution.get("divergence").is_none(), "{execution}");
     }
 }
 
