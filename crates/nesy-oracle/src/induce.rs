@@ -134,7 +134,11 @@ fn focus_object(call: Option<&ApiCall>, prev: &State, next: &State) -> Option<Sy
     }
 }
 
+/// Every type-correct binding of `schema`'s parameters; `focus`, the object the call works on,
+/// fixes the first parameter when that is an item.
 fn bindings(schema: &Operator, universe: &Universe, focus: Option<Symbol>) -> Vec<Vec<Symbol>> {
+    let item_first = schema.params.first().is_some_and(|p| p.ty.as_str() == "item");
+    let focus = focus.filter(|_| item_first);
     let mut out = vec![Vec::new()];
     for (i, p) in schema.params.iter().enumerate() {
         let objects = universe.objects_of(p.ty).unwrap_or_default();
@@ -206,10 +210,7 @@ pub fn induce(
     names.extend(req.next.objects());
     let universe = world.universe(names.iter().map(|s| s.as_str()));
     let call_object = call.and_then(ApiCall::object);
-    let tool_free = !req
-        .previous
-        .iter()
-        .any(|a| matches!(a.pred().as_str(), "GripperHolding" | "VacuumAttached"));
+    let tool_free = !holds_something(&req.previous);
     let schemas: Vec<Operator> = world
         .schemas_for(ctx.embodiment, &universe)
         .into_iter()
@@ -241,8 +242,7 @@ pub fn induce(
     let focus = focus_object(call, &req.previous, &req.next);
     let mut best: Option<Candidate> = None;
     for schema in &schemas {
-        let item_first = schema.params.first().is_some_and(|p| p.ty.as_str() == "item");
-        for args in bindings(schema, &universe, focus.filter(|_| item_first)) {
+        for args in bindings(schema, &universe, focus) {
             let Some(c) = evaluate(schema, args, &universe, &req.previous, &req.next) else {
                 continue;
             };
@@ -295,6 +295,13 @@ pub fn induce(
     })
 }
 
+/// Whether the end effector holds something in `state` (fingers or suction).
+fn holds_something(state: &State) -> bool {
+    state
+        .iter()
+        .any(|a| matches!(a.pred().as_str(), "GripperHolding" | "VacuumAttached"))
+}
+
 /// Whether a schema only works the tool (closes or opens it, takes or lets go of a handle)
 /// without moving the arm.
 fn tool_step(schema: &str, embodiment: Embodiment) -> bool {
@@ -334,25 +341,21 @@ fn two_steps(
         if !tool_step(&first.name, ctx.embodiment) {
             continue;
         }
-        let item_first = first.params.first().is_some_and(|p| p.ty.as_str() == "item");
-        for first_args in bindings(&first, universe, first_focus.filter(|_| item_first)) {
+        for first_args in bindings(&first, universe, first_focus) {
             let Some((op1, unmet1, middle)) = step(&first, &first_args, universe, previous) else {
                 continue;
             };
             if middle == *previous || unmet1.len() >= single {
                 continue;
             }
-            let tool_free = !middle
-                .iter()
-                .any(|a| matches!(a.pred().as_str(), "GripperHolding" | "VacuumAttached"));
+            let tool_free = !holds_something(&middle);
             let focus = focus_object(call, &middle, next);
             for schema in second {
                 if call.is_some_and(|c| !schema_fits_call(&schema.name, ctx.embodiment, c.name(), tool_free))
                 {
                     continue;
                 }
-                let item_first = schema.params.first().is_some_and(|p| p.ty.as_str() == "item");
-                for args in bindings(schema, universe, focus.filter(|_| item_first)) {
+                for args in bindings(schema, universe, focus) {
                     let Some(c) = evaluate(schema, args, universe, &middle, next) else {
                         continue;
                     };
