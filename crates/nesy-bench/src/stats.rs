@@ -111,6 +111,20 @@ pub fn units_to_detect(p1: f64, p2: f64) -> Option<u64> {
     Some(((a + b) * (a + b) / (delta * delta)).ceil() as u64)
 }
 
+/// Units per side needed to tell the success rate `rate` from one 10 points lower (or
+/// higher, when `rate` is under 10 %), as [`units_to_detect`] counts them: the figure the
+/// reports give beside each overall rate.
+///
+/// ```
+/// use nesy_bench::stats::{units_to_detect, units_to_detect_ten_points};
+/// assert_eq!(units_to_detect_ten_points(0.5), units_to_detect(0.5, 0.4));
+/// assert_eq!(units_to_detect_ten_points(0.05), units_to_detect(0.05, 0.15));
+/// ```
+pub fn units_to_detect_ten_points(rate: f64) -> Option<u64> {
+    let other = if rate >= 0.1 { rate - 0.1 } else { rate + 0.1 };
+    units_to_detect(rate, other)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

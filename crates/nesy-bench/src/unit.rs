@@ -83,6 +83,23 @@ impl Selection {
         }
     }
 
+    /// One line: the patterns (or all 440) and the sample, if any.
+    pub fn describe(&self) -> String {
+        let mut text = if self.patterns.is_empty() {
+            "all 440 scenarios".to_owned()
+        } else {
+            self.patterns.join(", ")
+        };
+        if let Some(k) = self.sample {
+            text.push_str(&format!(
+                "; a {}sample of {k}, seed {}",
+                if self.stratify { "stratified " } else { "" },
+                self.sample_seed
+            ));
+        }
+        text
+    }
+
     /// Parses `all` or a comma-separated list of ids and prefixes.
     pub fn parse(text: &str) -> Selection {
         let patterns = if text.trim() == "all" {

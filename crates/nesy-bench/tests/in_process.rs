@@ -52,6 +52,7 @@ fn config(run_dir: &Path, demos: &Path) -> RunConfig {
         max_error_rate: None,
         worker: nesy_testkit::own_worker(),
         record_cassettes: false,
+        record_executions: false,
         reexecute: None,
     }
 }

@@ -61,6 +61,8 @@ pub(crate) enum Command {
     Run(commands::run::RunArgs),
     /// Generate, list, show and sweep the benchmark's 440 scenarios; write one's planning problem.
     Scenarios(commands::scenarios::ScenariosArgs),
+    /// Serve a folder of runs and their HTML reports to a browser (read-only, loopback by default).
+    Serve(commands::serve::ServeArgs),
     /// Verify a plan against a PDDL domain and problem, like VAL.
     Verify(commands::verify::VerifyArgs),
     /// Worker process of `nesy run` (internal).
@@ -114,6 +116,7 @@ pub(crate) fn run(cli: Cli) -> ExitCode {
         Command::Render(args) => commands::render::run(args),
         Command::Run(args) => commands::run::run(args),
         Command::Scenarios(args) => commands::scenarios::run(args),
+        Command::Serve(args) => commands::serve::run(args),
         Command::Verify(args) => commands::verify::run(args),
         Command::PolicyWorker(args) => commands::worker::run(args),
     };

@@ -324,8 +324,9 @@ fn tool_step(schema: &str, embodiment: Embodiment) -> bool {
 /// fits the recorded call (from `second`). Keyframes chosen from a video can miss a grasp or
 /// a release (the fingers close behind the object, suction shows nothing) but not an arm
 /// motion, so the hidden step is looked for among the tool steps only. The pair must
-/// reproduce s_{t+1} exactly and leave fewer preconditions unmet than `single` (the best one
-/// schema's observer mismatches and unmet preconditions); the best such pair is the answer.
+/// reproduce s_{t+1} exactly, the second step must hold what it moves once the first is done,
+/// and the two must leave fewer preconditions unmet than `single` (the best one schema's
+/// observer mismatches and unmet preconditions); the best such pair is the answer.
 fn two_steps(
     world: &WorldDomain,
     ctx: &InductionContext,
@@ -359,6 +360,13 @@ fn two_steps(
                     let Some(c) = evaluate(schema, args, universe, &middle, next) else {
                         continue;
                     };
+                    // The recorded call's step must move nothing the hand does not hold once
+                    // the hidden step is done: a pair that carries an object never taken
+                    // explains the state by accident, e.g. an object a closing lid pushed,
+                    // read as carried.
+                    if c.unmet.iter().any(|u| needs_holding(u, ctx.embodiment)) {
+                        continue;
+                    }
                     let score = unmet1.len() + c.unmet.len();
                     if c.mismatch == 0 && score < single && best.as_ref().is_none_or(|b| score < b.0) {
                         let step = FirstStep {
@@ -375,6 +383,12 @@ fn two_steps(
     }
     let (_, first, second) = best?;
     Some(joined(previous, next, first, second))
+}
+
+/// Whether `literal` says the end effector holds something (`GripperHolding ?x`,
+/// `VacuumAttached ?x`).
+fn needs_holding(literal: &Formula, embodiment: Embodiment) -> bool {
+    matches!(literal, Formula::Atom(atom) if atom.pred.as_str() == embodiment.holding_predicate())
 }
 
 /// The hidden tool step of a two-step transition, grounded.

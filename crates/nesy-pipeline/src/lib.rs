@@ -41,6 +41,7 @@
 
 mod error;
 pub mod execute;
+mod html_report;
 mod inputs;
 pub mod output;
 mod progress;
@@ -69,6 +70,7 @@ use states::{StateSource, StatesMode, SymbolicStates};
 use synth::{CodegenMode, SandboxChecks, SynthError, SynthesisRequest, SynthesizedPolicy};
 
 pub use error::{PipelineError, StopReason};
+pub use html_report::{HTML_REPORT_FILE, RolloutFiles, report_html};
 pub use inputs::{DemoInput, DemoKeyframes, TARGET_SCENE_BESIDE, TargetInput, load_vocabulary};
 pub use progress::{LogProgress, NoProgress, Progress};
 pub use setting::{ImagesMode, Setting, derive_setting};

@@ -11,6 +11,9 @@
 //! | `target_{top,front,back}[_marked].png` | the rendered target views |
 //! | `report.md` | a readable summary embedding the target views |
 //! | `summary.json` | what `--json` prints |
+//! | `report.html` | the run for a browser: keyframes, operators, both procedures, policy, rollout ([`crate::report_html`]) |
+//! | `execution.mcap`, `rollout.mp4` | the execution recorded (`--render-every N`) |
+//! | `rollout_first.png`, `rollout_last.png` | a benchmark unit's recorded first and last frames |
 //! | `failure.json` | only for a run that stopped before an outcome: the error, naming the call, and its failure kind (with `target_scene.json`) |
 
 use std::fmt::Write as _;
@@ -44,6 +47,15 @@ pub const TARGET_SCENE_FILE: &str = "target_scene.json";
 pub const REPORT_FILE: &str = "report.md";
 /// `summary.json`.
 pub const SUMMARY_FILE: &str = "summary.json";
+/// `execution.mcap`: the execution replayed and recorded in the demo format (a keyframe
+/// after every action with the three views and the observer's state, and the goal checks).
+pub const EXECUTION_RECORDING_FILE: &str = "execution.mcap";
+/// `rollout.mp4`: the execution filmed from one camera, each frame captioned with its call.
+pub const ROLLOUT_VIDEO_FILE: &str = "rollout.mp4";
+/// `rollout_first.png`: the execution recording's first keyframe (before any call), one view.
+pub const ROLLOUT_FIRST_FRAME_FILE: &str = "rollout_first.png";
+/// `rollout_last.png`: the execution recording's last keyframe, one view.
+pub const ROLLOUT_LAST_FRAME_FILE: &str = "rollout_last.png";
 /// `failure.json`: written instead of the usual outputs when a run stops before it has an
 /// outcome (a model call whose re-ask budget ran out, a transport failure, a cassette miss).
 pub const FAILURE_FILE: &str = "failure.json";
@@ -160,6 +172,52 @@ impl RunDir {
             },
         )?;
         Ok(Some(path))
+    }
+
+    /// Replays `execution`'s recorded API calls on its scene and writes the recording
+    /// (`execution.mcap`) and the first and last keyframes' `view` as PNG
+    /// (`rollout_first.png`, `rollout_last.png`; the first view when there is no `view`).
+    /// Rendering runs on `render_threads` threads. Returns the recording.
+    pub fn write_execution_recording(
+        &self,
+        execution: &ExecutionReport,
+        view: &str,
+        render_threads: usize,
+    ) -> Result<nesy_sim::demo::ExecutionRecording, PipelineError> {
+        let mcap = self.file(EXECUTION_RECORDING_FILE);
+        let failed = |message: String| PipelineError::write(&mcap, std::io::Error::other(message));
+        let scene = nesy_sim::scene::SceneSpec::from_file(&execution.scene_path).map_err(|e| {
+            failed(format!(
+                "reading the scene {}: {e}",
+                execution.scene_path.display()
+            ))
+        })?;
+        let options = nesy_sim::demo::RecordOptions {
+            side: Some("execution".to_owned()),
+            render_threads,
+            ..nesy_sim::demo::RecordOptions::default()
+        };
+        let recording = nesy_sim::demo::replay_execution(&scene, &execution.result.trace, &options, None)
+            .map_err(|e| failed(format!("replaying the execution: {e}")))?;
+        recording
+            .write_mcap_file(&mcap)
+            .map_err(|e| failed(e.to_string()))?;
+        let keyframes = &recording.demo.keyframes;
+        for (name, keyframe) in [
+            (ROLLOUT_FIRST_FRAME_FILE, keyframes.first()),
+            (ROLLOUT_LAST_FRAME_FILE, keyframes.last()),
+        ] {
+            let Some(keyframe) = keyframe else { continue };
+            let images = keyframe
+                .views
+                .get(view)
+                .or_else(|| keyframe.views.iter().next().map(|v| &v.images));
+            if let Some(images) = images {
+                let path = self.file(name);
+                std::fs::write(&path, &images.raw).map_err(|e| PipelineError::write(&path, e))?;
+            }
+        }
+        Ok(recording)
     }
 
     /// Writes every output of `run`.

@@ -71,6 +71,9 @@ pub struct RunConfig {
     pub worker: WorkerCommand,
     /// Record the offline responder's calls too (live calls are always recorded).
     pub record_cassettes: bool,
+    /// Record every executed unit's execution: `execution.mcap` and its first and last
+    /// frames, which the report's failure gallery shows.
+    pub record_executions: bool,
     /// Re-execute the specifications of this earlier run (phase B only).
     pub reexecute: Option<PathBuf>,
 }

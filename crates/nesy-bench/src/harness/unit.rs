@@ -391,6 +391,9 @@ pub(super) async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
             format!("the execution record could not be written ({e}); the unit runs again on resume");
         return failed_record(shared, unit, UnitStatus::Interrupted, message, effort);
     }
+    if shared.config.record_executions {
+        record_execution(shared, &dir, &report).await;
+    }
     let scores = scores_of(&report, unit);
     let (status, error) = execution_verdict(&report);
     effort.time.total_s = started.elapsed().as_secs_f64();
@@ -441,6 +444,10 @@ fn account_calls(effort: &mut Effort, counts: &CallCounts, usage: Option<&RunUsa
     effort.images = counts.images;
     effort.calls_by_purpose = counts.by_purpose.clone();
     if let Some(u) = usage {
+        // The calls' summed wall time; a specification that completes replaces it with the
+        // reasoner's own measure, but a unit that fails keeps it, so its model seconds are
+        // not lost.
+        effort.time.vlm_s = u.total.latency_ms_total / 1e3;
         effort.tokens = u.total.prompt_tokens + u.total.completion_tokens;
         effort.cost_usd = u.total.cost_usd;
         effort.cost_by_purpose = u
@@ -476,6 +483,27 @@ async fn execute_code(
     })
     .await
     .and_then(|r| r)
+}
+
+/// The view the failure gallery shows of each recorded execution.
+pub(super) const GALLERY_VIEW: &str = "front";
+
+/// Replays the unit's execution and writes its recording and first and last frames, under a
+/// CPU slot. The unit's result does not depend on it: a recording that cannot be written is
+/// logged and left out.
+async fn record_execution(shared: &Shared, dir: &RunDir, report: &ExecutionReport) {
+    let dir = dir.clone();
+    let report = report.clone();
+    let written = cpu(shared, move || {
+        dir.write_execution_recording(&report, GALLERY_VIEW, 1)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    })
+    .await
+    .and_then(|r| r);
+    if let Err(e) = written {
+        tracing::warn!("the execution recording was not written: {e}");
+    }
 }
 
 /// The unit's scores: the episode's goal checks, or zeros with the target's label when no
@@ -628,4 +656,22 @@ pub(super) async fn specify_and_code(
             template_s,
         },
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_unit_that_fails_keeps_its_model_seconds() {
+        let mut usage = RunUsage::default();
+        usage.total.calls = 3;
+        usage.total.latency_ms_total = 4_500.0;
+        usage.total.prompt_tokens = 100;
+        usage.total.completion_tokens = 20;
+        let mut effort = Effort::default();
+        account_calls(&mut effort, &CallCounts::default(), Some(&usage));
+        assert_eq!(effort.time.vlm_s, 4.5);
+        assert_eq!(effort.tokens, 120);
+    }
 }

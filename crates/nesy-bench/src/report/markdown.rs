@@ -291,10 +291,7 @@ fn write_wilson(md: &mut String, tables: &Tables) {
             let _ = write!(row, " {} |", cell(p));
         }
         let all = tables.all[v].sr_counts();
-        let needed = all.rate().and_then(|r| {
-            let other = if r >= 0.1 { r - 0.1 } else { r + 0.1 };
-            crate::stats::units_to_detect(r, other)
-        });
+        let needed = all.rate().and_then(crate::stats::units_to_detect_ten_points);
         let _ = writeln!(
             md,
             "{row} {} | {} |",

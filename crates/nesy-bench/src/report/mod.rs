@@ -9,6 +9,7 @@
 
 mod csv;
 mod figures;
+mod html;
 mod markdown;
 pub mod plot;
 mod study_tables;
@@ -31,6 +32,8 @@ use crate::unit_record::UnitRecord;
 use csv::{csv_field, stages_csv, status_csv, table1_csv, time_csv, units_csv};
 use figures::{plot_cells, plot_complexity, plot_gap};
 use markdown::markdown;
+
+pub use html::BENCH_HTML_FILE;
 use plot::Value;
 
 /// Tallies of one group of units.
@@ -199,6 +202,8 @@ pub struct ReportOptions {
 pub struct ReportFiles {
     /// `report.md`.
     pub report: PathBuf,
+    /// `report.html`: the tables, the plots and the failure gallery.
+    pub html: PathBuf,
     /// The CSV tables.
     pub tables: Vec<PathBuf>,
     /// The PNG plots.
@@ -283,6 +288,7 @@ pub fn write(run: &Path, options: &ReportOptions) -> Result<ReportFiles, BenchEr
     std::fs::create_dir_all(run.join("plots")).map_err(|e| BenchError::io(run.join("plots"), e))?;
     let mut files = ReportFiles {
         report: run.join("report.md"),
+        html: run.join(BENCH_HTML_FILE),
         tables: Vec::new(),
         plots: Vec::new(),
         partial: !missing.is_empty(),
@@ -338,6 +344,24 @@ pub fn write(run: &Path, options: &ReportOptions) -> Result<ReportFiles, BenchEr
         study_md.as_deref(),
     );
     std::fs::write(&files.report, md).map_err(|e| BenchError::io(&files.report, e))?;
+    let relative = |paths: &[PathBuf]| -> Vec<String> {
+        paths
+            .iter()
+            .map(|p| p.strip_prefix(run).unwrap_or(p).display().to_string())
+            .collect()
+    };
+    let page = html::bench_html(&html::HtmlInputs {
+        run,
+        manifest: &manifest,
+        tables: &tables,
+        records: &ordered,
+        missing: &missing,
+        banner: banner.as_deref(),
+        study: study_md.as_deref(),
+        plots: relative(&files.plots),
+        csv: relative(&files.tables),
+    });
+    std::fs::write(&files.html, page).map_err(|e| BenchError::io(&files.html, e))?;
     Ok(files)
 }
 

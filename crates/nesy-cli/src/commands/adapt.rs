@@ -184,6 +184,7 @@ pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     } else {
         out!("{}", summary(&run))?;
     }
+    let mut rollout_files = None;
     if let Some(execution) = run.execution.as_ref().filter(|_| args.render_every != 0) {
         let rollout = super::rollout::record_rollout(
             &execution.scene_path,
@@ -193,7 +194,15 @@ pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
             args.render_every,
         )?;
         super::rollout::announce(&rollout, "  recording ", args.json)?;
+        rollout_files = Some(pipeline::RolloutFiles {
+            video: pipeline::output::ROLLOUT_VIDEO_FILE.to_owned(),
+            recording: pipeline::output::EXECUTION_RECORDING_FILE.to_owned(),
+            summary: super::rollout::describe(&rollout),
+        });
     }
+    // Written last, so that it can show the rollout.
+    let html = pipeline::report_html(&run, &demo, &target, rollout_files.as_ref());
+    RunDir::create(&run.out_dir)?.write_text(pipeline::HTML_REPORT_FILE, &html)?;
     if let Some(error @ pipeline::synth::SynthError::Call { .. }) = &run.codegen_error {
         eprintln!("error: {error} (outputs written to {})", run.out_dir.display());
     }

@@ -160,6 +160,10 @@ pub(crate) struct RunArgs {
     /// Record the offline responder's calls to per-unit cassettes too (live calls always are).
     #[arg(long)]
     pub record_cassettes: bool,
+    /// Record each executed unit's execution (`execution.mcap`, and its first and last
+    /// frames for the report's failure gallery).
+    #[arg(long)]
+    pub record_executions: bool,
     /// Re-execute the stored programs of this earlier run (phase B only: no model call).
     #[arg(long, value_name = "RUN")]
     pub reexecute_from: Option<PathBuf>,
@@ -427,6 +431,7 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
         max_error_rate: args.max_error_rate,
         worker: WorkerCommand::current_exe().context("locating the nesy executable")?,
         record_cassettes: args.record_cassettes,
+        record_executions: args.record_executions,
         reexecute: args.reexecute_from.clone(),
     })
 }

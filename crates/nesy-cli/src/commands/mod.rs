@@ -10,6 +10,7 @@ pub(crate) mod render;
 pub(crate) mod rollout;
 pub(crate) mod run;
 pub(crate) mod scenarios;
+pub(crate) mod serve;
 pub(crate) mod verify;
 pub(crate) mod worker;
 

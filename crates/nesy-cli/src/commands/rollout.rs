@@ -13,10 +13,7 @@ use nesy_sim::api::TraceEntry;
 use nesy_sim::demo::{ExecutionRecording, RecordOptions, VideoFrame, VideoOptions, replay_execution};
 use nesy_sim::scene::SceneSpec;
 
-/// The execution recording's file name in the output folder.
-pub(crate) const EXECUTION_MCAP: &str = "execution.mcap";
-/// The rollout video's file name in the output folder.
-pub(crate) const ROLLOUT_VIDEO: &str = "rollout.mp4";
+use nesy_pipeline::output::{EXECUTION_RECORDING_FILE, ROLLOUT_VIDEO_FILE};
 
 /// Side of the rollout's square frames (pixels).
 const ROLLOUT_SIZE: u32 = 384;
@@ -97,7 +94,7 @@ pub(crate) fn record_rollout(
         side: Some("execution".to_owned()),
         ..RecordOptions::default()
     };
-    let video_path = out_dir.join(ROLLOUT_VIDEO);
+    let video_path = out_dir.join(ROLLOUT_VIDEO_FILE);
     let (recording, written) = with_video_encoder(&video_path, fps, |frames| {
         replay_execution(&scene, trace, &options, Some((&video, frames)))
     })
@@ -110,7 +107,7 @@ pub(crate) fn record_rollout(
         video_path.display(),
         recording.frames
     );
-    let mcap = out_dir.join(EXECUTION_MCAP);
+    let mcap = out_dir.join(EXECUTION_RECORDING_FILE);
     recording
         .write_mcap_file(&mcap)
         .with_context(|| format!("writing {}", mcap.display()))?;

@@ -79,12 +79,44 @@ fn killed_runs_resume_shards_merge_and_configurations_do_not_mix() {
 
     // The reference: one uninterrupted run (it records the demos for everyone).
     let whole = scratch.path().join("whole");
-    let out = common::nesy(&run_args(&whole, &demos, &[]));
+    let out = common::nesy(&run_args(&whole, &demos, &["--record-executions"]));
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(lines(&whole), 9, "one record per unit");
     let reference = table(&whole, "table1.csv");
     let report = std::fs::read_to_string(whole.join("report.md")).unwrap();
     assert!(report.contains("OFFLINE"), "{report}");
+    // The HTML report's gallery shows every unit that did not succeed, each with the first
+    // and last frames of its recorded execution, and links to its files.
+    let html = std::fs::read_to_string(whole.join("report.html")).unwrap();
+    let gallery = html.split("<section id=\"gallery\">").nth(1).unwrap();
+    let shard = std::fs::read_dir(whole.join("results"))
+        .unwrap()
+        .flatten()
+        .next()
+        .unwrap();
+    let mut failed = 0;
+    for line in std::fs::read_to_string(shard.path()).unwrap().lines() {
+        let record: serde_json::Value = serde_json::from_str(line).unwrap();
+        let unit = record["artifacts"].as_str().unwrap();
+        let executed = whole.join(unit).join("execution.json").is_file();
+        if executed {
+            assert!(
+                whole.join(unit).join("execution.mcap").is_file(),
+                "{unit} was recorded"
+            );
+        }
+        if record["status"] == "succeeded" {
+            continue;
+        }
+        failed += 1;
+        let card = gallery
+            .split("<div class=\"card\">")
+            .find(|c| c.contains(&format!("href=\"{unit}/")))
+            .unwrap_or_else(|| panic!("{unit} is missing from the gallery"));
+        let frames = card.matches(&format!("<img src=\"{unit}/rollout_")).count();
+        assert_eq!(frames, if executed { 2 } else { 0 }, "{unit}: {card}");
+    }
+    assert!(failed > 0, "the sample has failures to show");
     for plot in ["sr_gc_pd.png", "domain_gap.png", "complexity.png"] {
         let bytes = std::fs::read(whole.join("plots").join(plot)).unwrap();
         assert_eq!(&bytes[1..4], b"PNG", "{plot}");
@@ -210,6 +242,51 @@ fn killed_runs_resume_shards_merge_and_configurations_do_not_mix() {
     // Status summarises a run.
     let status = common::nesy(&["bench".into(), "status".into(), whole.display().to_string()]);
     assert!(String::from_utf8_lossy(&status.stdout).contains("9 of 9 unit(s) final"));
+
+    // Two real runs compared unit by unit. The killed-and-resumed run is the same run: no
+    // unit changes outcome. A run with one switch flipped (verification off) pairs with the
+    // whole run's NeSyCR units by scenario; three pairs can never be significant.
+    let compare = |a: &Path, b: &Path, extra: &[&str]| {
+        let mut args: Vec<String> = ["bench", "compare"].map(String::from).to_vec();
+        args.push(a.display().to_string());
+        args.push(b.display().to_string());
+        args.extend(extra.iter().map(|s| s.to_string()));
+        common::nesy(&args)
+    };
+    let same = compare(
+        &whole,
+        &killed,
+        &["--a", "nesycr", "--b", "nesycr", "--json", "--fail-if-worse", "0"],
+    );
+    assert_eq!(
+        same.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&same.stderr)
+    );
+    let same: serde_json::Value = serde_json::from_slice(&same.stdout).unwrap();
+    assert_eq!(same["overall"]["a"]["n"], 3, "{same}");
+    assert_eq!(same["changed"].as_array().map(Vec::len), Some(0), "{same}");
+    let unverified = scratch.path().join("unverified");
+    let mut args = run_args(&unverified, &demos, &[]);
+    let methods = args.iter().position(|a| a == METHODS).unwrap();
+    args[methods] = "nesycr+verification=off".into();
+    let out = common::nesy(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let switched = compare(
+        &whole,
+        &unverified,
+        &["--a", "nesycr", "--json", "--fail-if-worse", "0"],
+    );
+    assert_eq!(
+        switched.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&switched.stderr)
+    );
+    let switched: serde_json::Value = serde_json::from_slice(&switched.stdout).unwrap();
+    assert_eq!(switched["overall"]["a"]["n"], 3, "{switched}");
+    assert_eq!(switched["overall"]["b"]["n"], 3, "{switched}");
 }
 
 #[test]
@@ -425,4 +502,41 @@ fn the_complexity_gap_study_reports_sr_and_pd_by_added_subtasks() {
         .collect::<String>();
     assert_eq!(results.matches("\"added_subtasks\":1").count(), 4, "{results}");
     assert_eq!(results.matches("\"added_subtasks\":0").count(), 4, "{results}");
+}
+
+/// On a demonstration recorded with a keyframe after every action, no transition hides a
+/// step, so the reference responder reads none as two. On `obst_high_04_s1` a closing lid
+/// pushes the black knight onto the board; read as a hidden release followed by carrying the
+/// knight (which the hand never held), the adapted procedure skipped moving the knight and the
+/// sweep failed.
+#[test]
+fn a_pushed_object_is_not_read_as_a_hidden_carry() {
+    let scratch = common::scratch();
+    let run = scratch.path().join("run");
+    let out = common::nesy(&[
+        "bench".into(),
+        "run".into(),
+        run.display().to_string(),
+        "--scenarios".into(),
+        "obst_high_04_s1".into(),
+        "--methods".into(),
+        "nesycr".into(),
+        "--vlm".into(),
+        "oracle".into(),
+        "--demos".into(),
+        scratch.path().join("demos").display().to_string(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let adaptation =
+        std::fs::read_to_string(run.join("units/obst_high_04_s1/nesycr/adaptation.json")).unwrap();
+    let adaptation: serde_json::Value = serde_json::from_str(&adaptation).unwrap();
+    let names: Vec<&str> = adaptation["world_model"]["procedure"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|op| op["name"].as_str().unwrap())
+        .collect();
+    assert!(names.iter().all(|n| !n.contains("Then")), "{names:?}");
+    let status = table(&run, "status.csv");
+    assert!(status.contains("nesycr,1,0,0,0"), "{status}");
 }

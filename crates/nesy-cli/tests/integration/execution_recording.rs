@@ -71,6 +71,28 @@ fn an_executed_adaptation_leaves_its_recording_and_rollout() {
     let frames = video_frames(&out.path().join("rollout.mp4"));
     let seconds = recording.keyframes.last().unwrap().time;
     assert!(frames as f64 >= seconds * 10.0, "{frames} frames for {seconds} s");
+
+    // The HTML report shows the demonstration, both procedures with the violation and the
+    // patch marked, and the rollout beside it; it loads nothing from elsewhere.
+    let html = std::fs::read_to_string(out.path().join("report.html")).unwrap();
+    let demo = nesy_sim::demo::read(common::workspace().join(DEMO)).unwrap();
+    assert_eq!(
+        html.matches("<div class=\"card\"><h3>keyframe ").count(),
+        demo.keyframes.len(),
+        "one card per keyframe"
+    );
+    assert_eq!(
+        html.matches("src=\"data:image/png;base64,").count(),
+        demo.keyframes.len() + 3
+    );
+    assert!(
+        html.contains("<video src=\"rollout.mp4\""),
+        "the rollout is shown"
+    );
+    assert!(html.contains("OpenGripperToDropRedCylinderIntoBottomDrawer  ← first violated precondition"));
+    assert!(html.contains("PullBottomDrawerOpen  ← added by a patch"));
+    assert!(html.contains("<span class=\"ok\">verified</span>"));
+    assert!(!html.contains("<script") && !html.contains("http://") && !html.contains("https://"));
 }
 
 #[test]

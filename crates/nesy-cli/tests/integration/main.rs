@@ -22,4 +22,5 @@ mod execution_recording;
 mod real_model;
 mod run_cli;
 mod scenarios_cli;
+mod serve_cli;
 mod verify;

@@ -745,3 +745,46 @@ fn fixture_demos_read_and_match_their_tasks() {
         assert!(size < 4_000_000, "{name}: {size} bytes");
     }
 }
+
+/// The Foxglove layouts shipped for `demo.mcap` and `execution.mcap` name only topics the
+/// writer publishes, so that a renamed topic cannot leave a layout showing empty panels.
+#[test]
+fn the_foxglove_layouts_name_only_topics_a_recording_has() {
+    let topics = nesy_sim::demo::mcap_format::topics();
+    for name in ["demo-layout.json", "execution-layout.json"] {
+        let path = nesy_testkit::workspace_root().join("assets/foxglove").join(name);
+        let layout: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let panels = layout["configById"].as_object().unwrap();
+        let mut named = 0;
+        for (id, config) in panels {
+            let topic = config["imageMode"]["imageTopic"]
+                .as_str()
+                .or(config["topicPath"].as_str());
+            let topic = topic.unwrap_or_else(|| panic!("{name}: panel {id} shows no topic"));
+            assert!(
+                topics.iter().any(|t| t == topic),
+                "{name}: panel {id} shows {topic}, which no recording has"
+            );
+            named += 1;
+        }
+        assert_eq!(named, 5, "{name}: three views, the call and the state");
+        // Every panel the mosaic places is configured, and every configured panel is placed.
+        fn leaves(node: &serde_json::Value, out: &mut Vec<String>) {
+            match node {
+                serde_json::Value::String(id) => out.push(id.clone()),
+                serde_json::Value::Object(split) => {
+                    leaves(&split["first"], out);
+                    leaves(&split["second"], out);
+                }
+                other => panic!("unexpected layout node {other}"),
+            }
+        }
+        let mut placed = Vec::new();
+        leaves(&layout["layout"], &mut placed);
+        placed.sort();
+        let mut configured: Vec<String> = panels.keys().cloned().collect();
+        configured.sort();
+        assert_eq!(placed, configured, "{name}");
+    }
+}
