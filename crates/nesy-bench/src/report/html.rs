@@ -10,6 +10,7 @@ use nesy_core::benchmark::FactorGroup;
 use nesy_pipeline::output::{ADAPTATION_FILE, ROLLOUT_FIRST_FRAME_FILE, ROLLOUT_LAST_FRAME_FILE};
 use nesy_view::{Html, Page};
 
+use super::csv::csv_fields;
 use super::{Aggregate, Tables, pct};
 use crate::manifest::Manifest;
 use crate::stats::units_to_detect_ten_points;
@@ -57,6 +58,7 @@ pub(super) fn bench_html(inputs: &HtmlInputs<'_>) -> String {
     if let Some(study) = inputs.study {
         page.section("study", "Study", Html::pre(study));
     }
+    page.section("tables", "Every table", csv_tables(inputs));
     page.section("plots", "Plots", plots(inputs));
     page.section("gallery", "Failure gallery", gallery(inputs));
     page.section("files", "Files", files(inputs));
@@ -204,6 +206,29 @@ fn statuses(tables: &Tables) -> Html {
         row
     });
     Html::table(&header, rows)
+}
+
+/// Each CSV table the report wrote, shown folded (the units table is left to its file: one
+/// row per unit).
+fn csv_tables(inputs: &HtmlInputs<'_>) -> Html {
+    Html::concat(inputs.csv.iter().map(|relative| {
+        if relative.ends_with("units.csv") {
+            return Html::tag(
+                "p",
+                "",
+                Html::concat([Html::link(relative, relative), Html::text(": one row per unit")]),
+            );
+        }
+        let text = match std::fs::read_to_string(inputs.run.join(relative)) {
+            Ok(text) => text,
+            Err(e) => return Html::tag("p", "bad", Html::text(&format!("{relative}: {e}"))),
+        };
+        let mut lines = text.lines();
+        let header = lines.next().map(csv_fields).unwrap_or_default();
+        let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
+        let rows = lines.map(|line| csv_fields(line).iter().map(|f| Html::text(f)).collect());
+        Html::details(relative, Html::table(&header_refs, rows), false)
+    }))
 }
 
 /// The plots, embedded.
