@@ -200,7 +200,7 @@ impl RunDir {
         let recording = nesy_sim::demo::replay_execution(&scene, &execution.result.trace, &options, None)
             .map_err(|e| failed(format!("replaying the execution: {e}")))?;
         recording
-            .write_mcap_file(&mcap)
+            .write_mcap_file(&mcap, None)
             .map_err(|e| failed(e.to_string()))?;
         let keyframes = &recording.demo.keyframes;
         for (name, keyframe) in [

@@ -93,7 +93,7 @@ fn record_with_video(
     video: &VideoOptions,
     path: &std::path::Path,
 ) -> anyhow::Result<(Recording, VideoTruth)> {
-    let (recorded, written) = super::rollout::with_video_encoder(path, video.fps, |frames| {
+    let (recorded, written, _) = super::rollout::with_video_encoder(path, video.fps, false, |frames| {
         record_scene_video(scene, options, video, frames)
     })?;
     let recorded = recorded?;

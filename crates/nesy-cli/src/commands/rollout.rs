@@ -10,6 +10,7 @@ use std::sync::mpsc::SyncSender;
 use anyhow::Context;
 use nesy_core::Embodiment;
 use nesy_sim::api::TraceEntry;
+use nesy_sim::demo::mcap_format::{Film, FilmFrame};
 use nesy_sim::demo::{ExecutionRecording, RecordOptions, VideoFrame, VideoOptions, replay_execution};
 use nesy_sim::scene::SceneSpec;
 
@@ -30,27 +31,41 @@ pub(crate) struct Rollout {
     pub fps: u32,
 }
 
+/// JPEG quality of the frames an execution recording keeps on its film topic.
+const FILM_JPEG_QUALITY: u8 = 85;
+
 /// Runs `produce` while a second thread encodes the frames it sends into an MP4 at `path`;
-/// returns what `produce` returned and the number of frames written.
+/// returns what `produce` returned, the number of frames written, and, when `keep_film`, each
+/// frame as JPEG with its time (for an execution recording's film topic).
 pub(crate) fn with_video_encoder<T>(
     path: &Path,
     fps: u32,
+    keep_film: bool,
     produce: impl FnOnce(SyncSender<VideoFrame>) -> T,
-) -> anyhow::Result<(T, usize)> {
+) -> anyhow::Result<(T, usize, Vec<FilmFrame>)> {
     // A few frames of slack keep the renderer and the encoder both busy.
     let (frames, received) = std::sync::mpsc::sync_channel::<VideoFrame>(4);
     let mut writer = nesy_import::VideoWriter::create(path, f64::from(fps))?;
-    let encoder = std::thread::spawn(move || -> Result<usize, nesy_import::ImportError> {
-        for frame in received {
-            writer.push(&frame.image)?;
-        }
-        writer.finish()
-    });
+    let encoder = std::thread::spawn(
+        move || -> Result<(usize, Vec<FilmFrame>), nesy_import::ImportError> {
+            let mut film = Vec::new();
+            for frame in received {
+                writer.push(&frame.image)?;
+                if keep_film {
+                    film.push(FilmFrame {
+                        time: frame.time,
+                        jpeg: frame.image.to_jpeg(FILM_JPEG_QUALITY),
+                    });
+                }
+            }
+            Ok((writer.finish()?, film))
+        },
+    );
     let produced = produce(frames);
-    let written = encoder
+    let (written, film) = encoder
         .join()
         .map_err(|_| anyhow::anyhow!("the video encoder thread stopped unexpectedly"))??;
-    Ok((produced, written))
+    Ok((produced, written, film))
 }
 
 /// The rollout's frame rate for `--render-every N`: one frame every `N` control steps, a
@@ -95,7 +110,7 @@ pub(crate) fn record_rollout(
         ..RecordOptions::default()
     };
     let video_path = out_dir.join(ROLLOUT_VIDEO_FILE);
-    let (recording, written) = with_video_encoder(&video_path, fps, |frames| {
+    let (recording, written, frames) = with_video_encoder(&video_path, fps, true, |frames| {
         replay_execution(&scene, trace, &options, Some((&video, frames)))
     })
     .with_context(|| format!("writing {}", video_path.display()))?;
@@ -108,8 +123,12 @@ pub(crate) fn record_rollout(
         recording.frames
     );
     let mcap = out_dir.join(EXECUTION_RECORDING_FILE);
+    let film = Film {
+        camera: video.camera.name.to_owned(),
+        frames,
+    };
     recording
-        .write_mcap_file(&mcap)
+        .write_mcap_file(&mcap, Some(&film))
         .with_context(|| format!("writing {}", mcap.display()))?;
     Ok(Rollout {
         mcap,

@@ -54,6 +54,31 @@ pub const STATE_SCHEMA_NAME: &str = "nesy.KeyframeState";
 /// Schema name of action messages.
 pub const ACTION_SCHEMA_NAME: &str = "nesy.KeyframeAction";
 
+/// The topic of a filmed camera's frames: `/film/<camera>` (a recording of an execution
+/// carries them beside its keyframes; the demo reader skips it).
+pub fn film_topic(camera: &str) -> String {
+    format!("/film/{camera}")
+}
+
+/// Frames filmed at a fixed rate by one camera, for an execution recording's `/film/<camera>`
+/// topic.
+#[derive(Clone, Debug, Default)]
+pub struct Film {
+    /// The camera's name (`corner`).
+    pub camera: String,
+    /// The frames in order.
+    pub frames: Vec<FilmFrame>,
+}
+
+/// One filmed frame.
+#[derive(Clone, Debug)]
+pub struct FilmFrame {
+    /// Simulated time in seconds, on the keyframes' clock.
+    pub time: f64,
+    /// The picture, JPEG.
+    pub jpeg: Vec<u8>,
+}
+
 /// The image topic of a camera: `/camera/<name>` or `/camera/<name>/marked`.
 pub fn image_topic(camera: CameraName, marked: bool) -> String {
     if marked {
@@ -230,7 +255,7 @@ fn time_ns(seconds: f64) -> u64 {
 
 /// Writes `demo` as MCAP into `w` and returns the writer.
 pub fn write_mcap<W: Write + Seek>(demo: &Demo, w: W) -> Result<W, mcap::McapError> {
-    write_mcap_with(demo, &[], w)
+    write_mcap_with(demo, &[], None, w)
 }
 
 /// [`write_mcap`] with further metadata records after the demo's own (readers of the demo
@@ -238,6 +263,7 @@ pub fn write_mcap<W: Write + Seek>(demo: &Demo, w: W) -> Result<W, mcap::McapErr
 pub(crate) fn write_mcap_with<W: Write + Seek>(
     demo: &Demo,
     extra: &[Metadata],
+    film: Option<&Film>,
     w: W,
 ) -> Result<W, mcap::McapError> {
     let options = mcap::WriteOptions::new()
@@ -301,6 +327,25 @@ pub(crate) fn write_mcap_with<W: Write + Seek>(
         out.write_to_known_channel(&header(action_channel), &json_bytes(&action))?;
     }
 
+    if let Some(film) = film {
+        let channel = out.add_channel(image_schema_id, &film_topic(&film.camera), "json", &no_meta)?;
+        for (index, frame) in film.frames.iter().enumerate() {
+            let ns = time_ns(frame.time);
+            let header = MessageHeader {
+                channel_id: channel,
+                sequence: u32::try_from(index).unwrap_or(u32::MAX),
+                log_time: ns,
+                publish_time: ns,
+            };
+            let message = ImageMessage {
+                timestamp: Timestamp::from_nanos(ns),
+                frame_id: film.camera.clone(),
+                data: BASE64.encode(&frame.jpeg),
+                format: "jpeg".to_owned(),
+            };
+            out.write_to_known_channel(&header, &json_bytes(&message))?;
+        }
+    }
     out.write_metadata(&Metadata {
         name: METADATA_NAME.to_owned(),
         metadata: metadata_map(&demo.metadata, demo.keyframes.len()),
@@ -350,19 +395,25 @@ fn metadata_map(meta: &DemoMetadata, keyframes: usize) -> BTreeMap<String, Strin
 
 /// Writes `demo` to `path` (creating parent folders).
 pub fn write_mcap_file(demo: &Demo, path: &Path) -> Result<(), DemoError> {
-    write_mcap_file_with(demo, &[], path)
+    write_mcap_file_with(demo, &[], None, path)
 }
 
 /// [`write_mcap_file`] with further metadata records.
-pub(crate) fn write_mcap_file_with(demo: &Demo, extra: &[Metadata], path: &Path) -> Result<(), DemoError> {
+pub(crate) fn write_mcap_file_with(
+    demo: &Demo,
+    extra: &[Metadata],
+    film: Option<&Film>,
+    path: &Path,
+) -> Result<(), DemoError> {
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).map_err(|e| DemoError::io(parent, e))?;
     }
-    let buffer =
-        write_mcap_with(demo, extra, std::io::Cursor::new(Vec::new())).map_err(|source| DemoError::Mcap {
+    let buffer = write_mcap_with(demo, extra, film, std::io::Cursor::new(Vec::new())).map_err(|source| {
+        DemoError::Mcap {
             path: path.to_owned(),
             source,
-        })?;
+        }
+    })?;
     std::fs::write(path, buffer.into_inner()).map_err(|e| DemoError::io(path, e))
 }
 

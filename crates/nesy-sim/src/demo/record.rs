@@ -451,8 +451,14 @@ pub struct ExecutionRecording {
 impl ExecutionRecording {
     /// Writes the recording to `path` in the `demo.mcap` format, with the goal checks and
     /// any divergence in a second metadata record
-    /// ([`EXECUTION_METADATA_NAME`](super::mcap_format::EXECUTION_METADATA_NAME)).
-    pub fn write_mcap_file(&self, path: &std::path::Path) -> Result<(), super::DemoError> {
+    /// ([`EXECUTION_METADATA_NAME`](super::mcap_format::EXECUTION_METADATA_NAME)), and the
+    /// rollout's frames, when given, on `/film/<camera>`
+    /// ([`film_topic`](super::mcap_format::film_topic)).
+    pub fn write_mcap_file(
+        &self,
+        path: &std::path::Path,
+        film: Option<&super::mcap_format::Film>,
+    ) -> Result<(), super::DemoError> {
         let mut metadata = std::collections::BTreeMap::new();
         let json = |value: serde_json::Result<String>| value.unwrap_or_else(|_| "null".to_owned());
         metadata.insert("outcome".to_owned(), json(serde_json::to_string(&self.outcome)));
@@ -463,7 +469,7 @@ impl ExecutionRecording {
             name: super::mcap_format::EXECUTION_METADATA_NAME.to_owned(),
             metadata,
         };
-        super::mcap_format::write_mcap_file_with(&self.demo, &[record], path)
+        super::mcap_format::write_mcap_file_with(&self.demo, &[record], film, path)
     }
 }
 

@@ -92,6 +92,23 @@ impl Image {
         }
     }
 
+    /// Encodes as JPEG at `quality` (1–100): a tenth of the PNG's size for a rendered frame,
+    /// which is what a recording of many frames needs.
+    pub fn to_jpeg(&self, quality: u8) -> Vec<u8> {
+        let mut out = Vec::new();
+        let (Ok(width), Ok(height)) = (u16::try_from(self.width), u16::try_from(self.height)) else {
+            return out;
+        };
+        // Encoding into a Vec cannot fail for a buffer of width × height × 3 bytes.
+        let _ = jpeg_encoder::Encoder::new(&mut out, quality.clamp(1, 100)).encode(
+            &self.rgb,
+            width,
+            height,
+            jpeg_encoder::ColorType::Rgb,
+        );
+        out
+    }
+
     /// Encodes as PNG.
     pub fn to_png(&self) -> Vec<u8> {
         let mut out = Vec::new();

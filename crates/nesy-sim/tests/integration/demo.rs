@@ -491,7 +491,7 @@ fn python_mcap_report(path: &Path) -> Option<serde_json::Value> {
     let script = r#"
 import base64, json, sys
 from mcap.reader import make_reader
-counts, pngs = {}, 0
+counts, pngs, jpegs = {}, 0, 0
 with open(sys.argv[1], "rb") as f:
     reader = make_reader(f)
     meta = [m for m in reader.iter_metadata()]
@@ -501,8 +501,11 @@ with open(sys.argv[1], "rb") as f:
         if channel.topic.startswith("/camera/"):
             assert base64.b64decode(body["data"])[:8] == b"\x89PNG\r\n\x1a\n"
             pngs += 1
+        if channel.topic.startswith("/film/"):
+            assert base64.b64decode(body["data"])[:3] == b"\xff\xd8\xff"
+            jpegs += 1
         counts[channel.topic] = counts.get(channel.topic, 0) + 1
-print(json.dumps({"counts": counts, "pngs": pngs, "metadata": {m.name: m.metadata for m in meta}}))
+print(json.dumps({"counts": counts, "pngs": pngs, "jpegs": jpegs, "metadata": {m.name: m.metadata for m in meta}}))
 "#;
     let out = std::process::Command::new(python)
         .args(["-c", script, path.to_str().unwrap()])
@@ -605,7 +608,20 @@ fn a_replayed_execution_is_the_execution_and_records_like_a_demo() {
 
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("execution.mcap");
-    recording.write_mcap_file(&path).unwrap();
+    // The filmed frames travel with the keyframes, on a topic of their own that the demo
+    // reader skips.
+    let film = mcap_format::Film {
+        camera: "corner".into(),
+        frames: frames
+            .iter()
+            .enumerate()
+            .map(|(i, image)| mcap_format::FilmFrame {
+                time: i as f64 / 10.0,
+                jpeg: image.to_jpeg(85),
+            })
+            .collect(),
+    };
+    recording.write_mcap_file(&path, Some(&film)).unwrap();
     let back = nesy_sim::demo::read_mcap(&path).unwrap();
     assert_eq!(back.keyframes.len(), recording.demo.keyframes.len());
     assert_eq!(back.metadata.side, None);
@@ -614,6 +630,11 @@ fn a_replayed_execution_is_the_execution_and_records_like_a_demo() {
         for topic in topics() {
             assert_eq!(report["counts"][&topic], n, "{topic}: {report}");
         }
+        assert_eq!(
+            report["counts"][mcap_format::film_topic("corner")],
+            frames.len() as u64
+        );
+        assert_eq!(report["jpegs"], frames.len() as u64);
         let execution = &report["metadata"][mcap_format::EXECUTION_METADATA_NAME];
         let goals: serde_json::Value = serde_json::from_str(execution["outcome"].as_str().unwrap()).unwrap();
         assert_eq!(
@@ -747,11 +768,15 @@ fn fixture_demos_read_and_match_their_tasks() {
 }
 
 /// The Foxglove layouts shipped for `demo.mcap` and `execution.mcap` name only topics the
-/// writer publishes, so that a renamed topic cannot leave a layout showing empty panels.
+/// writer publishes (the execution's also its film), so that a renamed topic cannot leave a
+/// layout showing empty panels.
 #[test]
 fn the_foxglove_layouts_name_only_topics_a_recording_has() {
-    let topics = nesy_sim::demo::mcap_format::topics();
-    for name in ["demo-layout.json", "execution-layout.json"] {
+    for (name, panels_expected) in [("demo-layout.json", 5), ("execution-layout.json", 6)] {
+        let mut topics = topics();
+        if name.starts_with("execution") {
+            topics.push(mcap_format::film_topic("corner"));
+        }
         let path = nesy_testkit::workspace_root().join("assets/foxglove").join(name);
         let layout: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
@@ -768,7 +793,10 @@ fn the_foxglove_layouts_name_only_topics_a_recording_has() {
             );
             named += 1;
         }
-        assert_eq!(named, 5, "{name}: three views, the call and the state");
+        assert_eq!(
+            named, panels_expected,
+            "{name}: three views, the call and the state (and the film)"
+        );
         // Every panel the mosaic places is configured, and every configured panel is placed.
         fn leaves(node: &serde_json::Value, out: &mut Vec<String>) {
             match node {
