@@ -131,11 +131,8 @@ fn verdict_line(run: &AdaptRun) -> String {
 /// A picture of a view (its marked version when there is one), embedded.
 fn view_image(images: &CameraImages, alt: &str) -> Html {
     let bytes = images.marked_or_raw();
-    let mime = match ImageFormat::of(bytes) {
-        Some(ImageFormat::Jpeg) => "image/jpeg",
-        _ => "image/png",
-    };
-    Html::image(bytes, mime, alt)
+    let format = ImageFormat::of(bytes).unwrap_or(ImageFormat::Png);
+    Html::image(bytes, format.mime(), alt)
 }
 
 /// Each keyframe: its first view, the call that led to it, and its state (folded).

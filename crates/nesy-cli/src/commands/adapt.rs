@@ -177,7 +177,8 @@ pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
         }
     };
     progress.stage("writing the outputs");
-    RunDir::create(&run.out_dir)?.write_all(&run, &target)?;
+    let out_dir = RunDir::create(&run.out_dir)?;
+    out_dir.write_all(&run, &target)?;
     progress.stage("");
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&run)?)?;
@@ -202,7 +203,7 @@ pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     }
     // Written last, so that it can show the rollout.
     let html = pipeline::report_html(&run, &demo, &target, rollout_files.as_ref());
-    RunDir::create(&run.out_dir)?.write_text(pipeline::HTML_REPORT_FILE, &html)?;
+    out_dir.write_text(pipeline::HTML_REPORT_FILE, &html)?;
     if let Some(error @ pipeline::synth::SynthError::Call { .. }) = &run.codegen_error {
         eprintln!("error: {error} (outputs written to {})", run.out_dir.display());
     }

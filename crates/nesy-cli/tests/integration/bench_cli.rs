@@ -13,14 +13,20 @@ const SCENARIOS: &str = "obst_low_00_s0,affo_low_01_s1,grip_low_02_s0";
 const METHODS: &str = "nesycr,imitation,replan";
 
 fn run_args(run: &Path, demos: &Path, extra: &[&str]) -> Vec<String> {
+    oracle_run_args(run, demos, METHODS, SCENARIOS, extra)
+}
+
+/// `nesy bench run RUN --methods METHODS --scenarios SCENARIOS --vlm oracle --demos DEMOS` and
+/// `extra`.
+fn oracle_run_args(run: &Path, demos: &Path, methods: &str, scenarios: &str, extra: &[&str]) -> Vec<String> {
     let mut args: Vec<String> = [
         "bench",
         "run",
         &run.display().to_string(),
         "--methods",
-        METHODS,
+        methods,
         "--scenarios",
-        SCENARIOS,
+        scenarios,
         "--vlm",
         "oracle",
         "--demos",
@@ -268,10 +274,13 @@ fn killed_runs_resume_shards_merge_and_configurations_do_not_mix() {
     assert_eq!(same["overall"]["a"]["n"], 3, "{same}");
     assert_eq!(same["changed"].as_array().map(Vec::len), Some(0), "{same}");
     let unverified = scratch.path().join("unverified");
-    let mut args = run_args(&unverified, &demos, &[]);
-    let methods = args.iter().position(|a| a == METHODS).unwrap();
-    args[methods] = "nesycr+verification=off".into();
-    let out = common::nesy(&args);
+    let out = common::nesy(&oracle_run_args(
+        &unverified,
+        &demos,
+        "nesycr+verification=off",
+        SCENARIOS,
+        &[],
+    ));
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let switched = compare(
         &whole,
@@ -513,19 +522,8 @@ fn the_complexity_gap_study_reports_sr_and_pd_by_added_subtasks() {
 fn a_pushed_object_is_not_read_as_a_hidden_carry() {
     let scratch = common::scratch();
     let run = scratch.path().join("run");
-    let out = common::nesy(&[
-        "bench".into(),
-        "run".into(),
-        run.display().to_string(),
-        "--scenarios".into(),
-        "obst_high_04_s1".into(),
-        "--methods".into(),
-        "nesycr".into(),
-        "--vlm".into(),
-        "oracle".into(),
-        "--demos".into(),
-        scratch.path().join("demos").display().to_string(),
-    ]);
+    let demos = scratch.path().join("demos");
+    let out = common::nesy(&oracle_run_args(&run, &demos, "nesycr", "obst_high_04_s1", &[]));
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let adaptation =
         std::fs::read_to_string(run.join("units/obst_high_04_s1/nesycr/adaptation.json")).unwrap();

@@ -44,17 +44,22 @@ fn start(dir: &std::path::Path, extra: &[&str]) -> (Server, String) {
     (Server { child, address }, line)
 }
 
+/// Sends `request` as written and returns the whole response.
+fn send(server: &Server, request: &str) -> String {
+    let mut stream = TcpStream::connect(&server.address).unwrap();
+    stream.write_all(request.as_bytes()).unwrap();
+    let mut response = String::new();
+    stream.read_to_string(&mut response).unwrap();
+    response
+}
+
 /// Sends `GET target` as written (no client-side normalisation) and returns the status code
 /// and body.
 fn get(server: &Server, target: &str) -> (u16, String) {
-    let mut stream = TcpStream::connect(&server.address).unwrap();
-    write!(
-        stream,
-        "GET {target} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"
-    )
-    .unwrap();
-    let mut response = String::new();
-    stream.read_to_string(&mut response).unwrap();
+    let response = send(
+        server,
+        &format!("GET {target} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"),
+    );
     let code = response
         .split(' ')
         .nth(1)
@@ -111,14 +116,10 @@ fn the_runs_folder_is_served_read_only_on_loopback_and_nothing_outside_it() {
     assert_eq!(get(&server, "/nothing.html").0, 404);
 
     // Only reading: any other method is refused.
-    let mut stream = TcpStream::connect(&server.address).unwrap();
-    write!(
-        stream,
-        "PUT /adapt/one/report.html HTTP/1.1\r\nContent-Length: 1\r\n\r\nx"
-    )
-    .unwrap();
-    let mut response = String::new();
-    stream.read_to_string(&mut response).unwrap();
+    let response = send(
+        &server,
+        "PUT /adapt/one/report.html HTTP/1.1\r\nContent-Length: 1\r\n\r\nx",
+    );
     assert!(response.starts_with("HTTP/1.1 405"), "{response}");
     assert_eq!(
         std::fs::read_to_string(runs.join("adapt/one/report.html")).unwrap(),

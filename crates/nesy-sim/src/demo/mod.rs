@@ -387,6 +387,14 @@ impl ImageFormat {
             ImageFormat::Jpeg => "jpg",
         }
     }
+
+    /// The media type: `image/png` or `image/jpeg`.
+    pub fn mime(self) -> &'static str {
+        match self {
+            ImageFormat::Png => "image/png",
+            ImageFormat::Jpeg => "image/jpeg",
+        }
+    }
 }
 
 /// Width and height of a PNG (from its header) or a JPEG (from its frame header), without

@@ -292,7 +292,7 @@ fn record(
     options: &RecordOptions,
     video: Option<(&VideoOptions, SyncSender<VideoFrame>)>,
 ) -> Result<(Recording, Filmed), RecordError> {
-    let film = video.map(|(video, frames)| Film {
+    let film = video.map(|(video, frames)| Filming {
         video,
         frames,
         caption: None,
@@ -313,7 +313,7 @@ fn record(
 }
 
 /// How to film while a driver works the robot.
-struct Film<'a> {
+struct Filming<'a> {
     video: &'a VideoOptions,
     frames: SyncSender<VideoFrame>,
     /// The caption written on every frame, which the driver updates.
@@ -340,7 +340,7 @@ struct Driven<T> {
 fn drive<T>(
     scene: &SceneSpec,
     options: &RecordOptions,
-    film: Option<Film<'_>>,
+    film: Option<Filming<'_>>,
     driver: impl FnOnce(&mut Sim) -> T,
 ) -> Result<Driven<T>, RecordError> {
     let started = Instant::now();
@@ -487,7 +487,7 @@ pub fn replay_execution(
     video: Option<(&VideoOptions, SyncSender<VideoFrame>)>,
 ) -> Result<ExecutionRecording, RecordError> {
     let caption = Arc::new(Mutex::new(String::new()));
-    let film = video.map(|(video, frames)| Film {
+    let film = video.map(|(video, frames)| Filming {
         video,
         frames,
         caption: Some(caption.clone()),
