@@ -264,7 +264,8 @@ pub enum ApiValue {
     Xy([f64; 2]),
 }
 
-/// Why the robot refused or failed a call. Refused calls do not move the robot.
+/// Why the robot refused or failed a call. Refused calls do not move the robot; a motion
+/// stopped by contact ([`ApiError::Collision`]) ends where it stopped.
 #[derive(Clone, Debug, PartialEq, thiserror::Error, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum ApiError {
@@ -324,6 +325,18 @@ pub enum ApiError {
     NoEmptySpace {
         /// The object to be placed.
         obj_name: String,
+    },
+    /// The motion was stopped by contact, as a real arm's protective stop ends it: a lid or
+    /// drawer the robot was moving ran into another piece of furniture. Unlike refusals,
+    /// the robot has moved: it stays where it stopped, still holding the handle.
+    #[error("{call}() was stopped by contact: {moving} ran into {obstacle}")]
+    Collision {
+        /// The call whose motion stopped.
+        call: String,
+        /// The part that was being moved.
+        moving: String,
+        /// The part it ran into.
+        obstacle: String,
     },
     /// The episode's budget of action calls is used up.
     #[error("action budget of {limit} calls exhausted")]

@@ -40,6 +40,12 @@ pyo3::create_exception!(
 );
 pyo3::create_exception!(
     robot,
+    CollisionError,
+    RobotError,
+    "The motion was stopped by contact: a lid or drawer being moved ran into other furniture; the robot stays where it stopped."
+);
+pyo3::create_exception!(
+    robot,
     InvalidArgumentError,
     RobotError,
     "An argument value is out of range."
@@ -74,6 +80,7 @@ fn api_error(err: ApiError) -> PyErr {
         | ApiError::OutOfWorkspace { .. }
         | ApiError::IkFailed { .. }
         | ApiError::NoEmptySpace { .. } => InfeasibleError::new_err(message),
+        ApiError::Collision { .. } => CollisionError::new_err(message),
         ApiError::InvalidArgument { .. } => InvalidArgumentError::new_err(message),
         ApiError::BudgetExhausted { .. } => BudgetExhaustedError::new_err(message),
     }
@@ -403,6 +410,7 @@ pub(crate) fn robot(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("WrongEmbodimentError", py.get_type::<WrongEmbodimentError>())?;
     m.add("UnknownObjectError", py.get_type::<UnknownObjectError>())?;
     m.add("InfeasibleError", py.get_type::<InfeasibleError>())?;
+    m.add("CollisionError", py.get_type::<CollisionError>())?;
     m.add("InvalidArgumentError", py.get_type::<InvalidArgumentError>())?;
     m.add("BudgetExhaustedError", py.get_type::<BudgetExhaustedError>())?;
     m.add("SandboxViolation", py.get_type::<SandboxViolation>())?;

@@ -76,7 +76,9 @@ pub struct Snapshot {
 /// (`docs/benchmark.md` §5's table).
 fn padding(name: &str) -> ([f64; 3], [f64; 3]) {
     match name {
-        parts::HINGE_BODY => ([-0.02, -0.02, -0.02], [0.02, 0.02, 0.05]),
+        hinge if parts::has_part_suffix(hinge, parts::HINGE_BODY) => {
+            ([-0.02, -0.02, -0.02], [0.02, 0.02, 0.05])
+        }
         parts::TOY_BOX => ([-0.02, -0.02, -0.01], [0.02, 0.02, 0.05]),
         parts::LEFT_CHESS_BOX | parts::RIGHT_CHESS_BOX => ([-0.01, -0.01, -0.01], [0.01, 0.01, 0.05]),
         _ => ([-0.01, -0.01, -0.01], [0.01, 0.01, 0.02]),
@@ -300,18 +302,22 @@ fn push_on_top_of(s: &Snapshot, inside: &[Option<usize>], atoms: &mut Vec<Atom>)
     on_top
 }
 
-/// Special rule: an open top drawer lies over the bottom drawer's handle (they belong to
-/// one asset, so the general rule never pairs them).
+/// Special rule: a cabinet's open top drawer lies over its bottom drawer's handle (they
+/// belong to one asset, so the general rule never pairs them).
 fn push_drawer_over_handle(s: &Snapshot, atoms: &mut Vec<Atom>) {
-    if let (Some(top), Some(handle)) = (
-        s.objects.iter().find(|o| o.name == parts::TOP_DRAWER),
-        s.objects.iter().find(|o| o.name == parts::BOTTOM_DRAWER_HANDLE),
-    ) && top.aabb.overlaps_xy(&handle.aabb, OVER_XY_MARGIN)
-    {
-        atoms.push(Atom::new(
-            "OnTopOf",
-            &[parts::TOP_DRAWER, parts::BOTTOM_DRAWER_HANDLE],
-        ));
+    for top in s.objects.iter().filter(|o| o.role == PartRole::Link) {
+        let Some(prefix) = parts::prefix_of(&top.name, parts::TOP_DRAWER) else {
+            continue;
+        };
+        let handle_name = format!("{prefix}{}", parts::BOTTOM_DRAWER_HANDLE);
+        if let Some(handle) = s
+            .objects
+            .iter()
+            .find(|o| o.name == handle_name && o.group == top.group)
+            && top.aabb.overlaps_xy(&handle.aabb, OVER_XY_MARGIN)
+        {
+            atoms.push(Atom::new("OnTopOf", &[&top.name, &handle.name]));
+        }
     }
 }
 

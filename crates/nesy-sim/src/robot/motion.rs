@@ -9,6 +9,7 @@ use crate::api::{ApiError, Direction, Embodiment};
 use crate::robot::kinematics::{IkOptions, Iso, OrientationGoal, pointing_rotation};
 use crate::robot::planner::{self, PlannerOptions};
 use crate::scene::TABLE_TOP;
+use crate::world::contact::ContactStop;
 use crate::world::geometry::{array_to_na, iso_to_pose};
 use crate::world::objects::PartRole;
 use crate::world::rng::Stream;
@@ -554,12 +555,18 @@ impl Sim {
     }
 
     /// Plays planned segments back with eased timing, then settles.
-    pub(crate) fn execute(&mut self, segments: &[Vec<Vec<f64>>], settle: u32) {
-        self.execute_at_least(segments, settle, MIN_SEGMENT);
+    pub(crate) fn execute(&mut self, segments: &[Vec<Vec<f64>>], settle: u32) -> Result<(), ContactStop> {
+        self.execute_at_least(segments, settle, MIN_SEGMENT)
     }
 
     /// [`Sim::execute`] with a longer shortest segment duration (s).
-    pub(crate) fn execute_at_least(&mut self, segments: &[Vec<Vec<f64>>], settle: u32, min_segment: f64) {
+    pub(crate) fn execute_at_least(
+        &mut self,
+        segments: &[Vec<Vec<f64>>],
+        settle: u32,
+        min_segment: f64,
+    ) -> Result<(), ContactStop> {
+        self.contact_stop = None;
         for path in segments {
             let (cumulative, total) = path_lengths(path);
             let tool_len = {
@@ -581,9 +588,15 @@ impl Sim {
                 let s = ease(k as f64 / steps as f64);
                 let q = sample_path(path, &cumulative, total, s);
                 self.control_step(&q);
+                // A protective stop: the arm halts where the driven link met furniture.
+                if let Some(stop) = self.contact_stop.take() {
+                    self.step_idle(settle);
+                    return Err(stop);
+                }
             }
         }
         self.step_idle(settle);
+        Ok(())
     }
 }
 

@@ -60,9 +60,10 @@ pub struct SceneSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectSpec {
-    /// Unique name, used by prompts, the API and the observer. Articulated kinds have fixed
-    /// part names and take the name of their base part: `hinge_body` for a hinge box,
-    /// `drawer_body` for a drawer cabinet.
+    /// Unique name, used by prompts, the API and the observer. Articulated kinds take the
+    /// name of their base part, `hinge_body` for a hinge box and `drawer_body` for a drawer
+    /// cabinet, optionally after a prefix ending in `_` that their other parts carry too
+    /// (`left_drawer_body` has the drawers `left_top_drawer` and `left_bottom_drawer`).
     pub name: String,
     /// What it is.
     pub kind: ObjectKind,
@@ -138,8 +139,9 @@ impl ObjectKind {
         )
     }
 
-    /// The fixed name an articulated kind's entry must have.
-    pub fn required_name(self) -> Option<&'static str> {
+    /// The base part name an articulated kind's entry must end with (after an optional
+    /// prefix ending in `_`).
+    pub fn required_suffix(self) -> Option<&'static str> {
         match self {
             ObjectKind::HingeBox => Some(parts::HINGE_BODY),
             ObjectKind::DrawerCabinet => Some(parts::DRAWER_BODY),
@@ -282,10 +284,19 @@ impl SceneError {
 /// Names of the parts an object entry creates, base part first.
 pub fn part_names(spec: &ObjectSpec) -> Vec<String> {
     match spec.kind {
-        ObjectKind::HingeBox => parts::HINGE_BOX_PARTS.map(str::to_owned).to_vec(),
-        ObjectKind::DrawerCabinet => parts::DRAWER_CABINET_PARTS.map(str::to_owned).to_vec(),
+        ObjectKind::HingeBox => parts::prefixed(part_prefix(spec), &parts::HINGE_BOX_PARTS),
+        ObjectKind::DrawerCabinet => parts::prefixed(part_prefix(spec), &parts::DRAWER_CABINET_PARTS),
         _ => vec![spec.name.clone()],
     }
+}
+
+/// The prefix an articulated object's parts carry: its name before the base part's name
+/// (`""` for `drawer_body`, `"left_"` for `left_drawer_body`); `""` for other kinds.
+pub fn part_prefix(spec: &ObjectSpec) -> &str {
+    spec.kind
+        .required_suffix()
+        .and_then(|suffix| parts::prefix_of(&spec.name, suffix))
+        .unwrap_or("")
 }
 
 impl SceneSpec {
@@ -355,7 +366,14 @@ impl SceneSpec {
             validate_object_names(i, o, &mut seen)?;
             validate_object_numbers(i, o)?;
         }
-        self.validate_articulations(&seen)?;
+        let links: HashSet<String> = self
+            .objects
+            .iter()
+            .filter(|o| o.kind.required_suffix().is_some())
+            .flat_map(part_names)
+            .filter(|part| parts::Joint::from_name(part).is_some())
+            .collect();
+        self.validate_articulations(&links)?;
         self.validate_goals(&seen, &reserved)
     }
 
@@ -378,23 +396,23 @@ impl SceneSpec {
         Ok(())
     }
 
-    /// Checks that each articulation names a known joint of a part in the scene (`seen`
-    /// holds every part name) and lies within that joint's limits.
-    fn validate_articulations(&self, seen: &HashSet<String>) -> Result<(), SceneError> {
+    /// Checks that each articulation names a moving link of an asset in the scene (`links`
+    /// holds their names) and lies within that joint's limits.
+    fn validate_articulations(&self, links: &HashSet<String>) -> Result<(), SceneError> {
         for (part, q) in &self.articulations {
             let at = format!("articulations.{part}");
             let Some((lo, hi)) = parts::Joint::from_name(part).map(parts::Joint::limits) else {
                 return Err(SceneError::invalid(
                     at,
-                    "one of hinge_lid, top_drawer, bottom_drawer",
+                    "one of hinge_lid, top_drawer, bottom_drawer (after an asset's prefix, if it has one)",
                     format!("{part:?}"),
                 ));
             };
-            if !seen.contains(part) {
+            if !links.contains(part) {
                 return Err(SceneError::invalid(
                     at,
-                    "a part of an object in the scene",
-                    format!("{part:?}, which no object provides"),
+                    "a lid or drawer of an asset in the scene",
+                    format!("{part:?}, which no asset provides"),
                 ));
             }
             if !(q.is_finite() && *q >= lo - 1e-9 && *q <= hi + 1e-9) {
@@ -451,12 +469,15 @@ fn validate_object_names(i: usize, o: &ObjectSpec, seen: &mut HashSet<String>) -
             format!("{:?}", o.name),
         ));
     }
-    if let Some(required) = o.kind.required_name()
-        && o.name != required
+    if let Some(required) = o.kind.required_suffix()
+        && !parts::has_part_suffix(&o.name, required)
     {
         return Err(SceneError::invalid(
             at("name"),
-            format!("\"{required}\" (the parts of a {:?} have fixed names)", o.kind),
+            format!(
+                "\"{required}\" or a prefix ending in '_' before it, such as \"left_{required}\" (a {:?}'s parts are named after it)",
+                o.kind
+            ),
             format!("{:?}", o.name),
         ));
     }

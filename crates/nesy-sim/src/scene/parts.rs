@@ -2,16 +2,22 @@
 //! assets with their limits and rest positions, in the benchmark's joint convention
 //! (`docs/benchmark.md` §2.3–§2.4).
 //!
-//! Articulated kinds have fixed part names (a hinge box is always `hinge_body`, `hinge_lid`
-//! and `hinge_handle`); the API, the observer, the goal checks, the experts and the template
-//! compiler all name them through these constants.
+//! Articulated kinds name their parts after their body: a hinge box whose entry is called
+//! `hinge_body` has the parts `hinge_body`, `hinge_lid` and `hinge_handle`, and one called
+//! `left_hinge_body` has `left_hinge_body`, `left_hinge_lid` and `left_hinge_handle`. A scene
+//! may hold several articulated assets as long as their prefixes differ; the benchmark's
+//! scenes use the bare names, which the API, the observer, the goal checks, the experts and
+//! the template compiler name through these constants.
 //!
 //! ```
 //! use nesy_sim::scene::parts::{self, Joint};
 //!
 //! assert_eq!(Joint::from_name(parts::HINGE_LID), Some(Joint::HingeLid));
+//! assert_eq!(Joint::from_name("left_top_drawer"), Some(Joint::TopDrawer));
+//! assert_eq!(Joint::from_name("left_top_drawer_handle"), None);
 //! assert_eq!(Joint::HingeLid.limits(), (-0.785, 0.8));
 //! assert_eq!(Joint::BottomDrawer.closed(), 0.0);
+//! assert_eq!(parts::prefixed("left_", &parts::DRAWER_CABINET_PARTS)[1], "left_bottom_drawer");
 //! ```
 
 /// The table, as the API and the observer name it.
@@ -57,6 +63,24 @@ pub const DRAWER_CABINET_PARTS: [&str; 5] = [
     TOP_DRAWER_HANDLE,
 ];
 
+/// True when `name` is `part` or ends with `_` followed by `part` (an asset's prefixed part).
+pub fn has_part_suffix(name: &str, part: &str) -> bool {
+    name.strip_suffix(part)
+        .is_some_and(|prefix| prefix.is_empty() || prefix.ends_with('_'))
+}
+
+/// The names of an asset's parts for a prefix (`""` or one ending in `_`), in the order of
+/// `asset_parts` (one of [`HINGE_BOX_PARTS`] and [`DRAWER_CABINET_PARTS`]).
+pub fn prefixed(prefix: &str, asset_parts: &[&str]) -> Vec<String> {
+    asset_parts.iter().map(|part| format!("{prefix}{part}")).collect()
+}
+
+/// The prefix of a prefixed part name: what `name` carries before `part` (`"left_"` for
+/// `left_top_drawer` and `top_drawer`), or `None` when it does not end with it.
+pub fn prefix_of<'a>(name: &'a str, part: &str) -> Option<&'a str> {
+    has_part_suffix(name, part).then(|| &name[..name.len() - part.len()])
+}
+
 /// Lid joint position when open (the lid stands vertical).
 pub const LID_OPEN: f64 = 0.785;
 /// Lid joint position when closed (the lid lies flat on the body).
@@ -93,9 +117,11 @@ impl Joint {
         }
     }
 
-    /// The joint of a moving link's part name.
+    /// The joint of a moving link's part name: the name is the link's own (`top_drawer`) or
+    /// ends with it after an asset's prefix (`left_top_drawer`). The scene checks that such a
+    /// name really is a link of one of its assets.
     pub fn from_name(name: &str) -> Option<Joint> {
-        Joint::ALL.into_iter().find(|j| j.name() == name)
+        Joint::ALL.into_iter().find(|j| has_part_suffix(name, j.name()))
     }
 
     /// Lower and upper limit.

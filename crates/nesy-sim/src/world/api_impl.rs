@@ -183,15 +183,18 @@ impl Sim {
         })
     }
 
-    /// The open top drawer covering the bottom drawer's handle (`docs/benchmark.md` §4 rule 3).
+    /// The open top drawer covering the bottom drawer's handle of the same cabinet
+    /// (`docs/benchmark.md` §4 rule 3).
     pub fn handle_covered_by(&self, part: usize) -> Option<usize> {
-        if self.parts[part].name != parts::BOTTOM_DRAWER_HANDLE {
+        let handle = &self.parts[part];
+        if handle.role != PartRole::Handle {
             return None;
         }
-        let top = self.part_index(parts::TOP_DRAWER)?;
-        self.part_aabb(top)
-            .overlaps_xy(&self.part_aabb(part), 0.005)
-            .then_some(top)
+        let prefix = parts::prefix_of(&handle.name, parts::BOTTOM_DRAWER_HANDLE)?;
+        let top = self.part_index(&format!("{prefix}{}", parts::TOP_DRAWER))?;
+        (self.parts[top].object == handle.object
+            && self.part_aabb(top).overlaps_xy(&self.part_aabb(part), 0.005))
+        .then_some(top)
     }
 
     /// A loose object resting on the articulation's link (it blocks a lid from opening).
@@ -309,9 +312,9 @@ impl Sim {
             rotation,
         });
         let plan = self.plan(&waypoints, pointing, transit)?;
-        self.execute(&plan, MOTION_SETTLE_STEPS);
+        let executed = self.execute(&plan, MOTION_SETTLE_STEPS);
         self.moved_since_reset = true;
-        Ok(())
+        executed.map_err(|stop| stop.into_error(self, "move_to_position"))
     }
 
     /// How far the tool backs off along its axis before a transit: the full `clearance`
@@ -438,6 +441,14 @@ impl Sim {
             }
         }
         self.do_move_to_position(target, pointing, crate::api::DEFAULT_LIFT_CLEARANCE, yaw)
+            .map_err(|err| match err {
+                ApiError::Collision { moving, obstacle, .. } => ApiError::Collision {
+                    call: "move_gripper_to".into(),
+                    moving,
+                    obstacle,
+                },
+                other => other,
+            })
     }
 
     /// Of the finger grasp spins `angle + k·step`, the one nearest the current tool whose
@@ -547,8 +558,9 @@ impl Sim {
             dir,
             None,
         )?;
-        self.execute_at_least(&plan, MOTION_SETTLE_STEPS, PARALLEL_MIN_DURATION);
+        let executed = self.execute_at_least(&plan, MOTION_SETTLE_STEPS, PARALLEL_MIN_DURATION);
         self.moved_since_reset = true;
+        executed.map_err(|stop| stop.into_error(self, "move_parallel"))?;
         let sideways = dir != Direction::Up;
         let empty_fingers =
             self.scene.embodiment == Embodiment::Finger && self.held.is_none() && self.handle_grasp.is_none();

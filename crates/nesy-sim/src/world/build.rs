@@ -404,6 +404,7 @@ impl Sim {
             last_push: None,
             hooks: Vec::new(),
             action_pause_steps: 0,
+            contact_stop: None,
         };
         sim.check_interpenetration()?;
         for _ in 0..sim.config.settle_steps {

@@ -1,8 +1,8 @@
 //! `get_empty_floor_xy`: a free table spot for putting an object down (`docs/benchmark.md` §4), with the
 //! authors' variable-shadowing bugs fixed (see the crate README).
 
-use crate::scene::parts;
 use crate::world::geometry::Aabb;
+use crate::world::objects::PartRole;
 use crate::world::{FLOOR_AABB, Sim};
 
 /// Obstacle padding in xy (m).
@@ -13,7 +13,7 @@ const REGION_X_MAX: f64 = 0.53;
 const REGION_Y: (f64, f64) = (-0.15, 0.16);
 
 /// Finds a free xy for `part`: on a grid of step 0.6 × its larger footprint side over the
-/// region x ∈ [0.11 + hx, min(0.53, hinge/drawer body min x) − hx], y ∈ [−0.15 + hy,
+/// region x ∈ [0.11 + hx, min(0.53, every hinge/drawer body's min x) − hx], y ∈ [−0.15 + hy,
 /// 0.16 − hy]; free means its padded footprint meets no other object's padded footprint.
 /// The current spot wins if it is free; otherwise the candidate nearest the object's
 /// current position.
@@ -22,10 +22,13 @@ pub(crate) fn empty_floor_xy(sim: &Sim, part: usize) -> Option<[f64; 2]> {
     let size = me.size();
     let (hx, hy) = (size[0] / 2.0, size[1] / 2.0);
     let mut x_max = REGION_X_MAX;
-    for name in [parts::HINGE_BODY, parts::DRAWER_BODY] {
-        if let Some(i) = sim.part_index(name) {
-            x_max = x_max.min(sim.part_aabb(i).min[0]);
-        }
+    for (i, _) in sim
+        .parts()
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.role == PartRole::ArticulatedBody)
+    {
+        x_max = x_max.min(sim.part_aabb(i).min[0]);
     }
     let (x_lo, x_hi) = (FLOOR_AABB.min[0] + hx, x_max - hx);
     let (y_lo, y_hi) = (REGION_Y.0 + hy, REGION_Y.1 - hy);

@@ -5,12 +5,14 @@
 //!
 //! - [`Sim`] is the world; it implements [`crate::api::RobotApi`] (in `api_impl`).
 //! - `build` builds it from a scene in named steps.
+//! - `contact` stops lids and drawers where they meet other furniture.
 //! - [`objects`] builds the benchmark's objects from their kinds; [`geometry`] holds the
 //!   boxes and frame conversions; `floor` finds free table spots; `rng` is the seeded
 //!   randomness that scene generation and motion planning draw from.
 
 mod api_impl;
 mod build;
+pub(crate) mod contact;
 pub(crate) mod floor;
 pub mod geometry;
 pub mod objects;
@@ -196,6 +198,9 @@ pub struct Sim {
     /// Control steps the robot holds still after each successful action (see
     /// [`Sim::set_action_pause`]).
     pub(crate) action_pause_steps: u32,
+    /// Set when a link the arm drives met other furniture during the current motion; the
+    /// motion ends at the next control step.
+    pub(crate) contact_stop: Option<contact::ContactStop>,
 }
 
 impl Sim {
@@ -448,8 +453,20 @@ impl Sim {
         }
         if let Some(grasp) = self.handle_grasp {
             let tool = (self.base * poses[self.robot.model.tool_link]).translation.vector;
-            let q_joint = self.follow_handle(&grasp, tool);
+            let wanted = self.follow_handle(&grasp, tool);
+            let (q_joint, stop) = self.travel_until_contact(grasp.articulation, wanted);
             self.set_articulation(grasp.articulation, q_joint);
+            if stop.is_some() {
+                self.contact_stop = self.contact_stop.or(stop);
+                // The hand stops up to one substep past the point of contact; the handle
+                // stays where the link stopped, so the grasp is re-anchored there (else the
+                // next motion would first have to make up that millimetre against the
+                // obstacle, even when it backs away from it).
+                if let Some(g) = self.handle_grasp.as_mut() {
+                    g.tool0 = tool;
+                    g.q0 = q_joint;
+                }
+            }
             // Like the authors' controller, a handle left more than the reach behind (the
             // joint at its limit while the hand moves on) slips out of the grasp.
             let a = &self.articulations[grasp.articulation];

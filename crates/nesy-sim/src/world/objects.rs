@@ -6,7 +6,7 @@
 use rapier3d::prelude::{Pose, SharedShape, Vector};
 
 use crate::scene::parts;
-use crate::scene::{ColourSpec, NamedColour, ObjectKind, ObjectSpec};
+use crate::scene::{ColourSpec, NamedColour, ObjectKind, ObjectSpec, part_prefix};
 
 /// Density of loose objects in kg/m³ (the authors' Genesis default).
 pub const DENSITY: f32 = 200.0;
@@ -420,8 +420,8 @@ pub fn build_object(spec: &ObjectSpec) -> Vec<PartBuild> {
         }
         ObjectKind::ChessBox => vec![fixed(&spec.name, PartRole::Fixed, chess_box(s, colour))],
         ObjectKind::ToyBox => vec![fixed(&spec.name, PartRole::Fixed, open_box(s, 0.004, colour))],
-        ObjectKind::HingeBox => hinge_box(colour),
-        ObjectKind::DrawerCabinet => drawer_cabinet(colour),
+        ObjectKind::HingeBox => hinge_box(part_prefix(spec), colour),
+        ObjectKind::DrawerCabinet => drawer_cabinet(part_prefix(spec), colour),
     }
 }
 
@@ -430,11 +430,12 @@ pub const HINGE_BOX_WALL: f32 = 0.005;
 
 /// Hinge box geometry: body 0.1025 × 0.205 × 0.1165 open at the top; lid 0.109 × 0.21 ×
 /// 0.01 hinged about y at the body's far (+x) top edge; a handle block on the lid's free
-/// (−x) edge.
-fn hinge_box(colour: [f32; 3]) -> Vec<PartBuild> {
+/// (−x) edge. Part names carry `prefix` (`docs/benchmark.md` §2.3).
+fn hinge_box(prefix: &str, colour: [f32; 3]) -> Vec<PartBuild> {
+    let [body_name, lid_name, handle_name] = parts::HINGE_BOX_PARTS.map(|part| format!("{prefix}{part}"));
     let [bx, by, bz] = [0.1025_f32, 0.205, 0.1165];
     let body = fixed(
-        parts::HINGE_BODY,
+        &body_name,
         PartRole::ArticulatedBody,
         open_box([bx, by, bz], HINGE_BOX_WALL, colour),
     );
@@ -442,7 +443,7 @@ fn hinge_box(colour: [f32; 3]) -> Vec<PartBuild> {
     let lid_colour = [colour[0] * 0.8, colour[1] * 0.8, colour[2] * 0.9];
     let hinge = at(bx / 2.0, 0.0, bz);
     let lid = PartBuild {
-        name: parts::HINGE_LID.into(),
+        name: lid_name,
         role: PartRole::Link,
         motion: PartMotion::Articulated,
         offset: hinge,
@@ -459,7 +460,7 @@ fn hinge_box(colour: [f32; 3]) -> Vec<PartBuild> {
         solid: true,
     };
     let handle = PartBuild {
-        name: parts::HINGE_HANDLE.into(),
+        name: handle_name,
         role: PartRole::Handle,
         motion: PartMotion::Articulated,
         offset: hinge,
@@ -485,8 +486,10 @@ const HANDLE_STANDOFF: f32 = 0.025;
 /// Drawer cabinet geometry: body 0.154 × 0.148 × 0.194 open at the front (−y) with a
 /// middle shelf; two drawers (open boxes 0.142 × 0.142, 0.085 tall with a front panel)
 /// sliding out toward −y by up to 0.1232; a visual-only bar handle 2.5 cm in front of each
-/// face.
-fn drawer_cabinet(colour: [f32; 3]) -> Vec<PartBuild> {
+/// face. Part names carry `prefix`.
+fn drawer_cabinet(prefix: &str, colour: [f32; 3]) -> Vec<PartBuild> {
+    let [body_name, bottom, top, bottom_handle, top_handle] =
+        parts::DRAWER_CABINET_PARTS.map(|part| format!("{prefix}{part}"));
     let [sx, sy, sz] = [0.154_f32, 0.148, 0.194];
     let t = 0.005_f32;
     let body_shapes = vec![
@@ -498,7 +501,7 @@ fn drawer_cabinet(colour: [f32; 3]) -> Vec<PartBuild> {
         cuboid([sx - 2.0 * t, sy - t, t], [0.0, -t / 2.0, 0.097], colour),
         cuboid([sx - 2.0 * t, sy - t, t], [0.0, -t / 2.0, sz - t / 2.0], colour),
     ];
-    let body = fixed(parts::DRAWER_BODY, PartRole::ArticulatedBody, body_shapes);
+    let body = fixed(&body_name, PartRole::ArticulatedBody, body_shapes);
     let front = -sy / 2.0;
     let drawer = |name: &str, z0: f32, tint: [f32; 3]| -> PartBuild {
         let (w, d, h, wt) = (0.142_f32, 0.142_f32, 0.085_f32, 0.004_f32);
@@ -553,10 +556,10 @@ fn drawer_cabinet(colour: [f32; 3]) -> Vec<PartBuild> {
     let tint = [colour[0] * 0.85 + 0.1, colour[1] * 0.85 + 0.05, colour[2] * 0.85];
     vec![
         body,
-        drawer(parts::BOTTOM_DRAWER, 0.0055, tint),
-        drawer(parts::TOP_DRAWER, 0.1, tint),
-        handle(parts::BOTTOM_DRAWER_HANDLE, 0.0055 + 0.06, 1),
-        handle(parts::TOP_DRAWER_HANDLE, 0.1 + 0.06, 2),
+        drawer(&bottom, 0.0055, tint),
+        drawer(&top, 0.1, tint),
+        handle(&bottom_handle, 0.0055 + 0.06, 1),
+        handle(&top_handle, 0.1 + 0.06, 2),
     ]
 }
 

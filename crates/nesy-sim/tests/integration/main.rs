@@ -12,6 +12,7 @@ mod demo;
 mod demo_goal;
 mod determinism;
 mod experts;
+mod furniture;
 mod kinematics;
 mod refusals;
 mod scenarios;
