@@ -53,7 +53,14 @@ pub struct ObjectView {
     pub joint: Option<(f64, f64, f64)>,
     /// True if it is in the grasp region (between the pads or under the cup).
     pub in_gripper: bool,
+    /// For a fine-grained object (its pieces merged into this one view): whether they are
+    /// gathered ([`GATHERED_SPREAD`]); `None` for every other object.
+    pub gathered: Option<bool>,
 }
+
+/// A fine-grained object is `Gathered` when every piece's centre lies within this distance
+/// (m) of the pieces' mean: a pile that a hand or a magnet can take as one.
+pub const GATHERED_SPREAD: f64 = 0.035;
 
 /// Everything the rules look at.
 #[derive(Clone, Debug, PartialEq)]
@@ -94,6 +101,7 @@ pub fn snapshot(sim: &Sim) -> Snapshot {
         group: None,
         joint: None,
         in_gripper: false,
+        gathered: None,
     };
     let objects = std::iter::once(floor)
         .chain(sim.parts().iter().enumerate().map(|(i, p)| {
@@ -113,9 +121,11 @@ pub fn snapshot(sim: &Sim) -> Snapshot {
                 group,
                 joint,
                 in_gripper: sim.part_in_gripper(i),
+                gathered: None,
             }
         }))
         .collect();
+    let objects = merge_pieces(sim, objects);
     Snapshot {
         objects,
         embodiment: sim.robot_embodiment(),
@@ -124,6 +134,51 @@ pub fn snapshot(sim: &Sim) -> Snapshot {
         held: sim.held_object().map(str::to_owned),
         grasped_handle: sim.grasped_handle().map(str::to_owned),
     }
+}
+
+/// Replaces the views of a fine-grained object's pieces (`views` holds the floor, then one
+/// view per part in part order) by one view named after the object: the pieces' combined
+/// box, in the grasp region if any piece is, and whether they are gathered.
+fn merge_pieces(sim: &Sim, views: Vec<ObjectView>) -> Vec<ObjectView> {
+    let mut merged: Vec<ObjectView> = Vec::with_capacity(views.len());
+    let mut pieces_of: Vec<(usize, Vec<[f64; 3]>)> = Vec::new();
+    let mut views = views.into_iter();
+    merged.extend(views.next());
+    for (part, mut view) in sim.parts().iter().zip(views) {
+        if !part.kind.is_fine_grained() {
+            merged.push(view);
+            continue;
+        }
+        let centre = view.aabb.centre();
+        match pieces_of.iter_mut().find(|(object, _)| *object == part.object) {
+            Some((_, centres)) => {
+                centres.push(centre);
+                let object_name = &sim.scene().objects[part.object].name;
+                if let Some(first) = merged.iter_mut().find(|v| &v.name == object_name) {
+                    first.aabb = first.aabb.union(&view.aabb);
+                    first.in_gripper |= view.in_gripper;
+                }
+            }
+            None => {
+                pieces_of.push((part.object, vec![centre]));
+                view.name = sim.scene().objects[part.object].name.clone();
+                merged.push(view);
+            }
+        }
+    }
+    for (object, centres) in pieces_of {
+        let n = centres.len() as f64;
+        let mean = [0, 1, 2].map(|k| centres.iter().map(|c| c[k]).sum::<f64>() / n);
+        let spread = centres
+            .iter()
+            .map(|c| (0..3).map(|k| (c[k] - mean[k]).powi(2)).sum::<f64>().sqrt())
+            .fold(0.0, f64::max);
+        let name = &sim.scene().objects[object].name;
+        if let Some(view) = merged.iter_mut().find(|v| &v.name == name) {
+            view.gathered = Some(spread <= GATHERED_SPREAD);
+        }
+    }
+    merged
 }
 
 /// The symbolic state of the simulator now.
@@ -156,7 +211,21 @@ pub fn observe_snapshot(s: &Snapshot) -> State {
     let on_top = push_on_top_of(s, &inside, &mut atoms);
     push_drawer_over_handle(s, &mut atoms);
     push_over_of(s, &inside, &on_top, &mut atoms);
+    push_fine_grained(s, &mut atoms);
     State::from_atoms(atoms)
+}
+
+/// Adds `Finegrained` for every object made of small pieces, and `Gathered` while its
+/// pieces lie together.
+fn push_fine_grained(s: &Snapshot, atoms: &mut Vec<Atom>) {
+    for o in &s.objects {
+        if let Some(gathered) = o.gathered {
+            atoms.push(Atom::new("Finegrained", &[&o.name]));
+            if gathered {
+                atoms.push(Atom::new("Gathered", &[&o.name]));
+            }
+        }
+    }
 }
 
 /// The end effector's four state predicates, whose names depend on the embodiment.
@@ -362,6 +431,7 @@ mod tests {
             group: None,
             joint: None,
             in_gripper: false,
+            gathered: None,
         }
     }
 

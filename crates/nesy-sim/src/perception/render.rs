@@ -386,7 +386,8 @@ pub fn render_camera(sim: &Sim, camera: &Camera, width: u32, height: u32, thread
     image
 }
 
-/// Draws the label of every scene object at its projected AABB centre, 20 px lower,
+/// Draws the label of every object as perception names it (the pieces of screws under one
+/// label) at its projected AABB centre, 20 px lower,
 /// clipped to the frame (`docs/benchmark.md` §1), as red text on a black box. Where a label would cover
 /// an earlier one it is nudged up or down in 11 px steps so every name stays readable.
 pub fn mark(sim: &Sim, camera: &Camera, image: &Image) -> Image {
@@ -394,14 +395,14 @@ pub fn mark(sim: &Sim, camera: &Camera, image: &Image) -> Image {
     let basis = Basis::new(camera, image.width, image.height);
     let (w, h) = (image.width as f32, image.height as f32);
     let mut placed: Vec<[i64; 4]> = Vec::new();
-    for (i, part) in sim.parts().iter().enumerate() {
-        let Some((x, y)) = basis.project(sim.part_aabb(i).centre(), image.width, image.height) else {
+    for (name, aabb) in sim.perceived_objects() {
+        let Some((x, y)) = basis.project(aabb.centre(), image.width, image.height) else {
             continue;
         };
         // `max` keeps the range valid on frames narrower than a label margin (--size 32).
         let x = x.clamp(24.0, (w - 21.0).max(24.0)) as i64;
         let y = (y + 20.0).clamp(24.0, (h - 21.0).max(24.0)) as i64;
-        let width = label_width(&part.name);
+        let width = label_width(&name);
         let boxed = |cy: i64| [x - width / 2 - 2, cy - 6, x + width / 2 + 2, cy + 6];
         let overlaps = |b: &[i64; 4]| {
             placed
@@ -420,7 +421,7 @@ pub fn mark(sim: &Sim, camera: &Camera, image: &Image) -> Image {
             .find(|&cy| !overlaps(&boxed(cy)))
             .unwrap_or(y);
         placed.push(boxed(cy));
-        draw_label(&mut out, &part.name, x, cy);
+        draw_label(&mut out, &name, x, cy);
     }
     out
 }

@@ -76,6 +76,35 @@ pub struct ObjectSpec {
     /// Overrides the kind's nominal outer size `[x, y, z]` in metres (before yaw).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub size: Option<[f64; 3]>,
+    /// Where the pieces of a fine-grained kind (`screws`) lie: `[x, y]` offsets in metres
+    /// from `pose.position`, in the object's frame, one per piece. The pieces are separate
+    /// bodies named `<name>_1`, `<name>_2`, …; perception reports them as the one object
+    /// `<name>`. Default: [`DEFAULT_PIECES`] pieces in a row 3 cm apart.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pieces: Option<Vec<[f64; 2]>>,
+}
+
+/// How many pieces a fine-grained object has when its entry lists none.
+pub const DEFAULT_PIECES: usize = 5;
+/// Most pieces a fine-grained object may have.
+pub const MAX_PIECES: usize = 40;
+/// Farthest (m) a piece may lie from its object's position.
+pub const MAX_PIECE_OFFSET: f64 = 0.3;
+
+impl ObjectSpec {
+    /// The `[x, y]` offsets of a fine-grained object's pieces (the listed ones, else the
+    /// default row); empty for other kinds.
+    pub fn piece_offsets(&self) -> Vec<[f64; 2]> {
+        if !self.kind.is_fine_grained() {
+            return Vec::new();
+        }
+        match &self.pieces {
+            Some(pieces) => pieces.clone(),
+            None => (0..DEFAULT_PIECES)
+                .map(|k| [0.03 * (k as f64 - (DEFAULT_PIECES - 1) as f64 / 2.0), 0.0])
+                .collect(),
+        }
+    }
 }
 
 /// Position and heading of an object.
@@ -121,6 +150,12 @@ pub enum ObjectKind {
     /// Cabinet with two prismatic drawers: parts `drawer_body`, `top_drawer`,
     /// `bottom_drawer`, `top_drawer_handle`, `bottom_drawer_handle`.
     DrawerCabinet,
+    /// Magnetic pickup hook, 14 cm long: a grey bar with a magnet at its +x end that pulls
+    /// the pieces of fine-grained objects within [`crate::world::magnet::MAGNET_RADIUS`].
+    MagneticHook,
+    /// Screws: several small steel pieces (each 2 × 0.6 × 0.6 cm), too small and scattered
+    /// to grasp one by one; see [`ObjectSpec::pieces`].
+    Screws,
 }
 
 impl ObjectKind {
@@ -136,7 +171,14 @@ impl ObjectKind {
                 | ObjectKind::Rook
                 | ObjectKind::Knight
                 | ObjectKind::Bishop
+                | ObjectKind::MagneticHook
+                | ObjectKind::Screws
         )
+    }
+
+    /// True for the kinds made of many small pieces (`Finegrained` in the states).
+    pub fn is_fine_grained(self) -> bool {
+        self == ObjectKind::Screws
     }
 
     /// The base part name an articulated kind's entry must end with (after an optional
@@ -286,6 +328,9 @@ pub fn part_names(spec: &ObjectSpec) -> Vec<String> {
     match spec.kind {
         ObjectKind::HingeBox => parts::prefixed(part_prefix(spec), &parts::HINGE_BOX_PARTS),
         ObjectKind::DrawerCabinet => parts::prefixed(part_prefix(spec), &parts::DRAWER_CABINET_PARTS),
+        kind if kind.is_fine_grained() => (1..=spec.piece_offsets().len())
+            .map(|k| format!("{}_{k}", spec.name))
+            .collect(),
         _ => vec![spec.name.clone()],
     }
 }
@@ -481,7 +526,10 @@ fn validate_object_names(i: usize, o: &ObjectSpec, seen: &mut HashSet<String>) -
             format!("{:?}", o.name),
         ));
     }
-    for part in part_names(o) {
+    // A fine-grained object's pieces are `<name>_<k>`, and perception reports them under
+    // `<name>`, which no other object may take.
+    let fine_grained_name = o.kind.is_fine_grained().then(|| o.name.clone());
+    for part in part_names(o).into_iter().chain(fine_grained_name) {
         if !seen.insert(part.clone()) {
             return Err(SceneError::invalid(
                 at("name"),
@@ -528,6 +576,31 @@ fn validate_object_numbers(i: usize, o: &ObjectSpec) -> Result<(), SceneError> {
                     at(&format!("size[{k}]")),
                     format!("a size in metres from {MIN_OBJECT_SIZE} to 2"),
                     v.to_string(),
+                ));
+            }
+        }
+    }
+    if let Some(pieces) = &o.pieces {
+        if !o.kind.is_fine_grained() {
+            return Err(SceneError::invalid(
+                at("pieces"),
+                "no pieces (only fine-grained kinds such as screws have them)",
+                format!("{} pieces on a {:?}", pieces.len(), o.kind),
+            ));
+        }
+        if pieces.is_empty() || pieces.len() > MAX_PIECES {
+            return Err(SceneError::invalid(
+                at("pieces"),
+                format!("1 to {MAX_PIECES} pieces"),
+                format!("{} pieces", pieces.len()),
+            ));
+        }
+        for (k, piece) in pieces.iter().enumerate() {
+            if !piece.iter().all(|v| v.is_finite() && v.abs() <= MAX_PIECE_OFFSET) {
+                return Err(SceneError::invalid(
+                    at(&format!("pieces[{k}]")),
+                    format!("an [x, y] offset within {MAX_PIECE_OFFSET} m of the object's position"),
+                    format!("{piece:?}"),
                 ));
             }
         }

@@ -122,6 +122,7 @@ pub(crate) fn object(name: &str, kind: ObjectKind, x: f64, y: f64, z: f64, yaw: 
         },
         colour: None,
         size: None,
+        pieces: None,
     }
 }
 

@@ -89,10 +89,11 @@ impl Sim {
         self.names().join(", ")
     }
 
-    /// `floor`, the scene's parts in order, then the robot's own entry.
+    /// `floor`, the scene's objects in order as perception names them (parts, with a
+    /// fine-grained object's pieces as one), then the robot's own entry.
     pub fn names(&self) -> Vec<String> {
         std::iter::once(parts::FLOOR.to_owned())
-            .chain(self.parts.iter().map(|p| p.name.clone()))
+            .chain(self.perceived_objects().into_iter().map(|(name, _)| name))
             .chain(std::iter::once(self.gripper_name().to_owned()))
             .collect()
     }
@@ -104,7 +105,22 @@ impl Sim {
         })
     }
 
-    fn part_or_unknown(&self, name: &str) -> Result<usize, ApiError> {
+    /// The part called `name`, for call `call`; a fine-grained object cannot be reached as
+    /// one part.
+    fn part_or_unknown(&self, name: &str, call: &str) -> Result<usize, ApiError> {
+        if let Some(pieces) = self
+            .scene
+            .objects
+            .iter()
+            .find(|o| o.kind.is_fine_grained() && o.name == name)
+        {
+            return Err(ApiError::Infeasible {
+                call: call.into(),
+                target: pieces.name.clone(),
+                reason: "its pieces are too small to grasp one by one; gather them with a magnetic hook"
+                    .into(),
+            });
+        }
         self.part_index(name).ok_or_else(|| ApiError::UnknownObject {
             name: name.to_owned(),
             known: self.known_names(),
@@ -358,7 +374,7 @@ impl Sim {
                 reason: "it is not an object the gripper can move to; use move_to_position".into(),
             });
         }
-        let part = self.part_or_unknown(name)?;
+        let part = self.part_or_unknown(name, "move_gripper_to")?;
         let aabb = self.part_aabb(part);
         let p = &self.parts[part];
         let call = "move_gripper_to".to_owned();
@@ -658,7 +674,7 @@ impl Sim {
     }
 
     fn do_grasp_handle(&mut self, name: &str, call: &str) -> Result<(), ApiError> {
-        let part = self.part_or_unknown(name)?;
+        let part = self.part_or_unknown(name, call)?;
         let infeasible = |reason: String| ApiError::Infeasible {
             call: call.into(),
             target: name.into(),
@@ -793,7 +809,15 @@ impl RobotApi for Sim {
     }
 
     fn obj_in_gripper(&mut self, obj_name: &str) -> Result<bool, ApiError> {
-        let result = self.part_or_unknown(obj_name).map(|p| self.part_in_gripper(p));
+        let pieces: Vec<usize> = (0..self.parts.len())
+            .filter(|&i| self.parts[i].kind.is_fine_grained() && self.perceived_name(i) == obj_name)
+            .collect();
+        let result = if pieces.is_empty() {
+            self.part_or_unknown(obj_name, "obj_in_gripper")
+                .map(|p| self.part_in_gripper(p))
+        } else {
+            Ok(pieces.iter().any(|&p| self.part_in_gripper(p)))
+        };
         self.record(
             ApiCall::ObjInGripper {
                 obj_name: obj_name.into(),
@@ -804,11 +828,13 @@ impl RobotApi for Sim {
     }
 
     fn get_empty_floor_xy(&mut self, obj_name: &str) -> Result<[f64; 2], ApiError> {
-        let result = self.part_or_unknown(obj_name).and_then(|p| {
-            empty_floor_xy(self, p).ok_or(ApiError::NoEmptySpace {
-                obj_name: obj_name.into(),
-            })
-        });
+        let result = self
+            .part_or_unknown(obj_name, "get_empty_floor_xy")
+            .and_then(|p| {
+                empty_floor_xy(self, p).ok_or(ApiError::NoEmptySpace {
+                    obj_name: obj_name.into(),
+                })
+            });
         self.record(
             ApiCall::GetEmptyFloorXy {
                 obj_name: obj_name.into(),

@@ -5,7 +5,8 @@
 //!
 //! - [`Sim`] is the world; it implements [`crate::api::RobotApi`] (in `api_impl`).
 //! - `build` builds it from a scene in named steps.
-//! - `contact` stops lids and drawers where they meet other furniture.
+//! - `contact` stops lids and drawers where they meet other furniture; [`magnet`] pulls
+//!   screws toward a magnetic hook.
 //! - [`objects`] builds the benchmark's objects from their kinds; [`geometry`] holds the
 //!   boxes and frame conversions; `floor` finds free table spots; `rng` is the seeded
 //!   randomness that scene generation and motion planning draw from.
@@ -15,6 +16,7 @@ mod build;
 pub(crate) mod contact;
 pub(crate) mod floor;
 pub mod geometry;
+pub mod magnet;
 pub mod objects;
 pub(crate) mod rng;
 
@@ -239,6 +241,31 @@ impl Sim {
         self.parts.iter().position(|p| p.name == name)
     }
 
+    /// The name perception gives a part: its own, except for the pieces of a fine-grained
+    /// object (`black_screws_3`), which are all perceived as that object (`black_screws`).
+    pub fn perceived_name(&self, part: usize) -> &str {
+        let p = &self.parts[part];
+        if p.kind.is_fine_grained() {
+            &self.scene.objects[p.object].name
+        } else {
+            &p.name
+        }
+    }
+
+    /// Every object as perception names it, in part order, with its world AABB (the union
+    /// of its pieces' for a fine-grained object).
+    pub fn perceived_objects(&self) -> Vec<(String, Aabb)> {
+        let mut objects: Vec<(String, Aabb)> = Vec::with_capacity(self.parts.len());
+        for i in 0..self.parts.len() {
+            let (name, aabb) = (self.perceived_name(i), self.part_aabb(i));
+            match objects.iter_mut().find(|(n, _)| n == name) {
+                Some((_, merged)) => *merged = merged.union(&aabb),
+                None => objects.push((name.to_owned(), aabb)),
+            }
+        }
+        objects
+    }
+
     /// World AABB of a part.
     pub fn part_aabb(&self, part: usize) -> Aabb {
         self.colliders_aabb(&self.parts[part].colliders)
@@ -258,8 +285,9 @@ impl Sim {
         })
     }
 
-    /// World AABB of a named object: a part, `floor` (the table) or `gripper` /
-    /// `vacuum_gripper` (hand and fingers, or the suction tool).
+    /// World AABB of a named object: a part, a fine-grained object (its pieces' union),
+    /// `floor` (the table) or `gripper` / `vacuum_gripper` (hand and fingers, or the suction
+    /// tool).
     pub fn object_aabb(&self, name: &str) -> Option<Aabb> {
         if let Some(i) = self.part_index(name) {
             return Some(self.part_aabb(i));
@@ -267,7 +295,10 @@ impl Sim {
         match name {
             parts::FLOOR => Some(self.colliders_aabb(&self.table_colliders)),
             n if n == self.gripper_name() => Some(self.colliders_aabb(&self.robot.gripper_colliders)),
-            _ => None,
+            n => self
+                .perceived_objects()
+                .into_iter()
+                .find_map(|(object, aabb)| (object == n).then_some(aabb)),
         }
     }
 
@@ -432,6 +463,7 @@ impl Sim {
             let q: Vec<f64> = q_prev.iter().zip(q_next).map(|(a, b)| a + (b - a) * s).collect();
             let g = g_prev + (g_next - g_prev) * s;
             self.drive_robot(&q, g);
+            self.apply_magnets();
             self.world.step();
         }
         self.q = q_next.to_vec();

@@ -253,6 +253,8 @@ pub fn nominal_size(kind: ObjectKind) -> [f64; 3] {
         ObjectKind::ToyBox => [0.139, 0.0985, 0.045],
         ObjectKind::HingeBox => [0.1025, 0.205, 0.1165],
         ObjectKind::DrawerCabinet => [0.154, 0.148, 0.194],
+        ObjectKind::MagneticHook => [0.14, 0.03, 0.025],
+        ObjectKind::Screws => SCREW_SIZE,
     }
 }
 
@@ -422,7 +424,62 @@ pub fn build_object(spec: &ObjectSpec) -> Vec<PartBuild> {
         ObjectKind::ToyBox => vec![fixed(&spec.name, PartRole::Fixed, open_box(s, 0.004, colour))],
         ObjectKind::HingeBox => hinge_box(part_prefix(spec), colour),
         ObjectKind::DrawerCabinet => drawer_cabinet(part_prefix(spec), colour),
+        ObjectKind::MagneticHook => loose(&spec.name, magnetic_hook(s, colour)),
+        ObjectKind::Screws => screws(spec, s, colour),
     }
+}
+
+/// Size `[x, y, z]` (m) of one screw, lying along x.
+pub const SCREW_SIZE: [f64; 3] = [0.02, 0.006, 0.006];
+/// Density of steel (kg/m³): screws and the hook's magnet.
+pub const STEEL_DENSITY: f32 = 7800.0;
+
+/// The magnetic hook in its frame (origin at the centre of its footprint, on the table): a
+/// bar along x and, at its +x end, the magnet block, as wide as the whole and the full
+/// height. `s` is the outer size.
+fn magnetic_hook(s: [f32; 3], colour: [f32; 3]) -> Vec<ShapeBuild> {
+    let magnet_len = s[0] * MAGNET_LENGTH_FRACTION as f32;
+    let bar_len = s[0] - magnet_len;
+    let bar_side = s[1].min(s[2]) * 0.7;
+    let mut magnet = cuboid(
+        [magnet_len, s[1], s[2]],
+        [s[0] / 2.0 - magnet_len / 2.0, 0.0, s[2] / 2.0],
+        [0.12, 0.12, 0.14],
+    );
+    magnet.density = STEEL_DENSITY;
+    vec![
+        cuboid(
+            [bar_len, bar_side, bar_side],
+            [-s[0] / 2.0 + bar_len / 2.0, 0.0, bar_side / 2.0],
+            colour,
+        ),
+        magnet,
+    ]
+}
+
+/// Share of the hook's length taken by its magnet block.
+pub const MAGNET_LENGTH_FRACTION: f64 = 0.25;
+
+/// The centre of a magnetic hook's magnet in the hook's frame, for outer size `size`.
+pub fn magnet_centre(size: [f64; 3]) -> [f64; 3] {
+    let magnet_len = size[0] * MAGNET_LENGTH_FRACTION;
+    [size[0] / 2.0 - magnet_len / 2.0, 0.0, size[2] / 2.0]
+}
+
+/// One loose part per piece of a fine-grained object, each at its offset in the object's
+/// frame and named `<name>_<k>`.
+fn screws(spec: &ObjectSpec, s: [f32; 3], colour: [f32; 3]) -> Vec<PartBuild> {
+    crate::scene::part_names(spec)
+        .into_iter()
+        .zip(spec.piece_offsets())
+        .map(|(name, [dx, dy])| {
+            let mut piece = cuboid(s, [0.0, 0.0, s[2] / 2.0], colour);
+            piece.density = STEEL_DENSITY;
+            let mut part = loose(&name, vec![piece]).remove(0);
+            part.offset = at(dx as f32, dy as f32, 0.0);
+            part
+        })
+        .collect()
 }
 
 /// Wall thickness (m) of the hinge box's body.

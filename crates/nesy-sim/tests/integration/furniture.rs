@@ -138,3 +138,131 @@ fn a_second_asset_needs_its_own_prefix() {
         "{err}"
     );
 }
+
+/// A magnetic hook on the table with screws around its magnet: two pieces within the
+/// magnet's reach, two beyond it.
+fn hook_and_screws() -> SceneSpec {
+    let scene = serde_json::json!({
+        "schema_version": 1,
+        "embodiment": "finger",
+        "objects": [
+            {"name": "magnetic_hook", "kind": "magnetic_hook", "pose": {"position": [0.45, 0.0, 0.5]}},
+            {"name": "black_screws", "kind": "screws", "pose": {"position": [0.56, 0.0, 0.5]},
+             "pieces": [[-0.02, 0.0], [-0.02, 0.02], [0.1, 0.0], [0.08, -0.08]]}
+        ],
+        "goals": []
+    });
+    SceneSpec::from_json_str(&scene.to_string(), "hook and screws").unwrap()
+}
+
+#[test]
+fn screws_near_the_magnet_gather_under_it_and_the_others_stay_put() {
+    use nesy_sim::world::magnet::MAGNET_RADIUS;
+    let scene = hook_and_screws();
+    assert_eq!(
+        scene.part_names(),
+        [
+            "magnetic_hook",
+            "black_screws_1",
+            "black_screws_2",
+            "black_screws_3",
+            "black_screws_4"
+        ]
+    );
+    let mut sim = Sim::new(&scene).unwrap();
+    let magnet = sim.magnet_centres()[0];
+    let distance = |sim: &Sim, piece: &str| {
+        let p = sim.part_pose(sim.part_index(piece).unwrap()).translation.vector;
+        ((p.x - magnet[0]).powi(2) + (p.y - magnet[1]).powi(2) + (p.z - magnet[2]).powi(2)).sqrt()
+    };
+    let position = |sim: &Sim, piece: &str| sim.part_pose(sim.part_index(piece).unwrap()).translation.vector;
+    let far_before = [position(&sim, "black_screws_3"), position(&sim, "black_screws_4")];
+    for piece in ["black_screws_3", "black_screws_4"] {
+        assert!(
+            distance(&sim, piece) > MAGNET_RADIUS,
+            "{piece} starts within reach"
+        );
+    }
+    sim.step_idle(100);
+    for piece in ["black_screws_1", "black_screws_2"] {
+        let d = distance(&sim, piece);
+        assert!(d < 0.03, "{piece} is still {d:.4} m from the magnet");
+    }
+    for (piece, before) in ["black_screws_3", "black_screws_4"].into_iter().zip(far_before) {
+        let moved = (position(&sim, piece) - before).norm();
+        assert!(
+            moved < 1e-3,
+            "{piece} moved {moved:.4} m outside the magnet's reach"
+        );
+    }
+    // Perception reports the pieces as one object, fine-grained and, with two pieces
+    // still far off, not gathered.
+    let state = format!("{:?}", observer::observe(&sim));
+    assert!(
+        state.contains("Finegrained") && !state.contains("Gathered"),
+        "{state}"
+    );
+    assert!(!state.contains("black_screws_1"), "{state}");
+    // The magnet does not drag the hook itself across the table.
+    let hook = position(&sim, "magnetic_hook");
+    assert!(
+        (hook.x - 0.45).abs() < 2e-3 && hook.y.abs() < 2e-3,
+        "hook at {hook:?}"
+    );
+}
+
+#[test]
+fn screws_all_within_reach_end_gathered() {
+    use nesy_sim::perception::observer::GATHERED_SPREAD;
+    let mut scene = hook_and_screws();
+    // Around the magnet's free end and both its sides, each within its reach.
+    let pieces = vec![[-0.015, 0.0], [-0.05, 0.045], [-0.05, -0.045]];
+    let n = pieces.len() as f64;
+    let mean = [0, 1].map(|k| pieces.iter().map(|p: &[f64; 2]| p[k]).sum::<f64>() / n);
+    let spread = pieces
+        .iter()
+        .map(|p| ((p[0] - mean[0]).powi(2) + (p[1] - mean[1]).powi(2)).sqrt())
+        .fold(0.0, f64::max);
+    assert!(
+        spread > GATHERED_SPREAD,
+        "the pieces start together ({spread:.3} m)"
+    );
+    scene.objects[1].pieces = Some(pieces);
+    let mut sim = Sim::new(&scene).unwrap();
+    sim.step_idle(100);
+    let after = format!("{:?}", observer::observe(&sim));
+    assert!(after.contains("(Gathered black_screws)"), "{after}");
+}
+
+#[test]
+fn the_lifted_hook_carries_the_screws_it_gathered() {
+    let mut scene = hook_and_screws();
+    scene.objects[1].pieces = Some(vec![[-0.015, 0.0], [-0.05, 0.045]]);
+    let mut sim = Sim::new(&scene).unwrap();
+    sim.step_idle(50);
+    sim.move_gripper_to("magnetic_hook", Direction::Down, 0.01)
+        .unwrap();
+    sim.close_gripper().unwrap();
+    assert_eq!(sim.held_object(), Some("magnetic_hook"));
+    sim.move_parallel(Direction::Up, 0.1, Direction::Down).unwrap();
+    sim.step_idle(50);
+    for piece in ["black_screws_1", "black_screws_2"] {
+        let z = sim.part_pose(sim.part_index(piece).unwrap()).translation.vector.z;
+        assert!(z > 0.5 + 0.08, "{piece} stayed at z {z:.3}");
+    }
+}
+
+#[test]
+fn the_api_knows_screws_as_one_object_too_small_to_grasp() {
+    let mut sim = Sim::new(&hook_and_screws()).unwrap();
+    let names = sim.get_obj_names();
+    assert!(names.iter().any(|n| n == "black_screws"), "{names:?}");
+    assert!(!names.iter().any(|n| n.starts_with("black_screws_")), "{names:?}");
+    let [[x0, _, _], [x1, _, _]] = sim.get_obj_bbox("black_screws").unwrap();
+    assert!(x1 - x0 > 0.1, "the box spans every piece: {x0}..{x1}");
+    match sim.move_gripper_to("black_screws", Direction::Down, 0.01) {
+        Err(ApiError::Infeasible { reason, .. }) => assert!(reason.contains("magnetic hook"), "{reason}"),
+        other => panic!("expected a refusal, got {other:?}"),
+    }
+    assert_eq!(sim.obj_in_gripper("black_screws"), Ok(false));
+}

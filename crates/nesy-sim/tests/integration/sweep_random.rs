@@ -28,6 +28,7 @@ fn episode(embodiment: Embodiment, seed: u64) -> Result<(), String> {
         },
         colour: None,
         size: None,
+        pieces: None,
     };
     let a = rng.range(0.0, std::f64::consts::TAU);
     let spec = SceneSpec {
