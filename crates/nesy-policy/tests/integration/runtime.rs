@@ -644,3 +644,40 @@ fn api_names_match_the_paper() {
     );
     assert!(signatures.contains(&"move_parallel(move_dir, offset, pointing_to='down')".to_owned()));
 }
+
+/// A drawer pulled into another cabinet's open drawer stops there, and the policy sees the
+/// contact as `robot.CollisionError`, a `RobotError` it can catch.
+#[test]
+fn a_drawer_stopped_by_another_raises_collision_error() {
+    let scene = serde_json::json!({
+        "schema_version": 1,
+        "embodiment": "finger",
+        "objects": [
+            {"name": "front_drawer_body", "kind": "drawer_cabinet",
+             "pose": {"position": [0.46, 0.19, 0.5], "yaw": 0.0}},
+            {"name": "side_drawer_body", "kind": "drawer_cabinet",
+             "pose": {"position": [0.30, 0.0, 0.5], "yaw": std::f64::consts::FRAC_PI_2}}
+        ],
+        "articulations": {"side_top_drawer": 0.12}
+    });
+    let scene =
+        nesy_sim::scene::SceneSpec::from_json_str(&scene.to_string(), "perpendicular cabinets").unwrap();
+    let sim = nesy_sim::world::Sim::new(&scene).unwrap();
+    let source = r#"
+move_gripper_to("front_top_drawer_handle")
+grasp_handle("front_top_drawer_handle")
+try:
+    move_parallel("left", 0.12)
+except robot.CollisionError as err:
+    print("stopped:", err, isinstance(err, robot.RobotError))
+"#;
+    let result = run_in_process(source, Box::new(sim), &Limits::default(), None).expect("interpreter starts");
+    assert_eq!(result.outcome, Outcome::Ok, "{:#?}", result.outcome);
+    assert!(
+        result.stdout.text.contains(
+            "stopped: move_parallel() was stopped by contact: front_top_drawer ran into side_top_drawer True"
+        ),
+        "{}",
+        result.stdout.text
+    );
+}
