@@ -46,7 +46,8 @@ pub struct SceneSpec {
     /// Objects, in scene order (perception lists them in this order after `floor`).
     pub objects: Vec<ObjectSpec>,
     /// Joint positions of articulated parts by part name (`hinge_lid`, `top_drawer`,
-    /// `bottom_drawer`), in the benchmark's convention: the hinge lid −0.785 closed to
+    /// `bottom_drawer`, after their asset's prefix if it has one), in the benchmark's
+    /// convention: the hinge lid −0.785 closed to
     /// +0.785 open (limits −0.785..0.8); drawers 0 closed to 0.1232 open. Parts not listed
     /// start closed.
     #[serde(default)]
