@@ -649,20 +649,10 @@ fn api_names_match_the_paper() {
 /// contact as `robot.CollisionError`, a `RobotError` it can catch.
 #[test]
 fn a_drawer_stopped_by_another_raises_collision_error() {
-    let scene = serde_json::json!({
-        "schema_version": 1,
-        "embodiment": "finger",
-        "objects": [
-            {"name": "front_drawer_body", "kind": "drawer_cabinet",
-             "pose": {"position": [0.46, 0.19, 0.5], "yaw": 0.0}},
-            {"name": "side_drawer_body", "kind": "drawer_cabinet",
-             "pose": {"position": [0.30, 0.0, 0.5], "yaw": std::f64::consts::FRAC_PI_2}}
-        ],
-        "articulations": {"side_top_drawer": 0.12}
-    });
-    let scene =
-        nesy_sim::scene::SceneSpec::from_json_str(&scene.to_string(), "perpendicular cabinets").unwrap();
-    let sim = nesy_sim::world::Sim::new(&scene).unwrap();
+    let sim = nesy_sim::world::Sim::from_file(
+        &nesy_testkit::workspace_root().join("fixtures/scenes/drawers_perpendicular_finger.json"),
+    )
+    .unwrap();
     let source = r#"
 move_gripper_to("front_top_drawer_handle")
 grasp_handle("front_top_drawer_handle")

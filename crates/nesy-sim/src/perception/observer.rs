@@ -104,28 +104,15 @@ pub fn snapshot(sim: &Sim) -> Snapshot {
         gathered: None,
     };
     let objects = std::iter::once(floor)
-        .chain(sim.parts().iter().enumerate().map(|(i, p)| {
-            let joint = (p.role == PartRole::Link)
-                .then(|| p.articulation.map(|a| &sim.articulations()[a]))
-                .flatten()
-                .map(|a| (a.q, a.limits.0, a.limits.1));
-            let group = matches!(
-                p.role,
-                PartRole::ArticulatedBody | PartRole::Link | PartRole::Handle
-            )
-            .then_some(p.object);
-            ObjectView {
-                name: p.name.clone(),
-                aabb: sim.part_aabb(i),
-                role: p.role,
-                group,
-                joint,
-                in_gripper: sim.part_in_gripper(i),
-                gathered: None,
-            }
-        }))
+        .chain(
+            sim.perceived_objects()
+                .into_iter()
+                .map(|(name, parts)| match parts.as_slice() {
+                    [part] if !sim.parts()[*part].kind.is_fine_grained() => part_view(sim, *part),
+                    pieces => pieces_view(sim, name, pieces),
+                }),
+        )
         .collect();
-    let objects = merge_pieces(sim, objects);
     Snapshot {
         objects,
         embodiment: sim.robot_embodiment(),
@@ -136,49 +123,50 @@ pub fn snapshot(sim: &Sim) -> Snapshot {
     }
 }
 
-/// Replaces the views of a fine-grained object's pieces (`views` holds the floor, then one
-/// view per part in part order) by one view named after the object: the pieces' combined
-/// box, in the grasp region if any piece is, and whether they are gathered.
-fn merge_pieces(sim: &Sim, views: Vec<ObjectView>) -> Vec<ObjectView> {
-    let mut merged: Vec<ObjectView> = Vec::with_capacity(views.len());
-    let mut pieces_of: Vec<(usize, Vec<[f64; 3]>)> = Vec::new();
-    let mut views = views.into_iter();
-    merged.extend(views.next());
-    for (part, mut view) in sim.parts().iter().zip(views) {
-        if !part.kind.is_fine_grained() {
-            merged.push(view);
-            continue;
-        }
-        let centre = view.aabb.centre();
-        match pieces_of.iter_mut().find(|(object, _)| *object == part.object) {
-            Some((_, centres)) => {
-                centres.push(centre);
-                let object_name = &sim.scene().objects[part.object].name;
-                if let Some(first) = merged.iter_mut().find(|v| &v.name == object_name) {
-                    first.aabb = first.aabb.union(&view.aabb);
-                    first.in_gripper |= view.in_gripper;
-                }
-            }
-            None => {
-                pieces_of.push((part.object, vec![centre]));
-                view.name = sim.scene().objects[part.object].name.clone();
-                merged.push(view);
-            }
-        }
+/// The view of one part.
+fn part_view(sim: &Sim, i: usize) -> ObjectView {
+    let p = &sim.parts()[i];
+    let joint = (p.role == PartRole::Link)
+        .then(|| p.articulation.map(|a| &sim.articulations()[a]))
+        .flatten()
+        .map(|a| (a.q, a.limits.0, a.limits.1));
+    let group = matches!(
+        p.role,
+        PartRole::ArticulatedBody | PartRole::Link | PartRole::Handle
+    )
+    .then_some(p.object);
+    ObjectView {
+        name: p.name.clone(),
+        aabb: sim.part_aabb(i),
+        role: p.role,
+        group,
+        joint,
+        in_gripper: sim.part_in_gripper(i),
+        gathered: None,
     }
-    for (object, centres) in pieces_of {
-        let n = centres.len() as f64;
-        let mean = [0, 1, 2].map(|k| centres.iter().map(|c| c[k]).sum::<f64>() / n);
-        let spread = centres
-            .iter()
-            .map(|c| (0..3).map(|k| (c[k] - mean[k]).powi(2)).sum::<f64>().sqrt())
-            .fold(0.0, f64::max);
-        let name = &sim.scene().objects[object].name;
-        if let Some(view) = merged.iter_mut().find(|v| &v.name == name) {
-            view.gathered = Some(spread <= GATHERED_SPREAD);
-        }
+}
+
+/// The one view of a fine-grained object's pieces: their combined box, in the grasp region
+/// if any piece is, and gathered when every piece's centre lies within [`GATHERED_SPREAD`]
+/// of their mean.
+fn pieces_view(sim: &Sim, name: &str, pieces: &[usize]) -> ObjectView {
+    let boxes: Vec<Aabb> = pieces.iter().map(|&p| sim.part_aabb(p)).collect();
+    let centres: Vec<[f64; 3]> = boxes.iter().map(Aabb::centre).collect();
+    let n = centres.len() as f64;
+    let mean = [0, 1, 2].map(|k| centres.iter().map(|c| c[k]).sum::<f64>() / n);
+    let spread = centres
+        .iter()
+        .map(|c| (0..3).map(|k| (c[k] - mean[k]).powi(2)).sum::<f64>().sqrt())
+        .fold(0.0, f64::max);
+    ObjectView {
+        name: name.to_owned(),
+        aabb: boxes.iter().fold(Aabb::EMPTY, |acc, b| acc.union(b)),
+        role: PartRole::Loose,
+        group: None,
+        joint: None,
+        in_gripper: pieces.iter().any(|&p| sim.part_in_gripper(p)),
+        gathered: Some(spread <= GATHERED_SPREAD),
     }
-    merged
 }
 
 /// The symbolic state of the simulator now.
@@ -375,10 +363,10 @@ fn push_on_top_of(s: &Snapshot, inside: &[Option<usize>], atoms: &mut Vec<Atom>)
 /// belong to one asset, so the general rule never pairs them).
 fn push_drawer_over_handle(s: &Snapshot, atoms: &mut Vec<Atom>) {
     for top in s.objects.iter().filter(|o| o.role == PartRole::Link) {
-        let Some(prefix) = parts::prefix_of(&top.name, parts::TOP_DRAWER) else {
+        let Some(handle_name) = parts::sibling(&top.name, parts::TOP_DRAWER, parts::BOTTOM_DRAWER_HANDLE)
+        else {
             continue;
         };
-        let handle_name = format!("{prefix}{}", parts::BOTTOM_DRAWER_HANDLE);
         if let Some(handle) = s
             .objects
             .iter()

@@ -395,14 +395,14 @@ pub fn mark(sim: &Sim, camera: &Camera, image: &Image) -> Image {
     let basis = Basis::new(camera, image.width, image.height);
     let (w, h) = (image.width as f32, image.height as f32);
     let mut placed: Vec<[i64; 4]> = Vec::new();
-    for (name, aabb) in sim.perceived_objects() {
-        let Some((x, y)) = basis.project(aabb.centre(), image.width, image.height) else {
+    for (name, parts) in sim.perceived_objects() {
+        let Some((x, y)) = basis.project(sim.parts_aabb(&parts).centre(), image.width, image.height) else {
             continue;
         };
         // `max` keeps the range valid on frames narrower than a label margin (--size 32).
         let x = x.clamp(24.0, (w - 21.0).max(24.0)) as i64;
         let y = (y + 20.0).clamp(24.0, (h - 21.0).max(24.0)) as i64;
-        let width = label_width(&name);
+        let width = label_width(name);
         let boxed = |cy: i64| [x - width / 2 - 2, cy - 6, x + width / 2 + 2, cy + 6];
         let overlaps = |b: &[i64; 4]| {
             placed
@@ -421,7 +421,7 @@ pub fn mark(sim: &Sim, camera: &Camera, image: &Image) -> Image {
             .find(|&cy| !overlaps(&boxed(cy)))
             .unwrap_or(y);
         placed.push(boxed(cy));
-        draw_label(&mut out, &name, x, cy);
+        draw_label(&mut out, name, x, cy);
     }
     out
 }

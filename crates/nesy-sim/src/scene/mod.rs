@@ -327,8 +327,10 @@ impl SceneError {
 /// Names of the parts an object entry creates, base part first.
 pub fn part_names(spec: &ObjectSpec) -> Vec<String> {
     match spec.kind {
-        ObjectKind::HingeBox => parts::prefixed(part_prefix(spec), &parts::HINGE_BOX_PARTS),
-        ObjectKind::DrawerCabinet => parts::prefixed(part_prefix(spec), &parts::DRAWER_CABINET_PARTS),
+        ObjectKind::HingeBox => parts::prefixed(part_prefix(spec), &parts::HINGE_BOX_PARTS).to_vec(),
+        ObjectKind::DrawerCabinet => {
+            parts::prefixed(part_prefix(spec), &parts::DRAWER_CABINET_PARTS).to_vec()
+        }
         kind if kind.is_fine_grained() => (1..=spec.piece_offsets().len())
             .map(|k| format!("{}_{k}", spec.name))
             .collect(),

@@ -18,6 +18,10 @@
 //! assert_eq!(Joint::HingeLid.limits(), (-0.785, 0.8));
 //! assert_eq!(Joint::BottomDrawer.closed(), 0.0);
 //! assert_eq!(parts::prefixed("left_", &parts::DRAWER_CABINET_PARTS)[1], "left_bottom_drawer");
+//! assert_eq!(
+//!     parts::sibling("left_top_drawer", parts::TOP_DRAWER, parts::BOTTOM_DRAWER_HANDLE).as_deref(),
+//!     Some("left_bottom_drawer_handle")
+//! );
 //! ```
 
 /// The table, as the API and the observer name it.
@@ -71,14 +75,21 @@ pub fn has_part_suffix(name: &str, part: &str) -> bool {
 
 /// The names of an asset's parts for a prefix (`""` or one ending in `_`), in the order of
 /// `asset_parts` (one of [`HINGE_BOX_PARTS`] and [`DRAWER_CABINET_PARTS`]).
-pub fn prefixed(prefix: &str, asset_parts: &[&str]) -> Vec<String> {
-    asset_parts.iter().map(|part| format!("{prefix}{part}")).collect()
+pub fn prefixed<const N: usize>(prefix: &str, asset_parts: &[&str; N]) -> [String; N] {
+    asset_parts.map(|part| format!("{prefix}{part}"))
 }
 
 /// The prefix of a prefixed part name: what `name` carries before `part` (`"left_"` for
 /// `left_top_drawer` and `top_drawer`), or `None` when it does not end with it.
 pub fn prefix_of<'a>(name: &'a str, part: &str) -> Option<&'a str> {
     has_part_suffix(name, part).then(|| &name[..name.len() - part.len()])
+}
+
+/// The name of the same asset's `other` part, when `name` is its `part` (with the asset's
+/// prefix, if any): `sibling("left_top_drawer", TOP_DRAWER, BOTTOM_DRAWER_HANDLE)` is
+/// `left_bottom_drawer_handle`.
+pub fn sibling(name: &str, part: &str, other: &str) -> Option<String> {
+    prefix_of(name, part).map(|prefix| format!("{prefix}{other}"))
 }
 
 /// Lid joint position when open (the lid stands vertical).

@@ -93,7 +93,11 @@ impl Sim {
     /// fine-grained object's pieces as one), then the robot's own entry.
     pub fn names(&self) -> Vec<String> {
         std::iter::once(parts::FLOOR.to_owned())
-            .chain(self.perceived_objects().into_iter().map(|(name, _)| name))
+            .chain(
+                self.perceived_objects()
+                    .into_iter()
+                    .map(|(name, _)| name.to_owned()),
+            )
             .chain(std::iter::once(self.gripper_name().to_owned()))
             .collect()
     }
@@ -108,15 +112,10 @@ impl Sim {
     /// The part called `name`, for call `call`; a fine-grained object cannot be reached as
     /// one part.
     fn part_or_unknown(&self, name: &str, call: &str) -> Result<usize, ApiError> {
-        if let Some(pieces) = self
-            .scene
-            .objects
-            .iter()
-            .find(|o| o.kind.is_fine_grained() && o.name == name)
-        {
+        if !self.pieces_of(name).is_empty() {
             return Err(ApiError::Infeasible {
                 call: call.into(),
-                target: pieces.name.clone(),
+                target: name.into(),
                 reason: "its pieces are too small to grasp one by one; gather them with a magnetic hook"
                     .into(),
             });
@@ -206,8 +205,8 @@ impl Sim {
         if handle.role != PartRole::Handle {
             return None;
         }
-        let prefix = parts::prefix_of(&handle.name, parts::BOTTOM_DRAWER_HANDLE)?;
-        let top = self.part_index(&format!("{prefix}{}", parts::TOP_DRAWER))?;
+        let top = parts::sibling(&handle.name, parts::BOTTOM_DRAWER_HANDLE, parts::TOP_DRAWER)?;
+        let top = self.part_index(&top)?;
         (self.parts[top].object == handle.object
             && self.part_aabb(top).overlaps_xy(&self.part_aabb(part), 0.005))
         .then_some(top)
@@ -244,9 +243,11 @@ impl Sim {
         Ok(())
     }
 
-    /// The tool motion of `move_to_position` (no trace entry).
+    /// The tool motion of `move_to_position` (no trace entry); `call` names the API call
+    /// that moves (`move_to_position` or `move_gripper_to`) in a collision.
     fn do_move_to_position(
         &mut self,
+        call: &str,
         pos: [f64; 3],
         pointing: Direction,
         clearance: f64,
@@ -330,7 +331,7 @@ impl Sim {
         let plan = self.plan(&waypoints, pointing, transit)?;
         let executed = self.execute(&plan, MOTION_SETTLE_STEPS);
         self.moved_since_reset = true;
-        executed.map_err(|stop| stop.into_error(self, "move_to_position"))
+        executed.map_err(|stop| stop.into_error(self, call))
     }
 
     /// How far the tool backs off along its axis before a transit: the full `clearance`
@@ -456,15 +457,13 @@ impl Sim {
                 self.gripper_target = self.preshape_travel(part, &rotation);
             }
         }
-        self.do_move_to_position(target, pointing, crate::api::DEFAULT_LIFT_CLEARANCE, yaw)
-            .map_err(|err| match err {
-                ApiError::Collision { moving, obstacle, .. } => ApiError::Collision {
-                    call: "move_gripper_to".into(),
-                    moving,
-                    obstacle,
-                },
-                other => other,
-            })
+        self.do_move_to_position(
+            "move_gripper_to",
+            target,
+            pointing,
+            crate::api::DEFAULT_LIFT_CLEARANCE,
+            yaw,
+        )
     }
 
     /// Of the finger grasp spins `angle + k·step`, the one nearest the current tool whose
@@ -809,9 +808,7 @@ impl RobotApi for Sim {
     }
 
     fn obj_in_gripper(&mut self, obj_name: &str) -> Result<bool, ApiError> {
-        let pieces: Vec<usize> = (0..self.parts.len())
-            .filter(|&i| self.parts[i].kind.is_fine_grained() && self.perceived_name(i) == obj_name)
-            .collect();
+        let pieces = self.pieces_of(obj_name);
         let result = if pieces.is_empty() {
             self.part_or_unknown(obj_name, "obj_in_gripper")
                 .map(|p| self.part_in_gripper(p))
@@ -874,7 +871,7 @@ impl RobotApi for Sim {
             angle,
         };
         self.action(call, None, |sim| {
-            sim.do_move_to_position(pos, pointing_to, lift_clearance, angle)
+            sim.do_move_to_position("move_to_position", pos, pointing_to, lift_clearance, angle)
         })
     }
 

@@ -39,11 +39,12 @@ impl ContactStop {
     }
 }
 
-/// A solid collider that a link may not enter, with its part and world pose.
+/// A solid collider that a link may not enter, with its part, world pose and box.
 struct Blocker<'a> {
     part: usize,
     shape: &'a dyn Shape,
     pose: Pose,
+    aabb: rapier3d::parry::bounding_volume::Aabb,
 }
 
 impl Sim {
@@ -69,6 +70,7 @@ impl Sim {
                         part: i,
                         shape: collider.shape(),
                         pose: *collider.position(),
+                        aabb: collider.compute_aabb(),
                     })
                 })
             })
@@ -90,7 +92,7 @@ impl Sim {
                 let pose = body_pose * local;
                 let aabb = collider.shape().compute_aabb(&pose);
                 for blocker in blockers {
-                    if !aabb.intersects(&blocker.shape.compute_aabb(&blocker.pose)) {
+                    if !aabb.intersects(&blocker.aabb) {
                         continue;
                     }
                     let touching = rapier3d::parry::query::intersection_test(
@@ -124,7 +126,7 @@ impl Sim {
         let Some(obstacle) = self.blocked_at(ai, wanted, &blockers) else {
             return (wanted, None);
         };
-        let stop = ContactStop {
+        let stop = |obstacle| ContactStop {
             moving: link,
             obstacle,
         };
@@ -133,7 +135,7 @@ impl Sim {
             return if toward_closed {
                 (wanted, None)
             } else {
-                (from, Some(stop))
+                (from, Some(stop(obstacle)))
             };
         }
         // `clear` is free and `hit` overlaps: halve the gap until it is below the resolution.
@@ -149,12 +151,6 @@ impl Sim {
                 None => clear = mid,
             }
         }
-        (
-            clear,
-            Some(ContactStop {
-                moving: link,
-                obstacle,
-            }),
-        )
+        (clear, Some(stop(obstacle)))
     }
 }

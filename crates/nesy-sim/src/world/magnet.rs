@@ -21,8 +21,8 @@ pub const MAGNET_RADIUS: f64 = 0.05;
 pub const MAGNET_PULL: f64 = 3.0 * 9.81;
 
 impl Sim {
-    /// World positions of the magnets of every magnetic hook in the scene, in part order.
-    pub fn magnet_centres(&self) -> Vec<[f64; 3]> {
+    /// Every magnetic hook's part and the world position of its magnet's centre.
+    fn magnets(&self) -> Vec<(usize, [f64; 3])> {
         self.parts
             .iter()
             .enumerate()
@@ -31,24 +31,26 @@ impl Sim {
                 let spec = &self.scene.objects[p.object];
                 let local = objects::magnet_centre(spec.size.unwrap_or_else(|| nominal_size(spec.kind)));
                 let at = self.part_pose(i) * nalgebra::Point3::from(local);
-                [at.x, at.y, at.z]
+                (i, [at.x, at.y, at.z])
             })
             .collect()
+    }
+
+    /// World positions of the magnets of every magnetic hook in the scene, in part order.
+    pub fn magnet_centres(&self) -> Vec<[f64; 3]> {
+        self.magnets().into_iter().map(|(_, centre)| centre).collect()
     }
 
     /// Gives every fine-grained piece within [`MAGNET_RADIUS`] of a magnet one substep's
     /// impulse toward it, and the hook the opposite impulse (a hook resting on the table
     /// is held by friction; a carried one is driven by the arm).
     pub(crate) fn apply_magnets(&mut self) {
-        let hooks: Vec<usize> = (0..self.parts.len())
-            .filter(|&i| self.parts[i].kind == ObjectKind::MagneticHook)
-            .collect();
-        if hooks.is_empty() {
+        let magnets = self.magnets();
+        if magnets.is_empty() {
             return;
         }
-        let magnets = self.magnet_centres();
         let dt = CONTROL_DT / f64::from(SUBSTEPS);
-        let mut reactions = vec![[0.0f64; 3]; hooks.len()];
+        let mut reactions = vec![[0.0f64; 3]; magnets.len()];
         for part in self.parts.iter().filter(|p| p.kind.is_fine_grained()) {
             let body = &mut self.world.bodies[part.body];
             if !body.is_dynamic() {
@@ -56,7 +58,7 @@ impl Sim {
             }
             let centre = body.center_of_mass();
             let p = [f64::from(centre.x), f64::from(centre.y), f64::from(centre.z)];
-            for (m, reaction) in magnets.iter().zip(reactions.iter_mut()) {
+            for ((_, m), reaction) in magnets.iter().zip(reactions.iter_mut()) {
                 let d = [m[0] - p[0], m[1] - p[1], m[2] - p[2]];
                 let distance = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
                 if !(1e-6..=MAGNET_RADIUS).contains(&distance) {
@@ -73,8 +75,8 @@ impl Sim {
                 }
             }
         }
-        for (&hook, r) in hooks.iter().zip(reactions) {
-            let body = &mut self.world.bodies[self.parts[hook].body];
+        for ((hook, _), r) in magnets.iter().zip(reactions) {
+            let body = &mut self.world.bodies[self.parts[*hook].body];
             if body.is_dynamic() && r.iter().any(|v| *v != 0.0) {
                 body.apply_impulse(Vector::new(r[0] as f32, r[1] as f32, r[2] as f32), true);
             }

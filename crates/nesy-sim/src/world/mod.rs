@@ -252,18 +252,32 @@ impl Sim {
         }
     }
 
-    /// Every object as perception names it, in part order, with its world AABB (the union
-    /// of its pieces' for a fine-grained object).
-    pub fn perceived_objects(&self) -> Vec<(String, Aabb)> {
-        let mut objects: Vec<(String, Aabb)> = Vec::with_capacity(self.parts.len());
+    /// Every object as perception names it, in part order, with its parts: a fine-grained
+    /// object's pieces together, one part for every other object.
+    pub fn perceived_objects(&self) -> Vec<(&str, Vec<usize>)> {
+        let mut objects: Vec<(&str, Vec<usize>)> = Vec::with_capacity(self.parts.len());
         for i in 0..self.parts.len() {
-            let (name, aabb) = (self.perceived_name(i), self.part_aabb(i));
-            match objects.iter_mut().find(|(n, _)| n == name) {
-                Some((_, merged)) => *merged = merged.union(&aabb),
-                None => objects.push((name.to_owned(), aabb)),
+            let name = self.perceived_name(i);
+            match objects.iter_mut().find(|(n, _)| *n == name) {
+                Some((_, parts)) => parts.push(i),
+                None => objects.push((name, vec![i])),
             }
         }
         objects
+    }
+
+    /// The pieces of the fine-grained object called `name` (none when no such object).
+    pub fn pieces_of(&self, name: &str) -> Vec<usize> {
+        (0..self.parts.len())
+            .filter(|&i| self.parts[i].kind.is_fine_grained() && self.perceived_name(i) == name)
+            .collect()
+    }
+
+    /// World AABB of several parts together.
+    pub fn parts_aabb(&self, parts: &[usize]) -> Aabb {
+        parts
+            .iter()
+            .fold(Aabb::EMPTY, |acc, &p| acc.union(&self.part_aabb(p)))
     }
 
     /// World AABB of a part.
@@ -295,10 +309,10 @@ impl Sim {
         match name {
             parts::FLOOR => Some(self.colliders_aabb(&self.table_colliders)),
             n if n == self.gripper_name() => Some(self.colliders_aabb(&self.robot.gripper_colliders)),
-            n => self
-                .perceived_objects()
-                .into_iter()
-                .find_map(|(object, aabb)| (object == n).then_some(aabb)),
+            n => {
+                let pieces = self.pieces_of(n);
+                (!pieces.is_empty()).then(|| self.parts_aabb(&pieces))
+            }
         }
     }
 

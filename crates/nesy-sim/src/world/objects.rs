@@ -489,7 +489,7 @@ pub const HINGE_BOX_WALL: f32 = 0.005;
 /// 0.01 hinged about y at the body's far (+x) top edge; a handle block on the lid's free
 /// (−x) edge. Part names carry `prefix` (`docs/benchmark.md` §2.3).
 fn hinge_box(prefix: &str, colour: [f32; 3]) -> Vec<PartBuild> {
-    let [body_name, lid_name, handle_name] = parts::HINGE_BOX_PARTS.map(|part| format!("{prefix}{part}"));
+    let [body_name, lid_name, handle_name] = parts::prefixed(prefix, &parts::HINGE_BOX_PARTS);
     let [bx, by, bz] = [0.1025_f32, 0.205, 0.1165];
     let body = fixed(
         &body_name,
@@ -546,7 +546,7 @@ const HANDLE_STANDOFF: f32 = 0.025;
 /// face. Part names carry `prefix`.
 fn drawer_cabinet(prefix: &str, colour: [f32; 3]) -> Vec<PartBuild> {
     let [body_name, bottom, top, bottom_handle, top_handle] =
-        parts::DRAWER_CABINET_PARTS.map(|part| format!("{prefix}{part}"));
+        parts::prefixed(prefix, &parts::DRAWER_CABINET_PARTS);
     let [sx, sy, sz] = [0.154_f32, 0.148, 0.194];
     let t = 0.005_f32;
     let body_shapes = vec![

@@ -1,29 +1,22 @@
 //! Several articulated assets in one scene: prefixed part names, and a drawer opened into
 //! another cabinet's open drawer stopped where the two meet.
 
+use crate::common;
+
 use nesy_sim::api::{ApiError, Direction, RobotApi};
 use nesy_sim::perception::observer;
 use nesy_sim::scene::SceneSpec;
 use nesy_sim::scene::parts::DRAWER_OPEN;
 use nesy_sim::world::Sim;
 
-/// Two cabinets at right angles: `front_` faces −y (its drawers open toward −y), `side_`
-/// is turned a quarter turn so that its drawers open toward +x, across the front cabinet's
-/// drawer path. `side_top_drawer` starts at `side_top`.
+/// Two cabinets at right angles (`fixtures/scenes/drawers_perpendicular_finger.json`):
+/// `front_` faces −y (its drawers open toward −y), `side_` is turned a quarter turn so that
+/// its drawers open toward +x, across the front cabinet's drawer path. `side_top_drawer`
+/// starts at `side_top`.
 fn perpendicular_cabinets(side_top: f64) -> SceneSpec {
-    let scene = serde_json::json!({
-        "schema_version": 1,
-        "embodiment": "finger",
-        "objects": [
-            {"name": "front_drawer_body", "kind": "drawer_cabinet",
-             "pose": {"position": [0.46, 0.19, 0.5], "yaw": 0.0}},
-            {"name": "side_drawer_body", "kind": "drawer_cabinet",
-             "pose": {"position": [0.30, 0.0, 0.5], "yaw": std::f64::consts::FRAC_PI_2}}
-        ],
-        "articulations": {"side_top_drawer": side_top},
-        "goals": []
-    });
-    SceneSpec::from_json_str(&scene.to_string(), "perpendicular cabinets").unwrap()
+    let mut scene = SceneSpec::from_file(&common::scene_path("drawers_perpendicular_finger")).unwrap();
+    scene.articulations.insert("side_top_drawer".into(), side_top);
+    scene
 }
 
 /// Grasps the front cabinet's top handle from above and pulls it open by a full travel.
@@ -92,67 +85,59 @@ fn a_drawer_opened_into_another_open_drawer_stops_at_contact() {
     assert!(sim.articulation_q("front_top_drawer").unwrap() < 0.01);
 }
 
+/// The error loading a finger scene of `objects` and `articulations` gives.
+fn load_error(objects: serde_json::Value, articulations: serde_json::Value) -> String {
+    let scene = serde_json::json!({
+        "schema_version": 1,
+        "embodiment": "finger",
+        "objects": objects,
+        "articulations": articulations
+    });
+    SceneSpec::from_json_str(&scene.to_string(), "scene")
+        .unwrap_err()
+        .to_string()
+}
+
 #[test]
 fn a_second_asset_needs_its_own_prefix() {
-    let scene = serde_json::json!({
-        "schema_version": 1,
-        "embodiment": "finger",
-        "objects": [
+    let twice = load_error(
+        serde_json::json!([
             {"name": "drawer_body", "kind": "drawer_cabinet", "pose": {"position": [0.46, 0.19, 0.5]}},
             {"name": "drawer_body", "kind": "drawer_cabinet", "pose": {"position": [0.30, 0.0, 0.5]}}
-        ]
-    });
-    let err = SceneSpec::from_json_str(&scene.to_string(), "twice")
-        .unwrap_err()
-        .to_string();
-    assert!(
-        err.contains("objects[1].name") && err.contains("duplicate"),
-        "{err}"
+        ]),
+        serde_json::json!({}),
     );
-    let scene = serde_json::json!({
-        "schema_version": 1,
-        "embodiment": "finger",
-        "objects": [{"name": "leftdrawer_body", "kind": "drawer_cabinet", "pose": {"position": [0.46, 0.19, 0.5]}}]
-    });
-    let err = SceneSpec::from_json_str(&scene.to_string(), "glued")
-        .unwrap_err()
-        .to_string();
     assert!(
-        err.contains("objects[0].name") && err.contains("left_drawer_body"),
-        "{err}"
+        twice.contains("objects[1].name") && twice.contains("duplicate"),
+        "{twice}"
     );
-    let scene = serde_json::json!({
-        "schema_version": 1,
-        "embodiment": "finger",
-        "objects": [
+    let glued = load_error(
+        serde_json::json!([
+            {"name": "leftdrawer_body", "kind": "drawer_cabinet", "pose": {"position": [0.46, 0.19, 0.5]}}
+        ]),
+        serde_json::json!({}),
+    );
+    assert!(
+        glued.contains("objects[0].name") && glued.contains("left_drawer_body"),
+        "{glued}"
+    );
+    let cube = load_error(
+        serde_json::json!([
             {"name": "left_drawer_body", "kind": "drawer_cabinet", "pose": {"position": [0.46, 0.19, 0.5]}},
             {"name": "top_drawer", "kind": "cube", "pose": {"position": [0.3, -0.2, 0.5]}}
-        ],
-        "articulations": {"top_drawer": 0.05}
-    });
-    let err = SceneSpec::from_json_str(&scene.to_string(), "cube")
-        .unwrap_err()
-        .to_string();
+        ]),
+        serde_json::json!({"top_drawer": 0.05}),
+    );
     assert!(
-        err.contains("articulations.top_drawer") && err.contains("no asset provides"),
-        "{err}"
+        cube.contains("articulations.top_drawer") && cube.contains("no asset provides"),
+        "{cube}"
     );
 }
 
 /// A magnetic hook on the table with screws around its magnet: two pieces within the
-/// magnet's reach, two beyond it.
+/// magnet's reach, two beyond it (`fixtures/scenes/hook_screws_finger.json`).
 fn hook_and_screws() -> SceneSpec {
-    let scene = serde_json::json!({
-        "schema_version": 1,
-        "embodiment": "finger",
-        "objects": [
-            {"name": "magnetic_hook", "kind": "magnetic_hook", "pose": {"position": [0.45, 0.0, 0.5]}},
-            {"name": "black_screws", "kind": "screws", "pose": {"position": [0.56, 0.0, 0.5]},
-             "pieces": [[-0.02, 0.0], [-0.02, 0.02], [0.1, 0.0], [0.08, -0.08]]}
-        ],
-        "goals": []
-    });
-    SceneSpec::from_json_str(&scene.to_string(), "hook and screws").unwrap()
+    SceneSpec::from_file(&common::scene_path("hook_screws_finger")).unwrap()
 }
 
 #[test]
