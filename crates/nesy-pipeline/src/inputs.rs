@@ -227,6 +227,12 @@ pub struct TargetInput {
 }
 
 impl TargetInput {
+    /// True when the target scene holds a tool, so that code generation offers the
+    /// tool-use calls; a camera target without a scene offers none.
+    pub fn holds_tool(&self) -> bool {
+        self.scene.as_ref().is_some_and(SceneSpec::holds_tool)
+    }
+
     /// Reads `path`: a scene file, or a camera target folder (`manifest.json` with one
     /// keyframe, optionally `scene.json`); without a path, the target scene recorded in the
     /// demo. A scene is built, observed and rendered. Embodiment atoms go into the state

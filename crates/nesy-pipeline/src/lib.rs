@@ -518,6 +518,7 @@ async fn synthesize_adapted(
         procedure: procedure.clone(),
         source: inputs.setting.source_embodiment,
         target: inputs.setting.target_embodiment,
+        tools: inputs.target.holds_tool(),
     };
     let synth_started = Instant::now();
     let result = synth::synthesize(reasoner, inputs.options.codegen, &request).await;

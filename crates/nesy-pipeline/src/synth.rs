@@ -41,6 +41,8 @@ pub struct SynthesisRequest {
     pub source: Embodiment,
     /// The target's end effector.
     pub target: Embodiment,
+    /// The target scene holds a tool: offer the tool-use calls.
+    pub tools: bool,
 }
 
 /// A synthesized program and how it was obtained.
@@ -108,6 +110,7 @@ pub async fn synthesize(
                     plan: Vec::new(),
                     embodiment: request.target,
                     extended: request.source != request.target,
+                    tools: request.tools,
                 })
                 .await;
             let source = match result {

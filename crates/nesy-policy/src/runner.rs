@@ -326,7 +326,8 @@ fn format_traceback(frames: &[TracebackFrame], exception: &str, message: &str, s
     out
 }
 
-/// Names of the robot API functions available to policies, in the paper's order.
+/// Names of the robot API functions available to policies: the paper's, in its order, then
+/// the tool-use call `gather_with_hook`.
 pub fn api_function_names() -> Vec<&'static str> {
     crate::python::robot_module::SIGNATURES
         .iter()

@@ -307,4 +307,14 @@ impl RobotApi for RecordingRobot {
         }
         self.action(ApiCall::DeactivateVacuum, result)
     }
+
+    fn gather_with_hook(&mut self, obj_name: &str) -> Result<(), ApiError> {
+        let result = self.bbox(obj_name).map(|_| ());
+        self.action(
+            ApiCall::GatherWithHook {
+                obj_name: obj_name.to_owned(),
+            },
+            result,
+        )
+    }
 }

@@ -94,6 +94,7 @@ fn prompts(c: &mut Criterion) {
         plan: Vec::new(),
         embodiment: nesy_core::Embodiment::Vacuum,
         extended: true,
+        tools: false,
     };
     let mut group = c.benchmark_group("prompts");
     group.bench_function("induction_request_6_rendered_images", |b| {

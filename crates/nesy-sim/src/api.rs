@@ -133,6 +133,9 @@ pub enum ApiCall {
     DetachVacuumHandle,
     ActivateVacuum,
     DeactivateVacuum,
+    GatherWithHook {
+        obj_name: String,
+    },
 }
 
 impl ApiCall {
@@ -158,6 +161,7 @@ impl ApiCall {
             ApiCall::DetachVacuumHandle => "detach_vacuum_handle",
             ApiCall::ActivateVacuum => "activate_vacuum",
             ApiCall::DeactivateVacuum => "deactivate_vacuum",
+            ApiCall::GatherWithHook { .. } => "gather_with_hook",
         }
     }
 
@@ -170,7 +174,8 @@ impl ApiCall {
             | ApiCall::GetObjSize { obj_name }
             | ApiCall::ObjInGripper { obj_name }
             | ApiCall::GetEmptyFloorXy { obj_name }
-            | ApiCall::MoveGripperTo { obj_name, .. } => Some(obj_name),
+            | ApiCall::MoveGripperTo { obj_name, .. }
+            | ApiCall::GatherWithHook { obj_name } => Some(obj_name),
             ApiCall::GraspHandle { handle_name } | ApiCall::AttachVacuumHandle { handle_name } => {
                 Some(handle_name)
             }
@@ -226,6 +231,7 @@ impl ApiCall {
             ApiCall::DetachVacuumHandle => done(robot.detach_vacuum_handle()),
             ApiCall::ActivateVacuum => done(robot.activate_vacuum()),
             ApiCall::DeactivateVacuum => done(robot.deactivate_vacuum()),
+            ApiCall::GatherWithHook { obj_name } => done(robot.gather_with_hook(obj_name)),
         }
     }
 
@@ -429,6 +435,10 @@ pub trait RobotApi {
     fn activate_vacuum(&mut self) -> Result<(), ApiError>;
     /// Vacuum counterpart of [`RobotApi::open_gripper`].
     fn deactivate_vacuum(&mut self) -> Result<(), ApiError>;
+    /// With a magnetic hook held, sweeps its magnet low over the pieces of the fine-grained
+    /// object `obj_name` (screws) and lifts again; the magnet pulls the pieces it passes
+    /// within reach of, so that they cling to it and travel with the hook (both robots).
+    fn gather_with_hook(&mut self, obj_name: &str) -> Result<(), ApiError>;
 }
 
 #[cfg(test)]

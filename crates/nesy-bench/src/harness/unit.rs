@@ -264,6 +264,7 @@ pub(super) async fn make_code(
                 procedure,
                 source: inputs.setting.source_embodiment,
                 target: inputs.setting.target_embodiment,
+                tools: target.holds_tool(),
             };
             let reasoner =
                 VlmReasoner::new(client.clone()).map_err(|e| (UnitStatus::MethodError, e.to_string()))?;
@@ -287,6 +288,7 @@ pub(super) async fn make_code(
                 // Combination (whose scenarios may change the end effector).
                 extended: matches!(inputs.setting.factor, Factor::Grip | Factor::Vacu | Factor::Comb)
                     || inputs.setting.source_embodiment != inputs.setting.target_embodiment,
+                tools: target.holds_tool(),
             };
             let source = reasoner.generate_code(&request).await.map_err(|e| {
                 let status = match FailureKind::of_reasoner(e.reasoner_kind()) {

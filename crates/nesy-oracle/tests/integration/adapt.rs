@@ -130,6 +130,7 @@ async fn adapt_and_execute(case: &Case, noise: OracleNoise, budget: usize) -> Ru
                 plan: Vec::new(),
                 embodiment: case.target,
                 extended: cross,
+                tools: false,
             })
             .await
             .unwrap();

@@ -168,10 +168,11 @@ mod sigs {
     sig!(detach_vacuum_handle, NONE);
     sig!(activate_vacuum, NONE);
     sig!(deactivate_vacuum, NONE);
+    sig!(gather_with_hook, OBJ);
 }
 
 /// Every function of the module with its signature, in the order of the paper's tables.
-pub(crate) const SIGNATURES: [&Signature; 19] = [
+pub(crate) const SIGNATURES: [&Signature; 20] = [
     &sigs::is_obj_visible,
     &sigs::get_obj_names,
     &sigs::get_obj_pos,
@@ -191,6 +192,7 @@ pub(crate) const SIGNATURES: [&Signature; 19] = [
     &sigs::detach_vacuum_handle,
     &sigs::activate_vacuum,
     &sigs::deactivate_vacuum,
+    &sigs::gather_with_hook,
 ];
 
 /// Perception functions taking one object name.
@@ -383,6 +385,20 @@ act_bare!(
     deactivate_vacuum
 );
 
+/// gather_with_hook(obj_name): sweep the held magnetic hook over a fine-grained object's
+/// pieces, so that its magnet gathers them (both end effectors).
+#[pyfunction(signature = (*args, **kwargs), text_signature = "(obj_name)")]
+fn gather_with_hook(
+    py: Python<'_>,
+    args: &Bound<'_, PyTuple>,
+    kwargs: Option<&Bound<'_, PyDict>>,
+) -> PyResult<()> {
+    let sig = &sigs::gather_with_hook;
+    let [name] = sig.bind::<1>(args, kwargs)?;
+    let name = sig.string(0, name.as_ref().expect("required"))?;
+    run(py, true, move |r| r.gather_with_hook(&name))
+}
+
 /// The `robot` module, registered with `append_to_inittab!` before the interpreter starts.
 #[pymodule]
 pub(crate) fn robot(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -405,6 +421,7 @@ pub(crate) fn robot(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(detach_vacuum_handle, m)?)?;
     m.add_function(wrap_pyfunction!(activate_vacuum, m)?)?;
     m.add_function(wrap_pyfunction!(deactivate_vacuum, m)?)?;
+    m.add_function(wrap_pyfunction!(gather_with_hook, m)?)?;
     let py = m.py();
     m.add("RobotError", py.get_type::<RobotError>())?;
     m.add("WrongEmbodimentError", py.get_type::<WrongEmbodimentError>())?;

@@ -635,7 +635,10 @@ fn huge_allocations_become_memory_errors() {
 
 #[test]
 fn api_names_match_the_paper() {
-    assert_eq!(nesy_policy::api_function_names().len(), 19);
+    // The paper's 19 functions, then the tool-use call.
+    let names = nesy_policy::api_function_names();
+    assert_eq!(names.len(), 20);
+    assert_eq!(names.last(), Some(&"gather_with_hook"));
     let signatures = nesy_policy::api_signatures();
     assert!(
         signatures.contains(
@@ -670,4 +673,35 @@ except robot.CollisionError as err:
         "{}",
         result.stdout.text
     );
+}
+
+/// A policy gathers scattered screws with the magnetic hook: `gather_with_hook` is in the
+/// `robot` module, refuses without a hook in hand, and after the sweep the screws travel
+/// with the hook.
+#[test]
+fn a_policy_gathers_screws_with_the_magnetic_hook() {
+    let sim = nesy_sim::world::Sim::from_file(
+        &nesy_testkit::workspace_root().join("fixtures/scenes/hook_screws_finger.json"),
+    )
+    .unwrap();
+    let source = r#"
+try:
+    gather_with_hook("black_screws")
+except robot.InfeasibleError as err:
+    print("refused:", err)
+move_gripper_to("magnetic_hook")
+close_gripper()
+gather_with_hook(obj_name="black_screws")
+print("in gripper:", obj_in_gripper("magnetic_hook"))
+"#;
+    let result = run_in_process(source, Box::new(sim), &Limits::default(), None).expect("interpreter starts");
+    assert_eq!(result.outcome, Outcome::Ok, "{:#?}", result.outcome);
+    let out = &result.stdout.text;
+    assert!(
+        out.contains("refused: gather_with_hook(black_screws) is infeasible: nothing is held"),
+        "{out}"
+    );
+    assert!(out.contains("in gripper: True"), "{out}");
+    let state = format!("{:?}", result.final_state);
+    assert!(state.contains("(Gathered black_screws)"), "{state}");
 }

@@ -38,6 +38,10 @@ pub struct CodeGenerationRequest {
     /// the demonstration's end effector differs from the target's, as the authors do; a
     /// vacuum target always gets it.
     pub extended: bool,
+    /// Offer the tool-use functions (`gather_with_hook`): the target scene holds a magnetic
+    /// hook. Off, the prompt is the one a scene without tools gets.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub tools: bool,
 }
 
 /// A generated program, ready for the sandbox, with how it was obtained.
@@ -191,6 +195,7 @@ pub fn build_request(
         action_names: &names,
         embodiment: request.embodiment,
         extended: request.extended,
+        tools: request.tools,
     };
     let extended = prompt.uses_extended();
     let rendered = prompts.code_generation(&prompt)?;

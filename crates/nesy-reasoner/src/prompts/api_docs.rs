@@ -34,6 +34,9 @@ pub const VACUUM_FUNCTIONS: [&str; 4] = [
     "deactivate_vacuum",
 ];
 
+/// Tool-use functions, offered when the scene holds a magnetic hook.
+pub const TOOL_FUNCTIONS: [&str; 1] = ["gather_with_hook"];
+
 /// The end-effector functions that exist only on the finger gripper.
 pub const FINGER_ONLY_FUNCTIONS: [&str; 4] =
     ["grasp_handle", "release_handle", "open_gripper", "close_gripper"];
@@ -44,56 +47,96 @@ pub const PERCEPTION_DOCS: &str = include_str!("../../prompts/api/perception.py"
 pub const FINGER_DOCS: &str = include_str!("../../prompts/api/finger.py");
 /// Docstrings of the vacuum functions.
 pub const VACUUM_DOCS: &str = include_str!("../../prompts/api/vacuum.py");
+/// Docstrings of the tool-use functions.
+pub const TOOL_DOCS: &str = include_str!("../../prompts/api/tools.py");
 
-/// The three documentation files with their paths under `prompts/`.
-pub const EMBEDDED: [(&str, &str); 3] = [
+/// The four documentation files with their paths under `prompts/`.
+pub const EMBEDDED: [(&str, &str); 4] = [
     ("api/perception.py", PERCEPTION_DOCS),
     ("api/finger.py", FINGER_DOCS),
     ("api/vacuum.py", VACUUM_DOCS),
+    ("api/tools.py", TOOL_DOCS),
 ];
 
-/// Every robot API function name (the 19 of the paper's tables).
+/// Every robot API function name: the 19 of the paper's tables, then the tool-use ones.
 pub fn all_functions() -> impl Iterator<Item = &'static str> {
     PERCEPTION_FUNCTIONS
         .into_iter()
         .chain(FINGER_FUNCTIONS)
         .chain(VACUUM_FUNCTIONS)
+        .chain(TOOL_FUNCTIONS)
 }
 
-/// The functions a prompt offers: perception and motion always, plus the finger functions
-/// and, when `vacuum`, the vacuum functions.
-pub fn offered_functions(vacuum: bool) -> Vec<&'static str> {
-    let mut names: Vec<&str> = PERCEPTION_FUNCTIONS.into_iter().chain(FINGER_FUNCTIONS).collect();
-    if vacuum {
-        names.extend(VACUUM_FUNCTIONS);
+/// Which optional groups of the robot API a prompt documents: the vacuum functions (the
+/// extended prompt) and the tool-use functions (a scene with a magnetic hook). The paper's
+/// perception, motion and finger functions are always there.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ApiOffer {
+    /// Document the vacuum tool's functions.
+    pub vacuum: bool,
+    /// Document the tool-use functions.
+    pub tools: bool,
+}
+
+impl ApiOffer {
+    fn groups(self) -> Vec<&'static [&'static str]> {
+        let mut groups: Vec<&[&str]> = vec![&PERCEPTION_FUNCTIONS, &FINGER_FUNCTIONS];
+        if self.vacuum {
+            groups.push(&VACUUM_FUNCTIONS);
+        }
+        if self.tools {
+            groups.push(&TOOL_FUNCTIONS);
+        }
+        groups
     }
-    names
+}
+
+/// The functions a prompt offers, in the order of the import block.
+pub fn offered_functions(offer: ApiOffer) -> Vec<&'static str> {
+    offer.groups().into_iter().flatten().copied().collect()
 }
 
 /// The "already imported" block: numpy, math and the robot functions.
-pub fn imports(vacuum: bool) -> String {
+pub fn imports(offer: ApiOffer) -> String {
     let mut lines = vec![
         "import math".to_string(),
         "import numpy as np".to_string(),
         "from robot import (".to_string(),
     ];
-    let mut groups: Vec<&[&str]> = vec![&PERCEPTION_FUNCTIONS, &FINGER_FUNCTIONS];
-    if vacuum {
-        groups.push(&VACUUM_FUNCTIONS);
-    }
-    for group in groups {
+    for group in offer.groups() {
         lines.push(format!("    {},", group.join(", ")));
     }
     lines.push(")".to_string());
     lines.join("\n")
 }
 
-/// The docstring block: perception and finger functions, plus the vacuum ones when
-/// `vacuum`.
-pub fn docstrings(vacuum: bool) -> String {
+/// The docstring block: perception and finger functions, plus the groups `offer` adds.
+pub fn docstrings(offer: ApiOffer) -> String {
     let mut parts = vec![PERCEPTION_DOCS.trim_end(), FINGER_DOCS.trim_end()];
-    if vacuum {
+    if offer.vacuum {
         parts.push(VACUUM_DOCS.trim_end());
     }
+    if offer.tools {
+        parts.push(TOOL_DOCS.trim_end());
+    }
     parts.join("\n\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tool_functions_are_offered_only_when_asked_for() {
+        let plain = ApiOffer::default();
+        let tools = ApiOffer { tools: true, ..plain };
+        assert!(!imports(plain).contains("gather_with_hook"));
+        assert!(!docstrings(plain).contains("gather_with_hook"));
+        assert!(!offered_functions(plain).contains(&"gather_with_hook"));
+        assert!(imports(tools).contains("    gather_with_hook,\n)"));
+        assert!(docstrings(tools).contains("def gather_with_hook(obj_name):"));
+        assert_eq!(offered_functions(tools).last(), Some(&"gather_with_hook"));
+        // The paper's functions keep their block and order either way.
+        assert!(imports(tools).starts_with(&imports(plain)[..imports(plain).len() - 1]));
+    }
 }

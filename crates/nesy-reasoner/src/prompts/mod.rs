@@ -270,6 +270,8 @@ pub struct CodeGenerationPrompt<'a> {
     pub embodiment: Embodiment,
     /// Use the extended prompt (both end effectors' functions and examples).
     pub extended: bool,
+    /// Document the tool-use functions (the scene holds a magnetic hook).
+    pub tools: bool,
 }
 
 impl CodeGenerationPrompt<'_> {
@@ -738,6 +740,10 @@ impl Prompts {
     /// [`CodeGenerationPrompt::uses_extended`]).
     pub fn code_generation(&self, prompt: &CodeGenerationPrompt<'_>) -> Result<RenderedPrompt, PromptError> {
         let extended = prompt.uses_extended();
+        let offer = api_docs::ApiOffer {
+            vacuum: extended,
+            tools: prompt.tools,
+        };
         let mut shown: Vec<&CodeExample> = self.finger_code.iter().collect();
         if extended {
             shown.extend(self.vacuum_code.iter());
@@ -764,8 +770,8 @@ impl Prompts {
             system,
             user,
             serde_json::json!({
-                "imports": api_docs::imports(extended),
-                "docstrings": api_docs::docstrings(extended),
+                "imports": api_docs::imports(offer),
+                "docstrings": api_docs::docstrings(offer),
                 "examples": examples,
                 "instruction": prompt.instruction.trim(),
                 "objects": prompt.objects.join(", "),

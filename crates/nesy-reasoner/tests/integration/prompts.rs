@@ -400,6 +400,7 @@ fn codegen_request(embodiment: Embodiment, extended: bool) -> ChatRequest {
         plan: Vec::new(),
         embodiment,
         extended,
+        tools: false,
     };
     let prompts = Prompts::builtin().unwrap();
     let (chat, used) = nesy_reasoner::codegen::build_request(
@@ -432,7 +433,13 @@ fn code_generation_prompts() {
     assert!(!finger.contains("vacuum"), "nor mentions the vacuum tool at all");
     let extended = text(&extended);
     for name in api_docs::all_functions() {
-        assert!(extended.contains(&format!("def {name}(")), "{name} is documented");
+        // The tool-use functions only for a scene with a tool, which this is not.
+        let offered = !api_docs::TOOL_FUNCTIONS.contains(&name);
+        assert_eq!(
+            extended.contains(&format!("def {name}(")),
+            offered,
+            "{name} is documented: {offered}"
+        );
     }
     assert!(extended.contains("never mix"));
     assert!(extended.contains("- End effector:\nvacuum suction tool"));
@@ -451,16 +458,12 @@ fn code_generation_prompts() {
 /// parameters and defaults (nesy-policy's signatures, which mirror nesy-sim's defaults).
 #[test]
 fn docstring_signatures_match_the_sandbox() {
-    let documented: Vec<String> = [
-        api_docs::PERCEPTION_DOCS,
-        api_docs::FINGER_DOCS,
-        api_docs::VACUUM_DOCS,
-    ]
-    .iter()
-    .flat_map(|docs| docs.lines())
-    .filter_map(|l| l.strip_prefix("def "))
-    .map(|l| l.trim_end_matches(':').replace('"', "'"))
-    .collect();
+    let documented: Vec<String> = api_docs::EMBEDDED
+        .iter()
+        .flat_map(|(_, docs)| docs.lines())
+        .filter_map(|l| l.strip_prefix("def "))
+        .map(|l| l.trim_end_matches(':').replace('"', "'"))
+        .collect();
     assert_eq!(documented, nesy_policy::api_signatures());
     assert_eq!(
         api_docs::all_functions().collect::<Vec<_>>(),

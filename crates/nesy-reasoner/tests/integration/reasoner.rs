@@ -188,6 +188,7 @@ async fn the_loop_recovers_from_a_rejected_operator_and_a_non_matching_patch() {
         plan: Vec::new(),
         embodiment: Embodiment::Finger,
         extended: false,
+        tools: false,
     };
     let policy = reasoner.generate_code(&request).await.unwrap();
     assert!(
@@ -485,6 +486,7 @@ async fn plausible_but_wrong_programs_are_re_asked_before_anything_runs() {
             plan: Vec::new(),
             embodiment: Embodiment::Finger,
             extended: false,
+            tools: false,
         };
         let policy = reasoner
             .generate_code(&request)

@@ -182,6 +182,12 @@ impl ObjectKind {
         self == ObjectKind::Screws
     }
 
+    /// True for the kinds a robot uses as a tool (the magnetic hook): a scene holding one is
+    /// offered the tool-use calls of the robot API.
+    pub fn is_tool(self) -> bool {
+        self == ObjectKind::MagneticHook
+    }
+
     /// The base part name an articulated kind's entry must end with (after an optional
     /// prefix ending in `_`).
     pub fn required_suffix(self) -> Option<&'static str> {
@@ -348,6 +354,12 @@ pub fn part_prefix(spec: &ObjectSpec) -> &str {
 }
 
 impl SceneSpec {
+    /// True when the scene holds a tool (a magnetic hook), so that policies for it are
+    /// offered the tool-use calls (`gather_with_hook`).
+    pub fn holds_tool(&self) -> bool {
+        self.objects.iter().any(|o| o.kind.is_tool())
+    }
+
     /// Parses and validates scene JSON; `origin` names the source in errors.
     pub fn from_json_str(text: &str, origin: &str) -> Result<SceneSpec, SceneError> {
         let de = &mut serde_json::Deserializer::from_str(text);

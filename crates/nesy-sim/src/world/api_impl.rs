@@ -85,7 +85,7 @@ fn covers(n: &Aabb, at: [f64; 2]) -> bool {
 }
 
 impl Sim {
-    fn known_names(&self) -> String {
+    pub(super) fn known_names(&self) -> String {
         self.names().join(", ")
     }
 
@@ -232,7 +232,7 @@ impl Sim {
         })
     }
 
-    fn check_workspace(&self, target: [f64; 3]) -> Result<(), ApiError> {
+    pub(super) fn check_workspace(&self, target: [f64; 3]) -> Result<(), ApiError> {
         let inside = (0..2).all(|i| target[i] >= FLOOR_AABB.min[i] && target[i] <= FLOOR_AABB.max[i]);
         if !inside
             || !(TABLE_TOP - 0.05..=TABLE_TOP + 0.8).contains(&target[2])
@@ -338,7 +338,7 @@ impl Sim {
     /// where the arm reaches that point, else the largest reachable fraction of it. Close to
     /// the base the arm cannot rise as high pointing down (its elbow would have to fold past
     /// its limit), and an object put down there left the hand unable to leave.
-    fn reachable_lift(
+    pub(super) fn reachable_lift(
         &self,
         from: Vector3<f64>,
         tool_axis: Vector3<f64>,
@@ -971,5 +971,12 @@ impl RobotApi for Sim {
                 Ok(())
             },
         )
+    }
+
+    fn gather_with_hook(&mut self, obj_name: &str) -> Result<(), ApiError> {
+        let call = ApiCall::GatherWithHook {
+            obj_name: obj_name.into(),
+        };
+        self.action(call, None, |sim| sim.do_gather_with_hook(obj_name))
     }
 }

@@ -15,6 +15,7 @@ mod api_impl;
 mod build;
 pub(crate) mod contact;
 pub(crate) mod floor;
+mod gather;
 pub mod geometry;
 pub mod magnet;
 pub mod objects;

@@ -251,3 +251,65 @@ fn the_api_knows_screws_as_one_object_too_small_to_grasp() {
     }
     assert_eq!(sim.obj_in_gripper("black_screws"), Ok(false));
 }
+
+#[test]
+fn gather_with_hook_sweeps_the_magnet_over_every_piece() {
+    use nesy_sim::api::ApiCall;
+    use nesy_sim::world::magnet::MAGNET_RADIUS;
+    let mut sim = Sim::new(&hook_and_screws()).unwrap();
+    sim.step_idle(50);
+    // Two pieces lie beyond the resting magnet's reach: only a sweep brings them in.
+    let magnet = sim.magnet_centres()[0];
+    let beyond = sim
+        .pieces_of("black_screws")
+        .into_iter()
+        .filter(|&p| {
+            let at = sim.part_pose(p).translation.vector;
+            ((at.x - magnet[0]).powi(2) + (at.y - magnet[1]).powi(2)).sqrt() > MAGNET_RADIUS
+        })
+        .count();
+    assert_eq!(beyond, 2);
+    sim.move_gripper_to("magnetic_hook", Direction::Down, 0.01)
+        .unwrap();
+    sim.close_gripper().unwrap();
+    sim.gather_with_hook("black_screws").unwrap();
+    sim.step_idle(50);
+    let state = format!("{:?}", observer::observe(&sim));
+    assert!(state.contains("(Gathered black_screws)"), "{state}");
+    let magnet = sim.magnet_centres()[0];
+    for piece in sim.pieces_of("black_screws") {
+        let at = sim.part_pose(piece).translation.vector;
+        let d = ((at.x - magnet[0]).powi(2) + (at.y - magnet[1]).powi(2) + (at.z - magnet[2]).powi(2)).sqrt();
+        assert!(
+            d < 0.03,
+            "{} is {d:.3} m from the magnet",
+            sim.parts()[piece].name
+        );
+    }
+    assert_eq!(sim.held_object(), Some("magnetic_hook"));
+    let last = sim.trace().last().unwrap();
+    assert_eq!(
+        last.call,
+        ApiCall::GatherWithHook {
+            obj_name: "black_screws".into()
+        }
+    );
+    assert_eq!(last.call.label(), "gather_with_hook(black_screws)");
+}
+
+#[test]
+fn gather_with_hook_needs_a_held_hook_and_a_fine_grained_object() {
+    let mut sim = Sim::new(&hook_and_screws()).unwrap();
+    let reason = |r: Result<(), ApiError>| match r {
+        Err(ApiError::Infeasible { reason, .. }) => reason,
+        other => panic!("expected a refusal, got {other:?}"),
+    };
+    let empty_handed = reason(sim.gather_with_hook("black_screws"));
+    assert!(empty_handed.contains("grasp a magnetic hook"), "{empty_handed}");
+    let rigid = reason(sim.gather_with_hook("magnetic_hook"));
+    assert!(rigid.contains("not small pieces"), "{rigid}");
+    assert!(matches!(
+        sim.gather_with_hook("red_screws"),
+        Err(ApiError::UnknownObject { .. })
+    ));
+}
