@@ -37,6 +37,13 @@ pub fn workspace_root() -> PathBuf {
         .unwrap_or(here)
 }
 
+/// Path of the scene fixture `fixtures/scenes/<name>.json`.
+pub fn scene_fixture(name: &str) -> PathBuf {
+    workspace_root()
+        .join("fixtures/scenes")
+        .join(format!("{name}.json"))
+}
+
 /// Copies the folder `from` and everything below it to `to` (created if missing).
 pub fn copy_tree(from: &std::path::Path, to: &std::path::Path) {
     std::fs::create_dir_all(to).expect("creating the copy's folder");

@@ -652,10 +652,8 @@ fn api_names_match_the_paper() {
 /// contact as `robot.CollisionError`, a `RobotError` it can catch.
 #[test]
 fn a_drawer_stopped_by_another_raises_collision_error() {
-    let sim = nesy_sim::world::Sim::from_file(
-        &nesy_testkit::workspace_root().join("fixtures/scenes/drawers_perpendicular_finger.json"),
-    )
-    .unwrap();
+    let sim = nesy_sim::world::Sim::from_file(&nesy_testkit::scene_fixture("drawers_perpendicular_finger"))
+        .unwrap();
     let source = r#"
 move_gripper_to("front_top_drawer_handle")
 grasp_handle("front_top_drawer_handle")
@@ -680,10 +678,7 @@ except robot.CollisionError as err:
 /// with the hook.
 #[test]
 fn a_policy_gathers_screws_with_the_magnetic_hook() {
-    let sim = nesy_sim::world::Sim::from_file(
-        &nesy_testkit::workspace_root().join("fixtures/scenes/hook_screws_finger.json"),
-    )
-    .unwrap();
+    let sim = nesy_sim::world::Sim::from_file(&nesy_testkit::scene_fixture("hook_screws_finger")).unwrap();
     let source = r#"
 try:
     gather_with_hook("black_screws")

@@ -78,14 +78,26 @@ pub struct ApiOffer {
     pub tools: bool,
 }
 
+/// One group of the robot API: its functions and the docstrings that document them.
+struct Group {
+    functions: &'static [&'static str],
+    docs: &'static str,
+}
+
 impl ApiOffer {
-    fn groups(self) -> Vec<&'static [&'static str]> {
-        let mut groups: Vec<&[&str]> = vec![&PERCEPTION_FUNCTIONS, &FINGER_FUNCTIONS];
+    /// The groups offered, in prompt order: the import block and the docstring block both
+    /// follow it, so a function is imported exactly when it is documented.
+    fn groups(self) -> Vec<Group> {
+        let group = |functions: &'static [&'static str], docs| Group { functions, docs };
+        let mut groups = vec![
+            group(&PERCEPTION_FUNCTIONS, PERCEPTION_DOCS),
+            group(&FINGER_FUNCTIONS, FINGER_DOCS),
+        ];
         if self.vacuum {
-            groups.push(&VACUUM_FUNCTIONS);
+            groups.push(group(&VACUUM_FUNCTIONS, VACUUM_DOCS));
         }
         if self.tools {
-            groups.push(&TOOL_FUNCTIONS);
+            groups.push(group(&TOOL_FUNCTIONS, TOOL_DOCS));
         }
         groups
     }
@@ -93,7 +105,11 @@ impl ApiOffer {
 
 /// The functions a prompt offers, in the order of the import block.
 pub fn offered_functions(offer: ApiOffer) -> Vec<&'static str> {
-    offer.groups().into_iter().flatten().copied().collect()
+    offer
+        .groups()
+        .iter()
+        .flat_map(|g| g.functions.iter().copied())
+        .collect()
 }
 
 /// The "already imported" block: numpy, math and the robot functions.
@@ -104,7 +120,7 @@ pub fn imports(offer: ApiOffer) -> String {
         "from robot import (".to_string(),
     ];
     for group in offer.groups() {
-        lines.push(format!("    {},", group.join(", ")));
+        lines.push(format!("    {},", group.functions.join(", ")));
     }
     lines.push(")".to_string());
     lines.join("\n")
@@ -112,14 +128,12 @@ pub fn imports(offer: ApiOffer) -> String {
 
 /// The docstring block: perception and finger functions, plus the groups `offer` adds.
 pub fn docstrings(offer: ApiOffer) -> String {
-    let mut parts = vec![PERCEPTION_DOCS.trim_end(), FINGER_DOCS.trim_end()];
-    if offer.vacuum {
-        parts.push(VACUUM_DOCS.trim_end());
-    }
-    if offer.tools {
-        parts.push(TOOL_DOCS.trim_end());
-    }
-    parts.join("\n\n")
+    offer
+        .groups()
+        .iter()
+        .map(|g| g.docs.trim_end())
+        .collect::<Vec<_>>()
+        .join("\n\n")
 }
 
 #[cfg(test)]

@@ -85,7 +85,7 @@ fn covers(n: &Aabb, at: [f64; 2]) -> bool {
 }
 
 impl Sim {
-    pub(super) fn known_names(&self) -> String {
+    fn known_names(&self) -> String {
         self.names().join(", ")
     }
 
@@ -102,7 +102,8 @@ impl Sim {
             .collect()
     }
 
-    fn aabb_or_unknown(&self, name: &str) -> Result<Aabb, ApiError> {
+    /// The box of the object called `name`, or the error naming every known object.
+    pub(super) fn aabb_or_unknown(&self, name: &str) -> Result<Aabb, ApiError> {
         self.object_aabb(name).ok_or_else(|| ApiError::UnknownObject {
             name: name.to_owned(),
             known: self.known_names(),

@@ -28,12 +28,7 @@ impl Sim {
     pub(crate) fn do_gather_with_hook(&mut self, obj_name: &str) -> Result<(), ApiError> {
         let pieces = self.pieces_of(obj_name);
         if pieces.is_empty() {
-            if self.object_aabb(obj_name).is_none() {
-                return Err(ApiError::UnknownObject {
-                    name: obj_name.into(),
-                    known: self.known_names(),
-                });
-            }
+            self.aabb_or_unknown(obj_name)?;
             let reason = "it is one rigid object, not small pieces; grasp it instead";
             return Err(self.refusal(obj_name, reason.into()));
         }

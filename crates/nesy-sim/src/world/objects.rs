@@ -441,11 +441,9 @@ fn magnetic_hook(s: [f32; 3], colour: [f32; 3]) -> Vec<ShapeBuild> {
     let magnet_len = s[0] * MAGNET_LENGTH_FRACTION as f32;
     let bar_len = s[0] - magnet_len;
     let bar_side = s[1].min(s[2]) * 0.7;
-    let mut magnet = cuboid(
-        [magnet_len, s[1], s[2]],
-        [s[0] / 2.0 - magnet_len / 2.0, 0.0, s[2] / 2.0],
-        [0.12, 0.12, 0.14],
-    );
+    // The block sits where the magnet's pull is centred.
+    let centre = magnet_centre(s.map(f64::from)).map(|v| v as f32);
+    let mut magnet = cuboid([magnet_len, s[1], s[2]], centre, [0.12, 0.12, 0.14]);
     magnet.density = STEEL_DENSITY;
     vec![
         cuboid(

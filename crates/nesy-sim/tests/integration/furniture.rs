@@ -1,8 +1,6 @@
 //! Several articulated assets in one scene: prefixed part names, and a drawer opened into
 //! another cabinet's open drawer stopped where the two meet.
 
-use crate::common;
-
 use nesy_sim::api::{ApiError, Direction, RobotApi};
 use nesy_sim::perception::observer;
 use nesy_sim::scene::SceneSpec;
@@ -14,7 +12,8 @@ use nesy_sim::world::Sim;
 /// its drawers open toward +x, across the front cabinet's drawer path. `side_top_drawer`
 /// starts at `side_top`.
 fn perpendicular_cabinets(side_top: f64) -> SceneSpec {
-    let mut scene = SceneSpec::from_file(&common::scene_path("drawers_perpendicular_finger")).unwrap();
+    let mut scene =
+        SceneSpec::from_file(&nesy_testkit::scene_fixture("drawers_perpendicular_finger")).unwrap();
     scene.articulations.insert("side_top_drawer".into(), side_top);
     scene
 }
@@ -137,7 +136,7 @@ fn a_second_asset_needs_its_own_prefix() {
 /// A magnetic hook on the table with screws around its magnet: two pieces within the
 /// magnet's reach, two beyond it (`fixtures/scenes/hook_screws_finger.json`).
 fn hook_and_screws() -> SceneSpec {
-    SceneSpec::from_file(&common::scene_path("hook_screws_finger")).unwrap()
+    SceneSpec::from_file(&nesy_testkit::scene_fixture("hook_screws_finger")).unwrap()
 }
 
 #[test]

@@ -3,11 +3,12 @@
 
 use crate::common;
 
-use common::{expect, load, scene_path};
+use common::{expect, load};
 use nesy_core::Embodiment;
 use nesy_sim::api::{ApiError, Direction, RobotApi};
 use nesy_sim::scene::{SceneError, SceneSpec};
 use nesy_sim::world::{Sim, SimConfig};
+use nesy_testkit::scene_fixture;
 
 fn wrong_embodiment(result: Result<(), ApiError>, call: &str, use_instead: &str, embodiment: Embodiment) {
     match result {
@@ -185,7 +186,7 @@ fn unreachable_and_out_of_workspace_targets_are_refused() {
 
 #[test]
 fn a_lid_with_fruit_on_it_cannot_be_opened() {
-    let text = std::fs::read_to_string(scene_path("hinge_finger")).unwrap();
+    let text = std::fs::read_to_string(scene_fixture("hinge_finger")).unwrap();
     let mut spec = SceneSpec::from_json_str(&text, "hinge").unwrap();
     // Put the apple on the closed lid (lid top at 0.6265 + handle clearance).
     spec.objects[1].pose.position = [0.525, 0.02, 0.627];
@@ -201,7 +202,7 @@ fn a_lid_with_fruit_on_it_cannot_be_opened() {
 
 #[test]
 fn an_object_wider_than_the_opening_is_not_grasped() {
-    let text = std::fs::read_to_string(scene_path("pick_place_finger")).unwrap();
+    let text = std::fs::read_to_string(scene_fixture("pick_place_finger")).unwrap();
     let mut spec = SceneSpec::from_json_str(&text, "wide").unwrap();
     spec.objects[1].size = Some([0.1, 0.1, 0.03]);
     spec.objects[1].pose.yaw = 0.0;
@@ -220,7 +221,7 @@ fn an_object_wider_than_the_opening_is_not_grasped() {
 
 #[test]
 fn the_action_budget_is_enforced() {
-    let text = std::fs::read_to_string(scene_path("pick_place_finger")).unwrap();
+    let text = std::fs::read_to_string(scene_fixture("pick_place_finger")).unwrap();
     let spec = SceneSpec::from_json_str(&text, "budget").unwrap();
     let mut sim = Sim::with_config(
         &spec,
@@ -238,7 +239,7 @@ fn the_action_budget_is_enforced() {
 }
 
 fn load_error(mutate: impl FnOnce(&mut serde_json::Value)) -> SceneError {
-    let text = std::fs::read_to_string(scene_path("pick_place_finger")).unwrap();
+    let text = std::fs::read_to_string(scene_fixture("pick_place_finger")).unwrap();
     let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
     mutate(&mut json);
     let text = serde_json::to_string_pretty(&json).unwrap();
@@ -328,7 +329,7 @@ fn malformed_scenes_name_the_json_path_and_the_expectation() {
 
     // JSON has no NaN: a NaN pose is a syntax error at its position; a value serde cannot
     // represent as finite is refused by validation.
-    let text = std::fs::read_to_string(scene_path("pick_place_finger")).unwrap();
+    let text = std::fs::read_to_string(scene_fixture("pick_place_finger")).unwrap();
     let bad = text.replacen("[0.6, -0.1, 0.5]", "[0.6, NaN, 0.5]", 1);
     let e = SceneSpec::from_json_str(&bad, "nan.json").unwrap_err();
     assert_eq!(e.json_path(), Some("objects[1].pose.position[1]"));
@@ -355,7 +356,7 @@ fn malformed_scenes_name_the_json_path_and_the_expectation() {
 
 #[test]
 fn every_fixture_scene_loads() {
-    for entry in std::fs::read_dir(scene_path("x").parent().unwrap()).unwrap() {
+    for entry in std::fs::read_dir(scene_fixture("x").parent().unwrap()).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "json") {
             Sim::from_file(&path).unwrap_or_else(|e| panic!("{e}"));

@@ -412,7 +412,7 @@ fn unstack_onto_an_empty_floor_spot_vacuum() {
 /// All four subtasks at the benchmark's composite offsets (pick_place at (0.35, 0.2), sweep at
 /// (0.35, −0.2), hinge at (0.65, 0.2), a reflected drawer cabinet at (0.65, −0.2)).
 fn composite(embodiment: nesy_core::Embodiment) {
-    let text = std::fs::read_to_string(common::scene_path("composite_all_finger")).unwrap();
+    let text = std::fs::read_to_string(nesy_testkit::scene_fixture("composite_all_finger")).unwrap();
     let mut spec = nesy_sim::scene::SceneSpec::from_json_str(&text, "composite").unwrap();
     spec.embodiment = embodiment;
     let mut sim = Sim::new(&spec).unwrap();
@@ -586,7 +586,7 @@ fn all_four_subtasks_at_composite_offsets_vacuum() {
 /// Obstruction level 1 of the sweep: a piece in the wrong box is lifted back onto the board,
 /// then swept into the right one.
 fn wrong_box_piece(embodiment: nesy_core::Embodiment) {
-    let text = std::fs::read_to_string(common::scene_path("sweep_finger")).unwrap();
+    let text = std::fs::read_to_string(nesy_testkit::scene_fixture("sweep_finger")).unwrap();
     let mut spec = nesy_sim::scene::SceneSpec::from_json_str(&text, "sweep").unwrap();
     spec.embodiment = embodiment;
     // The white rook starts in the right (black) box.
@@ -638,7 +638,7 @@ fn a_piece_in_the_wrong_box_is_moved_back_and_swept_vacuum() {
 
 /// Obstruction level 2 of the hinge: a fruit on the closed lid is moved to the floor first.
 fn fruit_on_lid(embodiment: nesy_core::Embodiment) {
-    let text = std::fs::read_to_string(common::scene_path("hinge_finger")).unwrap();
+    let text = std::fs::read_to_string(nesy_testkit::scene_fixture("hinge_finger")).unwrap();
     let mut spec = nesy_sim::scene::SceneSpec::from_json_str(&text, "hinge").unwrap();
     spec.embodiment = embodiment;
     spec.objects[1].pose.position = [0.525, 0.02, 0.627];

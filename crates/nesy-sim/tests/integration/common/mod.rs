@@ -1,21 +1,12 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
-
 use nesy_sim::perception::observer::observe;
 use nesy_sim::world::Sim;
 
-/// Path of a scene fixture.
-pub(crate) fn scene_path(name: &str) -> PathBuf {
-    nesy_testkit::workspace_root()
-        .join("fixtures/scenes")
-        .join(format!("{name}.json"))
-}
-
 /// Builds the world of a scene fixture.
 pub(crate) fn load(name: &str) -> Sim {
-    Sim::from_file(&scene_path(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+    Sim::from_file(&nesy_testkit::scene_fixture(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 /// Asserts that the observed state holds every `present` atom and none of `absent`.
