@@ -17,7 +17,7 @@ use serde::Serialize;
 use crate::demo2code::observe_all;
 use crate::inputs::{BaselineInputs, Fidelity};
 use crate::parse::{LinePatch, apply_line_patches, line_patches, prepared, unordered_list, without_number};
-use crate::prompts::{BaselinePrompts, bullets, numbered, state_lines};
+use crate::prompts::{EpisodePrompts, bullets, numbered, state_lines};
 use crate::stage::{NUMBERED_PLAN, Stage, numbered_plan};
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
@@ -53,7 +53,7 @@ struct CorrectionVars<'a> {
 
 /// Runs Critic-V on `inputs`.
 pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<BaselinePlan, BaselineError> {
-    let prompts = BaselinePrompts::builtin()?;
+    let prompts = &EpisodePrompts::for_inputs(inputs)?;
     let (observations, mut stages) = observe_all(client, prompts, inputs).await?;
     let (system, user) = prompts.render(
         "demo2code.source_actions",

@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use crate::inputs::{BaselineInputs, Keyframe};
 use crate::parse::unordered_list;
-use crate::prompts::{BaselinePrompts, bullets, numbered, state_lines};
+use crate::prompts::{EpisodePrompts, bullets, numbered, state_lines};
 use crate::stage::{Stage, StageRecord, target_plan};
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
@@ -36,7 +36,7 @@ struct ActionsVars<'a> {
 /// Runs Demo2Code on `inputs`: the observations (concurrently, as the client's concurrency
 /// allows), then the plan.
 pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<BaselinePlan, BaselineError> {
-    let prompts = BaselinePrompts::builtin()?;
+    let prompts = &EpisodePrompts::for_inputs(inputs)?;
     let (observations, stages) = observe_all(client, prompts, inputs).await?;
     let prompt = prompts.render(
         "demo2code.actions",
@@ -62,7 +62,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
 /// One observation per keyframe, in keyframe order, with their stage records.
 pub(crate) async fn observe_all(
     client: &VlmClient,
-    prompts: &BaselinePrompts,
+    prompts: &EpisodePrompts,
     inputs: &BaselineInputs,
 ) -> Result<(Vec<String>, Vec<StageRecord>), BaselineError> {
     let calls = inputs
@@ -74,7 +74,7 @@ pub(crate) async fn observe_all(
 
 async fn observe(
     client: &VlmClient,
-    prompts: &BaselinePrompts,
+    prompts: &EpisodePrompts,
     inputs: &BaselineInputs,
     keyframe: &Keyframe,
 ) -> Result<(String, StageRecord), BaselineError> {

@@ -15,7 +15,7 @@ use serde::Serialize;
 
 use crate::inputs::BaselineInputs;
 use crate::parse::first_block;
-use crate::prompts::{BaselinePrompts, bullets, state_lines};
+use crate::prompts::{EpisodePrompts, bullets, state_lines};
 use crate::stage::{Stage, StageRecord, target_plan};
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
@@ -42,7 +42,7 @@ struct PlanVars<'a> {
 
 /// Runs GPT4V-Robotics on `inputs`.
 pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<BaselinePlan, BaselineError> {
-    let prompts = BaselinePrompts::builtin()?;
+    let prompts = &EpisodePrompts::for_inputs(inputs)?;
     let (description, describe) = describe_domain(client, prompts, inputs).await?;
     let prompt = prompts.render(
         "gpt4v.plan",
@@ -67,9 +67,9 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
 
 /// The domain description (the first fenced block of the reply) from every keyframe's
 /// state and images in one request; Statler, LLM-DM and MoReVQA open with the same call.
-pub async fn describe_domain(
+pub(crate) async fn describe_domain(
     client: &VlmClient,
-    prompts: &BaselinePrompts,
+    prompts: &EpisodePrompts,
     inputs: &BaselineInputs,
 ) -> Result<(String, StageRecord), BaselineError> {
     let states: Vec<String> = inputs

@@ -42,6 +42,11 @@ pub enum SceneObservation {
 }
 
 impl SceneObservation {
+    /// Whether the scene is shown as pictures (rather than as its state in text).
+    pub fn is_images(&self) -> bool {
+        matches!(self, SceneObservation::Images(_))
+    }
+
     /// The request parts standing for the scene `scene`: its six captioned images, or one
     /// text part listing its ground-truth atoms.
     ///

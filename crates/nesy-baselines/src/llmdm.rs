@@ -37,7 +37,7 @@ use serde::Serialize;
 use crate::gpt4v::describe_domain;
 use crate::inputs::{BaselineInputs, Fidelity};
 use crate::parse::{blocks, first_block, ordered_list, prepared, unordered_list};
-use crate::prompts::{BaselinePrompts, bullets, numbered, state_lines};
+use crate::prompts::{EpisodePrompts, bullets, numbered, state_lines};
 use crate::stage::{NUMBERED_PLAN, Stage, StageRecord, numbered_plan};
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
@@ -135,7 +135,7 @@ enum SolveError {
 
 /// Runs LLM-DM on `inputs`.
 pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<BaselinePlan, BaselineError> {
-    let prompts = BaselinePrompts::builtin()?;
+    let prompts = &EpisodePrompts::for_inputs(inputs)?;
     let (description, describe) = describe_domain(client, prompts, inputs).await?;
     let mut flow = Flow {
         client,
@@ -176,7 +176,7 @@ pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<Baseline
 struct Flow<'a> {
     client: &'a VlmClient,
     inputs: &'a BaselineInputs,
-    prompts: &'a BaselinePrompts,
+    prompts: &'a EpisodePrompts,
     description: String,
     stages: Vec<StageRecord>,
 }

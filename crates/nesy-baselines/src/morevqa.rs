@@ -22,7 +22,7 @@ use crate::gpt4v::describe_domain;
 use crate::inputs::{BaselineInputs, Fidelity};
 use crate::json;
 use crate::parse::prepared;
-use crate::prompts::{BaselinePrompts, bullets, numbered, state_lines};
+use crate::prompts::{EpisodePrompts, bullets, numbered, state_lines};
 use crate::stage::{NUMBERED_PLAN, Stage, StageRecord, numbered_plan};
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
@@ -96,7 +96,7 @@ struct PlanVars<'a> {
 
 /// Runs MoReVQA on `inputs`.
 pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<BaselinePlan, BaselineError> {
-    let prompts = BaselinePrompts::builtin()?;
+    let prompts = &EpisodePrompts::for_inputs(inputs)?;
     let tolerant = inputs.fidelity == Fidelity::Repaired;
     let (description, describe) = describe_domain(client, prompts, inputs).await?;
     let mut stages = vec![describe];
@@ -206,7 +206,7 @@ struct Grounded {
 async fn ground_and_verify<'a>(
     stage: &impl Fn(&'static str, (String, String), bool, &'static str) -> Stage<'a>,
     keep: &mut impl FnMut(StageRecord),
-    prompts: &BaselinePrompts,
+    prompts: &EpisodePrompts,
     inputs: &BaselineInputs,
     description: &str,
     parsed: &Parsed,

@@ -6,6 +6,8 @@ use std::sync::OnceLock;
 use minijinja::Environment;
 use serde::Serialize;
 
+use crate::BaselineInputs;
+
 /// `(name, text)` of every template.
 const TEMPLATES: &[(&str, &str)] = &[
     (
@@ -231,21 +233,80 @@ impl BaselinePrompts {
         Ok(BaselinePrompts { env })
     }
 
-    /// Renders `{stage}.system` and `{stage}.user` with `vars`.
-    pub fn render(&self, stage: &str, vars: &impl Serialize) -> Result<(String, String), PromptError> {
+    /// Renders `{stage}.system` and `{stage}.user` with `vars`, and `images` telling the
+    /// templates whether the scenes are shown as pictures or as their ground-truth states in
+    /// text, so that no request announces pictures it does not carry.
+    pub fn render(
+        &self,
+        stage: &str,
+        images: bool,
+        vars: &impl Serialize,
+    ) -> Result<(String, String), PromptError> {
+        let context = WithSetting { images, vars };
         let one = |part: &str| {
             let name = format!("{stage}.{part}");
             self.env
                 .get_template(&name)
-                .and_then(|t| t.render(minijinja::value::Serde(vars)))
+                .and_then(|t| t.render(minijinja::value::Serde(&context)))
                 .map_err(|error| PromptError { name, error })
         };
         Ok((one("system")?, one("user")?))
     }
 
+    /// SHA-256 (hex) over every template's name and text. A benchmark run records it beside
+    /// NeSyCR's prompt fingerprint, so baseline results from different templates are never
+    /// mixed.
+    ///
+    /// ```
+    /// let fingerprint = nesy_baselines::BaselinePrompts::fingerprint();
+    /// assert_eq!(fingerprint.len(), 64);
+    /// ```
+    pub fn fingerprint() -> String {
+        use sha2::{Digest, Sha256};
+        let mut hash = Sha256::new();
+        for (name, text) in TEMPLATES {
+            for field in [name, text] {
+                hash.update((field.len() as u64).to_le_bytes());
+                hash.update(field.as_bytes());
+            }
+        }
+        hash.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    }
+
     /// The template names, for listings and tests.
     pub fn template_names() -> impl Iterator<Item = &'static str> {
         TEMPLATES.iter().map(|(n, _)| *n)
+    }
+}
+
+/// A stage's variables with the observation setting beside them.
+#[derive(Serialize)]
+struct WithSetting<'a, V> {
+    images: bool,
+    #[serde(flatten)]
+    vars: &'a V,
+}
+
+/// The templates as the flows of one episode render them: in that episode's observation
+/// setting (pictures, or ground-truth states as text).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct EpisodePrompts {
+    templates: &'static BaselinePrompts,
+    images: bool,
+}
+
+impl EpisodePrompts {
+    /// The built-in templates in the setting of `inputs`.
+    pub(crate) fn for_inputs(inputs: &BaselineInputs) -> Result<EpisodePrompts, PromptError> {
+        Ok(EpisodePrompts {
+            templates: BaselinePrompts::builtin()?,
+            images: inputs.target_observation.is_images(),
+        })
+    }
+
+    /// Renders `{stage}.system` and `{stage}.user` with `vars` in the episode's setting.
+    pub(crate) fn render(&self, stage: &str, vars: &impl Serialize) -> Result<(String, String), PromptError> {
+        self.templates.render(stage, self.images, vars)
     }
 }
 
@@ -276,4 +337,49 @@ pub(crate) fn numbered<'a, I: IntoIterator<Item = &'a String>>(items: I) -> Stri
 /// A state as `- atom` lines, sorted.
 pub(crate) fn state_lines(state: &nesy_core::State) -> String {
     bullets(state.sorted_by_text().into_iter().map(|a| a.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every template rendered with only the setting defined (any other variable renders
+    /// empty), so the wording chosen by the setting is all that differs.
+    fn render_all(images: bool) -> Vec<(&'static str, String)> {
+        let mut env = nesy_reasoner::prompts::template_environment().unwrap();
+        env.set_undefined_behavior(minijinja::UndefinedBehavior::Chainable);
+        TEMPLATES
+            .iter()
+            .map(|(name, text)| {
+                let rendered = env
+                    .render_str(text, minijinja::context! { images })
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+                (*name, rendered)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn no_template_announces_pictures_in_the_state_text_setting() {
+        for (name, text) in render_all(false) {
+            let lower = text.to_lowercase();
+            for word in ["image", "visual", " views"] {
+                assert!(
+                    !lower.contains(word),
+                    "{name} says {word:?} without pictures:\n{text}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_pictures_setting_keeps_the_authors_wording() {
+        let with = render_all(true);
+        let announcing = with.iter().filter(|(_, t)| t.contains("images")).count();
+        assert_eq!(announcing, 26, "the templates that attach the scene's images");
+        let (_, describe) = with.iter().find(|(n, _)| *n == "gpt4v.describe.system").unwrap();
+        assert!(describe.contains(
+            "and for every keyframe six images (the top, front and back views, each plain and with object labels), each captioned with its keyframe's number."
+        ));
+    }
 }

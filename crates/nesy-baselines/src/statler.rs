@@ -22,7 +22,7 @@ use serde::Serialize;
 use crate::gpt4v::describe_domain;
 use crate::inputs::{BaselineInputs, Fidelity};
 use crate::parse::{ordered_list, unordered_list};
-use crate::prompts::{BaselinePrompts, bullets, numbered, state_lines};
+use crate::prompts::{EpisodePrompts, bullets, numbered, state_lines};
 use crate::stage::Stage;
 use crate::{BaselineError, BaselinePlan, IMAGES_PER_SCENE, RequestShape};
 
@@ -54,7 +54,7 @@ struct ActionsVars<'a> {
 
 /// Runs Statler on `inputs`.
 pub async fn run(client: &VlmClient, inputs: &BaselineInputs) -> Result<BaselinePlan, BaselineError> {
-    let prompts = BaselinePrompts::builtin()?;
+    let prompts = &EpisodePrompts::for_inputs(inputs)?;
     let (description, describe) = describe_domain(client, prompts, inputs).await?;
     let mut stages = vec![describe];
     let objects: Vec<String> = inputs

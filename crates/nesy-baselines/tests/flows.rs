@@ -195,6 +195,13 @@ fn in_the_text_observation_setting_no_request_carries_a_picture() {
     assert_eq!((observe.len(), actions.len()), (3, 1));
     for request in observe.iter().chain(&actions) {
         assert!(messages(request).iter().all(|m| images(m) == 0));
+        for message in messages(request) {
+            let text = text_of(message);
+            assert!(
+                !text.contains("image"),
+                "a request without pictures announces some:\n{text}"
+            );
+        }
     }
     let user = text_of(&messages(&observe[1])[1]);
     assert!(

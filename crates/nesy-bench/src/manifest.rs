@@ -129,6 +129,16 @@ pub struct VariantEntry {
     pub deviations: Vec<String>,
 }
 
+/// SHA-256 (hex) over NeSyCR's prompt fingerprint and the baselines' template fingerprint:
+/// every prompt text a benchmark run can send.
+pub fn prompts_fingerprint() -> String {
+    use sha2::{Digest, Sha256};
+    let mut hash = Sha256::new();
+    hash.update(nesy_reasoner::prompts::Prompts::fingerprint());
+    hash.update(nesy_baselines::BaselinePrompts::fingerprint());
+    hash.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
 /// The build and the machine a run came from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Provenance {
@@ -138,7 +148,8 @@ pub struct Provenance {
     pub git_commit: String,
     /// The simulator's fingerprint.
     pub sim_fingerprint: String,
-    /// The prompts' fingerprint.
+    /// The prompts' fingerprint: NeSyCR's prompt files and the baselines' templates
+    /// ([`prompts_fingerprint`]).
     pub prompts_fingerprint: String,
     /// Host name.
     pub host: String,
@@ -153,7 +164,7 @@ impl Provenance {
             nesy_version: env!("CARGO_PKG_VERSION").to_owned(),
             git_commit: GIT_COMMIT.to_owned(),
             sim_fingerprint: nesy_sim::FINGERPRINT.to_owned(),
-            prompts_fingerprint: nesy_reasoner::prompts::Prompts::fingerprint(),
+            prompts_fingerprint: prompts_fingerprint(),
             host: host_name(),
             machine: machine(),
         }
