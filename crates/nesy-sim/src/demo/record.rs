@@ -18,7 +18,7 @@ use crate::perception::render::{Camera, Image, View, draw_label, render_camera, 
 use crate::scene::{SceneError, SceneSpec};
 use crate::tasks::experts::{self, ExpertError};
 use crate::tasks::goal::{EpisodeOutcome, GoalError, GoalMonitor};
-use crate::world::{Sim, SimHook};
+use crate::world::{FurnitureContact, FurnitureContactProbe, Sim, SimHook};
 
 /// How to record.
 #[derive(Clone, Debug, PartialEq)]
@@ -568,6 +568,9 @@ pub struct ExpertRun {
     pub actions: usize,
     /// Simulated seconds.
     pub sim_seconds: f64,
+    /// How deep the arm and what it carried went into furniture, deepest first
+    /// ([`FurnitureContactProbe`]).
+    pub furniture_contacts: Vec<FurnitureContact>,
 }
 
 impl ExpertRun {
@@ -581,13 +584,19 @@ impl ExpertRun {
 pub fn run_expert(scene: &SceneSpec) -> Result<ExpertRun, RecordError> {
     let mut sim = Sim::new(scene)?;
     let monitor = GoalMonitor::attach(&mut sim)?;
+    sim.add_hook(Box::new(FurnitureContactProbe::default()));
     let start = sim.time();
     let expert_error = experts::run(&mut sim, scene).err();
     let outcome = monitor.finish(&mut sim);
+    let furniture_contacts = sim
+        .hook::<FurnitureContactProbe>()
+        .map(FurnitureContactProbe::contacts)
+        .unwrap_or_default();
     Ok(ExpertRun {
         outcome,
         expert_error,
         actions: sim.actions_used(),
         sim_seconds: sim.time() - start,
+        furniture_contacts,
     })
 }

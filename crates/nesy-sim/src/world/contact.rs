@@ -6,24 +6,45 @@
 //! the two meet, as a real one does, and the arm that pulls it stops there too (the
 //! motion ends with [`ApiError::Collision`], the way a real arm's protective stop ends it).
 //!
-//! Loose objects are not obstacles here: they are dynamic bodies, and the link pushes them
-//! through the physics as it moves.
+//! The arm is kinematic too, so its links and the object it carries pass through furniture
+//! the same way. [`FurnitureContactProbe`] measures how deep they go: for every link or
+//! carried object and every piece of furniture, the deepest overlap of an episode and the
+//! call that made it.
+//!
+//! Loose objects are not obstacles here: they are dynamic bodies, and the arm and the links
+//! push them through the physics as they move.
 
 use rapier3d::parry::bounding_volume::BoundingVolume;
 use rapier3d::prelude::{Pose, Shape};
+use serde::Serialize;
 
 use crate::api::ApiError;
-use crate::world::Sim;
+use crate::api::TraceEntry;
 use crate::world::objects::{self, PartRole};
+use crate::world::{Part, Sim, SimHook};
 
 /// Joint resolution (m for drawers, rad for lids) to which the contact position is found.
 pub(crate) const CONTACT_RESOLUTION: f64 = 1e-4;
 
-/// A motion ended by contact: the moving link and the part it ran into.
+/// Overlap (m) of the arm, its fingers or a carried object with furniture below which it is
+/// a touch or a brush (fingers grazing a box's wall on their way in) rather than a push into
+/// the part that a real arm's protective stop would end.
+pub const FURNITURE_TOUCH_DEPTH: f64 = 0.005;
+
+/// What was moving when a motion was stopped by contact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Mover {
+    /// A scene part (part index): a lid or drawer the arm drives, or an object it carries.
+    Part(usize),
+    /// A link of the robot (link index in its model).
+    RobotLink(usize),
+}
+
+/// A motion ended by contact: what was moving and the part it ran into.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct ContactStop {
-    /// The link (part index) whose travel was stopped.
-    pub moving: usize,
+    /// What was stopped.
+    pub moving: Mover,
     /// The part (part index) it ran into.
     pub obstacle: usize,
 }
@@ -31,9 +52,13 @@ pub(crate) struct ContactStop {
 impl ContactStop {
     /// The API error of the call `call` whose motion this stopped.
     pub(crate) fn into_error(self, sim: &Sim, call: &str) -> ApiError {
+        let moving = match self.moving {
+            Mover::Part(part) => sim.parts[part].name.clone(),
+            Mover::RobotLink(link) => format!("the robot's {}", sim.robot.model.links[link].name),
+        };
         ApiError::Collision {
             call: call.to_owned(),
-            moving: sim.parts[self.moving].name.clone(),
+            moving,
             obstacle: sim.parts[self.obstacle].name.clone(),
         }
     }
@@ -53,11 +78,17 @@ impl Sim {
     /// own body without touching it).
     fn furniture_blockers(&self, ai: usize) -> Vec<Blocker<'_>> {
         let own = self.parts[self.articulations[ai].link].object;
+        self.furniture_colliders(|part| part.object != own)
+    }
+
+    /// The solid colliders of every fixed part, articulated body and link that `keep`
+    /// accepts.
+    fn furniture_colliders(&self, keep: impl Fn(&Part) -> bool) -> Vec<Blocker<'_>> {
         self.parts
             .iter()
             .enumerate()
             .filter(|(_, p)| {
-                p.object != own
+                keep(p)
                     && matches!(
                         p.role,
                         PartRole::Fixed | PartRole::ArticulatedBody | PartRole::Link
@@ -127,7 +158,7 @@ impl Sim {
             return (wanted, None);
         };
         let stop = |obstacle| ContactStop {
-            moving: link,
+            moving: Mover::Part(link),
             obstacle,
         };
         if self.blocked_at(ai, from, &blockers).is_some() {
@@ -152,5 +183,149 @@ impl Sim {
             }
         }
         (clear, Some(stop(obstacle)))
+    }
+
+    /// How deep each of the robot's links and the carried object presses into each piece of
+    /// furniture it overlaps, at the bodies' current poses.
+    pub(crate) fn arm_furniture_depths(&self) -> Vec<((Mover, usize), f64)> {
+        let blockers = self.furniture_colliders(|_| true);
+        if blockers.is_empty() {
+            return Vec::new();
+        }
+        let links = self
+            .robot
+            .bodies
+            .iter()
+            .map(|&(link, body)| (Mover::RobotLink(link), body));
+        let held = self
+            .held
+            .map(|held| (Mover::Part(held.part), self.parts[held.part].body));
+        let mut depths: Vec<((Mover, usize), f64)> = Vec::new();
+        // The hand holding a handle closes around it, against the lid or drawer front it is
+        // mounted on: that link is not an obstacle to the gripper's own colliders.
+        let grasped_link = self
+            .handle_grasp
+            .map(|grasp| self.articulations[grasp.articulation].link);
+        for (mover, body) in links.chain(held) {
+            for &c in self.world.bodies[body].colliders() {
+                let collider = &self.world.colliders[c];
+                if collider.is_sensor() {
+                    continue;
+                }
+                let (shape, pose) = (collider.shape(), collider.position());
+                let aabb = collider.compute_aabb();
+                let gripping = self.robot.gripper_colliders.contains(&c);
+                for blocker in &blockers {
+                    if !aabb.intersects(&blocker.aabb) || (gripping && Some(blocker.part) == grasped_link) {
+                        continue;
+                    }
+                    let contact =
+                        rapier3d::parry::query::contact(pose, shape, &blocker.pose, blocker.shape, 0.0);
+                    let Ok(Some(contact)) = contact else { continue };
+                    let depth = -f64::from(contact.dist);
+                    if depth <= 0.0 {
+                        continue;
+                    }
+                    let key = (mover, blocker.part);
+                    match depths.iter_mut().find(|(k, _)| *k == key) {
+                        Some((_, deepest)) => *deepest = deepest.max(depth),
+                        None => depths.push((key, depth)),
+                    }
+                }
+            }
+        }
+        depths
+    }
+}
+
+/// The deepest overlap of one link or carried object with one piece of furniture during an
+/// episode.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FurnitureContact {
+    /// What overlapped: `the robot's <link>` or the carried object's name.
+    pub moving: String,
+    /// The furniture part.
+    pub obstacle: String,
+    /// The deepest overlap (m).
+    pub depth: f64,
+    /// The API call during which it was deepest, as `name #index` in the trace.
+    pub call: String,
+}
+
+/// A hook that measures, after every control step, how deep the robot's links and the
+/// object it carries overlap every fixed part, articulated body and link (the hand and a lid
+/// or drawer whose handle it holds excepted), and keeps the deepest overlap of each pair.
+///
+/// ```
+/// use nesy_core::Embodiment;
+/// use nesy_sim::api::{Direction, RobotApi};
+/// use nesy_sim::scene::SubtaskKind;
+/// use nesy_sim::tasks::TaskConfig;
+/// use nesy_sim::world::{FurnitureContactProbe, Sim};
+///
+/// let task = TaskConfig::single(SubtaskKind::PickPlace, 3, 0, 0, Embodiment::Finger)
+///     .generate()
+///     .unwrap();
+/// let mut sim = Sim::new(&task.scene).unwrap();
+/// sim.add_hook(Box::new(FurnitureContactProbe::default()));
+/// sim.move_to_position([0.4, 0.0, 0.6], Direction::Down, 0.0, 0.0).unwrap();
+/// let probe = sim.hook::<FurnitureContactProbe>().unwrap();
+/// assert!(probe.contacts().is_empty(), "a move through free space touches nothing");
+/// ```
+#[derive(Debug, Default)]
+pub struct FurnitureContactProbe {
+    /// `(moving, obstacle, depth, trace index of the call)`; `None` while the call runs.
+    deepest: Vec<(String, String, f64, Option<String>)>,
+}
+
+impl FurnitureContactProbe {
+    /// Every pair that overlapped, deepest first.
+    pub fn contacts(&self) -> Vec<FurnitureContact> {
+        let mut contacts: Vec<FurnitureContact> = self
+            .deepest
+            .iter()
+            .map(|(moving, obstacle, depth, call)| FurnitureContact {
+                moving: moving.clone(),
+                obstacle: obstacle.clone(),
+                depth: *depth,
+                call: call.clone().unwrap_or_else(|| "(after the last call)".to_owned()),
+            })
+            .collect();
+        contacts.sort_by(|a, b| b.depth.total_cmp(&a.depth));
+        contacts
+    }
+}
+
+impl SimHook for FurnitureContactProbe {
+    fn step_interval(&self) -> Option<u64> {
+        Some(1)
+    }
+
+    fn on_step(&mut self, sim: &Sim) {
+        for ((mover, obstacle), depth) in sim.arm_furniture_depths() {
+            let moving = match mover {
+                Mover::Part(part) => sim.parts[part].name.clone(),
+                Mover::RobotLink(link) => format!("the robot's {}", sim.robot.model.links[link].name),
+            };
+            let obstacle = &sim.parts[obstacle].name;
+            match self
+                .deepest
+                .iter_mut()
+                .find(|(m, o, _, _)| *m == moving && o == obstacle)
+            {
+                Some(entry) if entry.2 >= depth => {}
+                Some(entry) => {
+                    entry.2 = depth;
+                    entry.3 = None;
+                }
+                None => self.deepest.push((moving, obstacle.clone(), depth, None)),
+            }
+        }
+    }
+
+    fn on_call(&mut self, _sim: &Sim, entry: &TraceEntry) {
+        for pending in self.deepest.iter_mut().filter(|e| e.3.is_none()) {
+            pending.3 = Some(format!("{} #{}", entry.call.name(), entry.index));
+        }
     }
 }

@@ -5,7 +5,8 @@
 //!
 //! - [`Sim`] is the world; it implements [`crate::api::RobotApi`] (in `api_impl`).
 //! - `build` builds it from a scene in named steps.
-//! - `contact` stops lids and drawers where they meet other furniture; [`magnet`] pulls
+//! - `contact` stops lids and drawers where they meet other furniture and measures how deep
+//!   the arm goes into it ([`FurnitureContactProbe`]); [`magnet`] pulls
 //!   screws toward a magnetic hook.
 //! - [`objects`] builds the benchmark's objects from their kinds; [`geometry`] holds the
 //!   boxes and frame conversions; `floor` finds free table spots; `rng` is the seeded
@@ -20,6 +21,8 @@ pub mod geometry;
 pub mod magnet;
 pub mod objects;
 pub(crate) mod rng;
+
+pub use contact::{FURNITURE_TOUCH_DEPTH, FurnitureContact, FurnitureContactProbe};
 
 use std::any::Any;
 

@@ -1,11 +1,12 @@
 //! Several articulated assets in one scene: prefixed part names, and a drawer opened into
-//! another cabinet's open drawer stopped where the two meet.
+//! another cabinet's open drawer stopped where the two meet, and how deep the arm goes into
+//! furniture.
 
 use nesy_sim::api::{ApiError, Direction, RobotApi};
 use nesy_sim::perception::observer;
 use nesy_sim::scene::SceneSpec;
 use nesy_sim::scene::parts::DRAWER_OPEN;
-use nesy_sim::world::Sim;
+use nesy_sim::world::{FURNITURE_TOUCH_DEPTH, FurnitureContactProbe, Sim};
 
 /// Two cabinets at right angles (`fixtures/scenes/drawers_perpendicular_finger.json`):
 /// `front_` faces −y (its drawers open toward −y), `side_` is turned a quarter turn so that
@@ -311,4 +312,40 @@ fn gather_with_hook_needs_a_held_hook_and_a_fine_grained_object() {
         sim.gather_with_hook("red_screws"),
         Err(ApiError::UnknownObject { .. })
     ));
+}
+
+#[test]
+fn the_furniture_probe_measures_a_descent_into_a_cabinet_and_names_the_part() {
+    let mut sim = Sim::new(&perpendicular_cabinets(0.0)).unwrap();
+    sim.add_hook(Box::new(FurnitureContactProbe::default()));
+    let [lo, hi] = sim.get_obj_bbox("side_drawer_body").unwrap();
+    let (x, y) = ((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0);
+    let deepest = |sim: &Sim| {
+        let probe = sim.hook::<FurnitureContactProbe>().unwrap();
+        probe.contacts().into_iter().next()
+    };
+
+    sim.move_to_position([x, y, hi[2] + 0.05], Direction::Down, 0.12, 0.0)
+        .unwrap();
+    assert_eq!(
+        deepest(&sim),
+        None,
+        "5 cm above the cabinet the hand touches nothing"
+    );
+
+    // The kinematic arm is not stopped; the probe says how far it went in, and where.
+    sim.move_to_position([x, y, hi[2] - 0.03], Direction::Down, 0.0, 0.0)
+        .unwrap();
+    let probe = sim.hook::<FurnitureContactProbe>().unwrap();
+    let into_top = probe
+        .contacts()
+        .into_iter()
+        .find(|c| c.obstacle == "side_drawer_body")
+        .expect("the fingers went through the cabinet's top");
+    assert!(into_top.moving.starts_with("the robot's panda_"), "{into_top:?}");
+    assert!(into_top.depth > FURNITURE_TOUCH_DEPTH, "{into_top:?}");
+    assert_eq!(
+        into_top.call, "move_to_position #2",
+        "the second move, after get_obj_bbox and the first"
+    );
 }
