@@ -11,6 +11,8 @@ use serde_json::{Map, Value, json};
 use crate::constraint::{ConstrainMode, ReplyForm, body_fields, form_for};
 use crate::request::{ChatRequest, ImageDetail, Part, ReasoningEffort, ReplyLength};
 
+/// What stands between the text parts of a message sent without images.
+const TEXT_PART_SEPARATOR: &str = "\n\n";
 /// The kind of server.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -334,9 +336,21 @@ impl Profile {
             body.insert("model".into(), Value::String(self.model.clone()));
         }
         let messages = request.messages.iter().map(|message| {
-            let content = match message.parts.as_slice() {
-                [Part::Text(text)] => Value::String(text.clone()),
-                parts => Value::Array(parts.iter().map(|part| self.part_json(part)).collect()),
+            let texts: Option<Vec<&str>> = message
+                .parts
+                .iter()
+                .map(|part| match part {
+                    Part::Text(text) => Some(text.as_str()),
+                    Part::Image(_) => None,
+                })
+                .collect();
+            // A message of text alone is sent as one string, its parts a blank line apart:
+            // llama.cpp's chat templates join an array's text parts with nothing between
+            // them, and a recorded prompt read "…state follows.scene, as its ground-truth
+            // state…" where two parts met.
+            let content = match texts {
+                Some(texts) => Value::String(texts.join(TEXT_PART_SEPARATOR)),
+                None => Value::Array(message.parts.iter().map(|part| self.part_json(part)).collect()),
             };
             json!({ "role": message.role.as_str(), "content": content })
         });

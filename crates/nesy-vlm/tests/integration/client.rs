@@ -253,6 +253,33 @@ async fn images_are_sent_as_base64_png_data_urls_in_order() {
     }
 }
 
+/// The Critic-V request whose reply (Gemma 3 270M through llama.cpp, state-text setting)
+/// echoed "…Its ground-truth state follows.scene, as its ground-truth state (no pictures in
+/// this setting): - (GripperClosed) …": the server had joined the user message's two text
+/// parts with nothing between them.
+#[tokio::test]
+async fn a_message_of_text_parts_is_one_string_with_the_parts_a_blank_line_apart() {
+    let server = MockServer::start().await;
+    Mock::given(method("POST"))
+        .respond_with(ResponseTemplate::new(200).set_body_json(completion("ok")))
+        .mount(&server)
+        .await;
+    let cfg = config(BackendKind::LlamaCpp, "gemma3-270m-q4_k_m", &server.uri());
+    let request = ChatRequest::new().message(Message::user(vec![
+        Part::text("Review the plan for this scene. The scene's ground-truth state follows."),
+        Part::text("scene, as its ground-truth state (no pictures in this setting):\n- (GripperClosed)"),
+    ]));
+    VlmClient::from_config(&cfg).unwrap().chat(request).await.unwrap();
+    let (body, _) = only_request(&server).await;
+    assert_eq!(
+        body["messages"][0]["content"],
+        json!(
+            "Review the plan for this scene. The scene's ground-truth state follows.\n\n\
+             scene, as its ground-truth state (no pictures in this setting):\n- (GripperClosed)"
+        )
+    );
+}
+
 #[tokio::test(start_paused = true)]
 async fn rate_limit_waits_for_retry_after_on_a_paused_clock() {
     let server = MockServer::start().await;
