@@ -17,7 +17,8 @@
 # window in tokens per request (8192); NESY_LOCAL_MODEL_SLOTS, requests served at once (1;
 # a benchmark with several units in flight uses 2, so that each keeps its prompt prefix
 # cached in its own slot); NESY_LOCAL_MODEL_THREADS, generation threads (all cores);
-# NESY_LOCAL_MODEL_JOBS, parallel compile jobs for the one-time build (all cores).
+# NESY_LOCAL_MODEL_JOBS, parallel compile jobs for the one-time build (all cores);
+# NESY_LOCAL_MODEL_PORT, the port (default: a free one).
 set -euo pipefail
 
 # Pinned sources: the sdist and wheels are checked against these digests before use.
@@ -54,7 +55,7 @@ say() { printf 'local-model: %s\n' "$*" >&2; }
 die() { say "error: $*"; exit 1; }
 
 usage() {
-  sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//' >&2
+  sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//' >&2
   exit "${1:-0}"
 }
 

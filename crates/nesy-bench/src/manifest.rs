@@ -51,6 +51,40 @@ impl Responder {
         !matches!(self, Responder::Live { .. })
     }
 
+    /// The responder as it enters a run's configuration hash: a live server's address left
+    /// out (the backend, the model and the constraint setting make the experiment, the port
+    /// does not), so that a run resumes after its local server restarts elsewhere.
+    ///
+    /// ```
+    /// use nesy_bench::manifest::Responder;
+    /// use nesy_vlm::ConstrainMode;
+    ///
+    /// let at = |base_url: &str| Responder::Live {
+    ///     backend: "llamacpp".into(),
+    ///     model: "gemma3-270m-q4_k_m".into(),
+    ///     base_url: base_url.into(),
+    ///     constrain: ConstrainMode::Auto,
+    /// };
+    /// let (here, there) = (at("http://127.0.0.1:41505/v1"), at("http://127.0.0.1:57617/v1"));
+    /// assert_eq!(here.identity(), there.identity());
+    /// ```
+    pub fn identity(&self) -> Responder {
+        match self {
+            Responder::Live {
+                backend,
+                model,
+                constrain,
+                ..
+            } => Responder::Live {
+                backend: backend.clone(),
+                model: model.clone(),
+                base_url: String::new(),
+                constrain: *constrain,
+            },
+            offline => offline.clone(),
+        }
+    }
+
     /// One line for reports.
     pub fn describe(&self) -> String {
         match self {
@@ -234,7 +268,7 @@ impl Manifest {
             sim: &self.provenance.sim_fingerprint,
             prompts: &self.provenance.prompts_fingerprint,
             suite: &self.suite_hash,
-            responder: &self.responder,
+            responder: &self.responder.identity(),
             run_seed: self.run_seed,
             repeats: self.repeats,
             settings: &self.settings,
@@ -297,7 +331,7 @@ impl Manifest {
         if self.provenance.prompts_fingerprint != other.provenance.prompts_fingerprint {
             parts.push("the prompts changed".to_owned());
         }
-        if self.responder != other.responder {
+        if self.responder.identity() != other.responder.identity() {
             parts.push(format!(
                 "the responder ({} vs {})",
                 self.responder.describe(),

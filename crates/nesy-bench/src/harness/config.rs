@@ -234,7 +234,7 @@ pub fn prepare(config: &RunConfig) -> Result<Prepared, BenchError> {
     for e in &mut entries {
         e.config_hash = config_hash(&(
             &e.variant,
-            &responder,
+            &responder.identity(),
             &config.settings,
             &provenance.sim_fingerprint,
             &provenance.prompts_fingerprint,

@@ -560,6 +560,49 @@ async fn in_the_text_observation_setting_no_method_sends_a_picture() {
     );
 }
 
+/// A local server restarted on another port serves the same experiment: the run resumes
+/// (here with nothing left to do). Another model is another experiment and is refused.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_live_run_resumes_against_its_server_on_another_port() {
+    let scratch = common::scratch();
+    let (demos, run) = (scratch.path().join("demos"), scratch.path().join("run"));
+    let (first, _) = hand_written_server().await;
+    let (second, _) = hand_written_server().await;
+    let urls = [format!("{}/v1", first.uri()), format!("{}/v1", second.uri())];
+    let (run_dir, demos_dir) = (run.clone(), demos.clone());
+    let refused = tokio::task::spawn_blocking(move || {
+        for url in &urls {
+            bench_with(&run_dir, &demos_dir, url, "demo2code", SCENARIO, &[]);
+        }
+        let args: Vec<String> = [
+            "bench",
+            "run",
+            &run_dir.display().to_string(),
+            "--methods",
+            "demo2code",
+            "--scenarios",
+            SCENARIO,
+            "--vlm",
+            &urls[1],
+            "--vlm-model",
+            "another-model",
+            "--demos",
+            &demos_dir.display().to_string(),
+        ]
+        .map(str::to_owned)
+        .to_vec();
+        common::nesy(&args)
+    })
+    .await
+    .unwrap();
+    assert_eq!(refused.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("another configuration") && stderr.contains("another-model"),
+        "{stderr}"
+    );
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn all_methods_replay_to_identical_records_over_the_fixture_scenarios() {
     const FIXTURES: &str = "obst_low_00_s0,grip_low_02_s0,comb_low_00_s0";

@@ -1,0 +1,154 @@
+#!/usr/bin/env python3
+"""Re-scores a recorded benchmark run offline and checks that it comes out the same.
+
+    scripts/rescore-run.py RUN_DIR [--nesy BIN] [--scenarios N] [--out DIR]
+
+RUN_DIR is a run folder that `nesy bench run --record-cassettes` wrote (manifest.json,
+results/*.jsonl, cassettes/): a published one under bench/runs/, or one in progress. The
+script replays the run's cassettes with the given build (`--vlm replay:RUN_DIR/cassettes`)
+over the units the run's results list, in the run's observation setting, repeats and seed,
+and compares every unit's record with the recorded one: status, error, scores, calls by
+purpose, images, tokens and cost (timings and the configuration hash, which names the
+responder, are left out). `--scenarios N` replays only the first N scenarios in id order (the
+slice CI runs). When the run is finished (its tables/ exist) and every scenario is replayed,
+the tables that hold no timings (table1, status, stages, domain_gap) must be byte-identical
+too.
+
+Exit 0 when everything matches, 1 with the differences otherwise, 2 on bad input.
+"""
+
+import argparse
+import json
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+# Fields of a unit's record that a replay must reproduce exactly.
+EFFORT_FIELDS = ("calls", "images", "calls_by_purpose", "tokens", "cost_usd")
+RECORD_FIELDS = ("status", "error", "scores", "method", "factor", "complexity", "seed")
+# The report's tables without timings.
+TIMELESS_TABLES = ("table1.csv", "status.csv", "stages.csv", "domain_gap.csv")
+
+
+def fail_input(message):
+    print(f"rescore-run: {message}", file=sys.stderr)
+    sys.exit(2)
+
+
+def read_records(run):
+    """The last record of every unit, keyed by (scenario, variant, repeat)."""
+    files = sorted((run / "results").glob("*.jsonl"))
+    if not files:
+        fail_input(f"{run / 'results'}: no results files (*.jsonl); is this a benchmark run folder?")
+    records = {}
+    for path in files:
+        for number, line in enumerate(path.read_text().splitlines(), start=1):
+            if not line.strip():
+                continue
+            try:
+                record = json.loads(line)
+                key = (record["scenario"], record["variant"], record["repeat"])
+            except (json.JSONDecodeError, KeyError, TypeError) as error:
+                fail_input(f"{path}:{number}: not a unit record ({error})")
+            records[key] = record
+    return records
+
+
+def comparable(record):
+    kept = {field: record.get(field) for field in RECORD_FIELDS}
+    effort = record.get("effort") or {}
+    kept["effort"] = {field: effort.get(field) for field in EFFORT_FIELDS}
+    return kept
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("run", type=Path, help="the recorded run folder")
+    parser.add_argument("--nesy", default="nesy", help="the nesy binary to re-score with")
+    parser.add_argument("--scenarios", type=int, help="replay only the first N scenarios")
+    parser.add_argument("--out", type=Path, help="keep the replayed run here (default: a temporary folder)")
+    args = parser.parse_args()
+
+    run = args.run
+    try:
+        manifest = json.loads((run / "manifest.json").read_text())
+    except (OSError, json.JSONDecodeError) as error:
+        fail_input(f"{run / 'manifest.json'}: {error}")
+    if not (run / "cassettes").is_dir():
+        fail_input(f"{run / 'cassettes'}: missing; the run was not recorded with --record-cassettes")
+    recorded = read_records(run)
+    scenarios = sorted({scenario for scenario, _, _ in recorded})
+    every_scenario = args.scenarios is None or args.scenarios >= len(scenarios)
+    if not every_scenario:
+        scenarios = scenarios[: args.scenarios]
+    variants = sorted({variant for scenario, variant, _ in recorded if scenario in scenarios})
+    settings = manifest.get("settings", {})
+
+    out = args.out or Path(tempfile.mkdtemp(prefix="nesy-rescore-"))
+    if out.exists() and any(out.iterdir()):
+        fail_input(f"{out}: exists and is not empty")
+    command = [
+        args.nesy, "bench", "run", str(out / "run"),
+        "--methods", ",".join(variants),
+        "--scenarios", ",".join(scenarios),
+        "--observation", settings.get("observation", "images"),
+        "--repeats", str(manifest.get("repeats", 1)),
+        "--seed", str(manifest.get("run_seed", 0)),
+        "--vlm", f"replay:{(run / 'cassettes').resolve()}",
+        "--demos", str(out / "demos"),
+        "--jobs", "2",
+        "--no-report",
+    ]
+    print("+ " + " ".join(command), flush=True)
+    finished = subprocess.run(command, stdout=subprocess.DEVNULL)
+    if finished.returncode not in (0, 1):
+        print(f"rescore-run: the replay exited with {finished.returncode}", file=sys.stderr)
+        return 1
+    replayed = read_records(out / "run")
+
+    differences = []
+    compared = 0
+    for key in sorted(k for k in recorded if k[0] in scenarios):
+        if key not in replayed:
+            differences.append(f"{'/'.join(map(str, key))}: not replayed")
+            continue
+        compared += 1
+        want, got = comparable(recorded[key]), comparable(replayed[key])
+        if want != got:
+            fields = sorted(f for f in want if want[f] != got[f])
+            differences.append(
+                f"{'/'.join(map(str, key))}: {', '.join(fields)} differ\n"
+                f"    recorded: {json.dumps({f: want[f] for f in fields})[:600]}\n"
+                f"    replayed: {json.dumps({f: got[f] for f in fields})[:600]}"
+            )
+    tables_checked = []
+    if every_scenario and (run / "tables").is_dir():
+        report = [args.nesy, "bench", "report", str(out / "run")]
+        print("+ " + " ".join(report), flush=True)
+        subprocess.run(report, stdout=subprocess.DEVNULL)
+        for table in TIMELESS_TABLES:
+            want, got = run / "tables" / table, out / "run" / "tables" / table
+            if want.exists():
+                tables_checked.append(table)
+                if not got.exists() or want.read_bytes() != got.read_bytes():
+                    differences.append(f"tables/{table}: not byte-identical")
+
+    print(
+        f"rescore-run: {compared} unit(s) of {len(scenarios)} scenario(s) replayed"
+        + (f"; tables compared: {', '.join(tables_checked)}" if tables_checked else "")
+    )
+    if args.out is None:
+        shutil.rmtree(out, ignore_errors=True)
+    if differences:
+        print("rescore-run: the replay differs from the recorded run:", file=sys.stderr)
+        for line in differences:
+            print("  " + line, file=sys.stderr)
+        return 1
+    print("rescore-run: every unit ends as recorded")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
