@@ -156,7 +156,10 @@ pub enum AuthScheme {
 pub struct ReplyCaps {
     /// Operator induction (`induce`): an action block.
     pub induce: u32,
-    /// Refinement (`patch`): one SEARCH/REPLACE block of a few actions.
+    /// Refinement (`patch`): one SEARCH/REPLACE block. Its grammar lets the SEARCH side
+    /// quote up to eight actions of the procedure and the REPLACE side hold six blocks, so a
+    /// reply held to it can need about 2,000 tokens; a smaller cap cuts such a reply off
+    /// before the grammar lets it end.
     pub patch: u32,
     /// State translation (`translate`): a list of atoms.
     pub translate: u32,
@@ -173,7 +176,7 @@ impl ReplyCaps {
     /// The caps used for local backends (vLLM, Ollama, llama.cpp) by default.
     pub const LOCAL: ReplyCaps = ReplyCaps {
         induce: 768,
-        patch: 1024,
+        patch: 2048,
         translate: 768,
         codegen: 2048,
         other: 1024,

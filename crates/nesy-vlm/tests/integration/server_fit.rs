@@ -370,12 +370,12 @@ async fn a_prompt_the_server_counts_larger_is_fitted_again_with_its_count() {
         .await;
     let cfg = config(BackendKind::LlamaCpp, "m", &format!("{}/v1", server.uri()));
     let client = VlmClient::from_config(&cfg).unwrap();
-    // The task and six rejected proposals with their corrections: about 6,500 tokens by the
-    // estimate, which leaves room for the 1,024-token patch cap.
+    // The task and six rejected proposals with their corrections: under the 6,144 tokens that
+    // the 2,048-token patch cap leaves of the 8,192-token window, by the estimate.
     let mut request = ChatRequest::new()
         .purpose("patch")
         .message(Message::system("Repair the procedure."))
-        .message(Message::user_text("(OnTopOf yellow_cube floor)\n".repeat(420)));
+        .message(Message::user_text("(OnTopOf yellow_cube floor)\n".repeat(340)));
     for turn in 0..6 {
         request = request
             .message(Message::assistant(format!(
