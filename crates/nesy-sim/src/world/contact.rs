@@ -32,7 +32,7 @@ pub(crate) const CONTACT_RESOLUTION: f64 = 1e-4;
 pub const FURNITURE_TOUCH_DEPTH: f64 = 0.005;
 
 /// What was moving when a motion was stopped by contact.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Mover {
     /// A scene part (part index): a lid or drawer the arm drives, or an object it carries.
     Part(usize),
@@ -52,13 +52,9 @@ pub(crate) struct ContactStop {
 impl ContactStop {
     /// The API error of the call `call` whose motion this stopped.
     pub(crate) fn into_error(self, sim: &Sim, call: &str) -> ApiError {
-        let moving = match self.moving {
-            Mover::Part(part) => sim.parts[part].name.clone(),
-            Mover::RobotLink(link) => format!("the robot's {}", sim.robot.model.links[link].name),
-        };
         ApiError::Collision {
             call: call.to_owned(),
-            moving,
+            moving: sim.mover_name(self.moving),
             obstacle: sim.parts[self.obstacle].name.clone(),
         }
     }
@@ -73,6 +69,14 @@ struct Blocker<'a> {
 }
 
 impl Sim {
+    /// How errors and reports name what moved: the part's name, or `the robot's <link>`.
+    fn mover_name(&self, mover: Mover) -> String {
+        match mover {
+            Mover::Part(part) => self.parts[part].name.clone(),
+            Mover::RobotLink(link) => format!("the robot's {}", self.robot.model.links[link].name),
+        }
+    }
+
     /// The solid colliders of every fixed part, articulated body and link that belongs to
     /// another scene object than articulation `ai`'s (a cabinet's drawers slide inside their
     /// own body without touching it).
@@ -274,8 +278,22 @@ pub struct FurnitureContact {
 /// ```
 #[derive(Debug, Default)]
 pub struct FurnitureContactProbe {
-    /// `(moving, obstacle, depth, trace index of the call)`; `None` while the call runs.
-    deepest: Vec<(String, String, f64, Option<String>)>,
+    /// One entry per pair that overlapped; names are made when a pair is first seen.
+    deepest: Vec<DeepestOverlap>,
+}
+
+/// A pair's deepest overlap so far.
+#[derive(Debug)]
+struct DeepestOverlap {
+    /// What moved and the part (index) it overlapped.
+    key: (Mover, usize),
+    /// Their names, made when the pair is first seen.
+    moving: String,
+    obstacle: String,
+    /// The deepest overlap (m).
+    depth: f64,
+    /// The call during which the overlap was deepest, once that call has returned.
+    call: Option<String>,
 }
 
 impl FurnitureContactProbe {
@@ -284,11 +302,14 @@ impl FurnitureContactProbe {
         let mut contacts: Vec<FurnitureContact> = self
             .deepest
             .iter()
-            .map(|(moving, obstacle, depth, call)| FurnitureContact {
-                moving: moving.clone(),
-                obstacle: obstacle.clone(),
-                depth: *depth,
-                call: call.clone().unwrap_or_else(|| "(after the last call)".to_owned()),
+            .map(|d| FurnitureContact {
+                moving: d.moving.clone(),
+                obstacle: d.obstacle.clone(),
+                depth: d.depth,
+                call: d
+                    .call
+                    .clone()
+                    .unwrap_or_else(|| "(after the last call)".to_owned()),
             })
             .collect();
         contacts.sort_by(|a, b| b.depth.total_cmp(&a.depth));
@@ -302,30 +323,27 @@ impl SimHook for FurnitureContactProbe {
     }
 
     fn on_step(&mut self, sim: &Sim) {
-        for ((mover, obstacle), depth) in sim.arm_furniture_depths() {
-            let moving = match mover {
-                Mover::Part(part) => sim.parts[part].name.clone(),
-                Mover::RobotLink(link) => format!("the robot's {}", sim.robot.model.links[link].name),
-            };
-            let obstacle = &sim.parts[obstacle].name;
-            match self
-                .deepest
-                .iter_mut()
-                .find(|(m, o, _, _)| *m == moving && o == obstacle)
-            {
-                Some(entry) if entry.2 >= depth => {}
-                Some(entry) => {
-                    entry.2 = depth;
-                    entry.3 = None;
+        for (key, depth) in sim.arm_furniture_depths() {
+            match self.deepest.iter_mut().find(|d| d.key == key) {
+                Some(deepest) if deepest.depth >= depth => {}
+                Some(deepest) => {
+                    deepest.depth = depth;
+                    deepest.call = None;
                 }
-                None => self.deepest.push((moving, obstacle.clone(), depth, None)),
+                None => self.deepest.push(DeepestOverlap {
+                    key,
+                    moving: sim.mover_name(key.0),
+                    obstacle: sim.parts[key.1].name.clone(),
+                    depth,
+                    call: None,
+                }),
             }
         }
     }
 
     fn on_call(&mut self, _sim: &Sim, entry: &TraceEntry) {
-        for pending in self.deepest.iter_mut().filter(|e| e.3.is_none()) {
-            pending.3 = Some(format!("{} #{}", entry.call.name(), entry.index));
+        for pending in self.deepest.iter_mut().filter(|d| d.call.is_none()) {
+            pending.call = Some(format!("{} #{}", entry.call.name(), entry.index));
         }
     }
 }
