@@ -253,7 +253,8 @@ impl BaselinePrompts {
         Ok((one("system")?, one("user")?))
     }
 
-    /// SHA-256 (hex) over every template's name and text. A benchmark run records it beside
+    /// SHA-256 (hex) over every template's name and text
+    /// ([`nesy_reasoner::prompts::files_fingerprint`]). A benchmark run records it beside
     /// NeSyCR's prompt fingerprint, so baseline results from different templates are never
     /// mixed.
     ///
@@ -262,15 +263,7 @@ impl BaselinePrompts {
     /// assert_eq!(fingerprint.len(), 64);
     /// ```
     pub fn fingerprint() -> String {
-        use sha2::{Digest, Sha256};
-        let mut hash = Sha256::new();
-        for (name, text) in TEMPLATES {
-            for field in [name, text] {
-                hash.update((field.len() as u64).to_le_bytes());
-                hash.update(field.as_bytes());
-            }
-        }
-        hash.finalize().iter().map(|b| format!("{b:02x}")).collect()
+        nesy_reasoner::prompts::files_fingerprint(TEMPLATES.iter().copied())
     }
 
     /// The template names, for listings and tests.

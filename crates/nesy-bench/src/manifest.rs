@@ -170,7 +170,7 @@ pub fn prompts_fingerprint() -> String {
     let mut hash = Sha256::new();
     hash.update(nesy_reasoner::prompts::Prompts::fingerprint());
     hash.update(nesy_baselines::BaselinePrompts::fingerprint());
-    hash.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    crate::variant::hex(&hash.finalize())
 }
 
 /// The build and the machine a run came from.

@@ -82,6 +82,28 @@ pub fn template_environment() -> Result<Environment<'static>, minijinja::Error> 
     Ok(env)
 }
 
+/// SHA-256 (hex) over named prompt files in order, each name and text preceded by its
+/// length: the fingerprint of a set of prompts ([`Prompts::fingerprint`]; the baselines'
+/// templates have theirs).
+///
+/// ```
+/// use nesy_reasoner::prompts::files_fingerprint;
+/// let one = files_fingerprint([("a.j2", "hello")]);
+/// assert_eq!(one.len(), 64);
+/// assert_ne!(one, files_fingerprint([("a.j2", "hell"), ("o", "")]));
+/// ```
+pub fn files_fingerprint<'a>(files: impl IntoIterator<Item = (&'a str, &'a str)>) -> String {
+    use sha2::{Digest, Sha256};
+    let mut hash = Sha256::new();
+    for (name, text) in files {
+        for field in [name, text] {
+            hash.update((field.len() as u64).to_le_bytes());
+            hash.update(field.as_bytes());
+        }
+    }
+    hash.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
 /// What the induction templates are given.
 const INDUCTION_VARIABLES: &[&str] = &[
     "predicates",
@@ -535,36 +557,24 @@ impl Prompts {
     }
 
     /// SHA-256 (hex) over every embedded prompt file: templates, few-shot examples and API
-    /// documentation, names and texts. A benchmark run records it, so results from different
-    /// prompts are never mixed.
+    /// documentation, names and texts ([`files_fingerprint`]). A benchmark run records it, so
+    /// results from different prompts are never mixed.
     pub fn fingerprint() -> String {
-        use sha2::{Digest, Sha256};
-        let mut h = Sha256::new();
-        let mut add = |name: &str, text: &str| {
-            h.update((name.len() as u64).to_le_bytes());
-            h.update(name.as_bytes());
-            h.update((text.len() as u64).to_le_bytes());
-            h.update(text.as_bytes());
-        };
-        for template in TEMPLATES {
-            add(template.name, template.text);
-        }
-        add("physical_constraints.txt", PHYSICAL_CONSTRAINTS);
-        for files in [
+        let examples = [
             examples::INDUCTION_FILES,
             examples::STATE_FILES,
             examples::FINGER_CODE_FILES,
             examples::VACUUM_CODE_FILES,
             examples::SCENE_FILES,
-        ] {
-            for f in files {
-                add(f.path, f.text);
-            }
-        }
-        for (name, text) in api_docs::EMBEDDED {
-            add(name, text);
-        }
-        h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+        ];
+        files_fingerprint(
+            TEMPLATES
+                .iter()
+                .map(|template| (template.name, template.text))
+                .chain([("physical_constraints.txt", PHYSICAL_CONSTRAINTS)])
+                .chain(examples.into_iter().flatten().map(|f| (f.path, f.text)))
+                .chain(api_docs::EMBEDDED),
+        )
     }
 
     /// The names of all template files.
