@@ -28,6 +28,7 @@ ROOT = Path(__file__).resolve().parent.parent
 NESY = {
     "nesy-core", "nesy-input", "nesy-import", "nesy-sim", "nesy-policy", "nesy-vlm", "nesy-reasoner",
     "nesy-oracle", "nesy-pipeline", "nesy-bench", "nesy-baselines", "nesy-cli", "nesy-testkit", "nesy-view",
+    "nesy-robot",
 }
 # What a crate that talks to models only must not link: the simulator, the sandbox,
 # physics and CPython.
@@ -52,6 +53,8 @@ DEPENDENCY_RULES = {
                     "importing reads pictures and writes a demo folder: no model, no runtime, no Python"),
     "nesy-oracle": ({"nesy-oracle", "nesy-reasoner", "nesy-vlm", "nesy-sim", "nesy-core", "nesy-input"},
                     {"pyo3"}, "the offline responder does not run programs"),
+    "nesy-robot": ({"nesy-robot", "nesy-policy", "nesy-sim", "nesy-core", "nesy-input"}, {"tokio", "reqwest"},
+                   "the robot bridge knows nothing of models and owns no async runtime: plain sockets and threads"),
     "nesy-view": ({"nesy-view"}, {"rapier3d", "pyo3", "reqwest"},
                   "pages and the read-only server know no nesy type: they are given text and pictures"),
 }
@@ -62,7 +65,7 @@ DEV_ONLY = "nesy-testkit"
 
 # Crates whose files import each other in no circle.
 ACYCLIC = ["nesy-sim", "nesy-input", "nesy-import", "nesy-reasoner", "nesy-oracle", "nesy-pipeline", "nesy-baselines", "nesy-bench",
-           "nesy-cli", "nesy-testkit", "nesy-view"]
+           "nesy-cli", "nesy-testkit", "nesy-view", "nesy-robot"]
 
 # Source rules: crate -> [(pattern, why)].
 SOURCE_RULES = {

@@ -55,6 +55,8 @@ libdir=$("$python" -c 'import sysconfig; print(sysconfig.get_config_var("LIBDIR"
 need=()
 [ -e "$libdir/libpython$version.so" ] || need+=("libpython$version-dev")
 "$python" -m pip --version >/dev/null 2>&1 || need+=(python3-pip)
+# Virtual environments (the Python package's wheel is tested in a fresh one).
+"$python" -c 'import ensurepip' >/dev/null 2>&1 || need+=("python$version-venv")
 [ ${#need[@]} -eq 0 ] || apt_install "${need[@]}"
 echo "CPython $version ($python)"
 

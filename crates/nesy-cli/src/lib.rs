@@ -57,7 +57,9 @@ pub(crate) enum Command {
     Record(commands::record::RecordArgs),
     /// Render a scene's top, front and back views as PNG (plain and labelled).
     Render(commands::render::RenderArgs),
-    /// Run a code policy against a scene in the sandboxed Python worker.
+    /// Serve the simulator over the robot protocol (test a robot set-up without hardware).
+    RobotServer(commands::robot_server::RobotServerArgs),
+    /// Run a code policy in the sandboxed Python worker against a scene, or on a robot.
     Run(commands::run::RunArgs),
     /// Generate, list, show and sweep the benchmark's 440 scenarios; write one's planning problem.
     Scenarios(commands::scenarios::ScenariosArgs),
@@ -114,6 +116,7 @@ pub(crate) fn run(cli: Cli) -> ExitCode {
         Command::Prompts(args) => commands::prompts::run(args),
         Command::Record(args) => commands::record::run(args),
         Command::Render(args) => commands::render::run(args),
+        Command::RobotServer(args) => commands::robot_server::run(args),
         Command::Run(args) => commands::run::run(args),
         Command::Scenarios(args) => commands::scenarios::run(args),
         Command::Serve(args) => commands::serve::run(args),

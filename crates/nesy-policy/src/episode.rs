@@ -16,10 +16,16 @@ pub trait Episode: RobotApi + Send {
     /// settle steps (`docs/benchmark.md` §7: 100 steps, then, if undecided, 100 more with the final check)
     /// and returns what the episode achieved.
     fn finish(&mut self) -> EpisodeEnd;
+
+    /// Where the tool tip is now (world frame, metres), if this robot can say: what a robot
+    /// bridge checks a relative move against before it sends it.
+    fn tool_position(&self) -> Option<[f64; 3]> {
+        None
+    }
 }
 
 /// What an episode reports after the policy and the settle steps.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EpisodeEnd {
     /// Goal-check results; `None` if this robot has no goal checks.
     pub subtasks: Option<Vec<SubtaskReport>>,

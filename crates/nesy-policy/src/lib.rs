@@ -51,6 +51,7 @@
 mod episode;
 mod limits;
 mod python;
+mod relay;
 mod result;
 mod runner;
 mod sim_episode;
@@ -61,6 +62,7 @@ mod worker;
 pub use episode::{Episode, EpisodeBuildError, EpisodeEnd, EpisodeFactory, EpisodeSpec};
 pub use limits::Limits;
 pub use python::interpreter::{InitError, StartupTimes, initialize};
+pub use relay::{CallRelay, RelayStop, RobotStopReason};
 pub use result::{
     CapturedText, ExecutionResult, Outcome, PythonError, StaticViolation, SubtaskReport, TimeLimit,
     TracebackFrame, WorkerReport,
@@ -74,5 +76,5 @@ pub use source::{SourceError, decode_policy_source};
 pub use testing::RecordingRobot;
 pub use worker::{
     RunError, WORKER_SUBCOMMAND, WorkerCommand, install_seccomp_filter, run_policy,
-    run_policy_without_static_checks, worker_main,
+    run_policy_without_static_checks, run_relayed, worker_main,
 };

@@ -5,6 +5,8 @@ use nesy_core::metrics::SubtaskResult;
 use nesy_sim::api::TraceEntry;
 use serde::{Deserialize, Serialize};
 
+use crate::relay::RobotStopReason;
+
 /// Everything an episode produced. Serialised as JSON by `nesy run --json` and carried from
 /// the worker process to the parent.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -45,7 +47,10 @@ impl ExecutionResult {
             Outcome::SandboxViolation { error, .. }
             | Outcome::Timeout { error, .. }
             | Outcome::Memory { error } => error.iter_mut().collect(),
-            Outcome::Ok | Outcome::Rejected { .. } | Outcome::Killed { .. } => Vec::new(),
+            Outcome::Ok
+            | Outcome::Rejected { .. }
+            | Outcome::Killed { .. }
+            | Outcome::RobotStopped { .. } => Vec::new(),
         };
         let compiled_as = format!("File \"{}\"", crate::POLICY_FILE);
         let named = format!("File \"{file}\"");
@@ -101,6 +106,17 @@ pub enum Outcome {
         /// Why, in words (signal name or exit status).
         reason: String,
     },
+    /// A relayed run on a robot was stopped at a call: nesy refused or the operator
+    /// declined it, the robot had already failed a call, or the robot did not answer, answered
+    /// garbage or hung up ([`crate::run_relayed`]).
+    RobotStopped {
+        /// The call the run stopped at, as a caption (`move_to_position(0.90, 0.00, 0.60)`).
+        call: String,
+        /// The kind of stop.
+        reason: RobotStopReason,
+        /// What happened, in words.
+        message: String,
+    },
 }
 
 impl Outcome {
@@ -114,6 +130,7 @@ impl Outcome {
             Outcome::Timeout { .. } => "timeout",
             Outcome::Memory { .. } => "memory",
             Outcome::Killed { .. } => "killed",
+            Outcome::RobotStopped { .. } => "robot_stopped",
         }
     }
 }

@@ -29,6 +29,11 @@ impl Episode for Sim {
             }
         }
     }
+
+    fn tool_position(&self) -> Option<[f64; 3]> {
+        let tip = self.tool_pose().translation.vector;
+        Some([tip.x, tip.y, tip.z])
+    }
 }
 
 fn subtask_result(outcome: &SubtaskOutcome) -> SubtaskReport {

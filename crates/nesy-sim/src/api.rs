@@ -350,6 +350,44 @@ pub enum ApiError {
         /// The budget.
         limit: usize,
     },
+    /// A robot reached through the robot protocol stopped the motion on its own account
+    /// (a protective or emergency stop, an operator, its controller) and stays where it
+    /// stopped. The simulator never answers this.
+    #[error("{call}() was stopped by the robot: {reason}")]
+    Stopped {
+        /// The call whose motion stopped.
+        call: String,
+        /// What the robot said.
+        reason: String,
+    },
+    /// A robot reached through the robot protocol did not complete the motion within its
+    /// own time limit. The simulator never answers this.
+    #[error("{call}() did not complete on the robot within {seconds:.1} s")]
+    TimedOut {
+        /// The call that did not complete.
+        call: String,
+        /// The robot's limit, in seconds.
+        seconds: f64,
+    },
+}
+
+impl ApiError {
+    /// The error's kind as the JSON `kind` field names it (`infeasible`, `collision`, ...).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            ApiError::WrongEmbodiment { .. } => "wrong_embodiment",
+            ApiError::UnknownObject { .. } => "unknown_object",
+            ApiError::Infeasible { .. } => "infeasible",
+            ApiError::OutOfWorkspace { .. } => "out_of_workspace",
+            ApiError::IkFailed { .. } => "ik_failed",
+            ApiError::InvalidArgument { .. } => "invalid_argument",
+            ApiError::NoEmptySpace { .. } => "no_empty_space",
+            ApiError::Collision { .. } => "collision",
+            ApiError::BudgetExhausted { .. } => "budget_exhausted",
+            ApiError::Stopped { .. } => "stopped",
+            ApiError::TimedOut { .. } => "timed_out",
+        }
+    }
 }
 
 /// One entry of an execution trace.

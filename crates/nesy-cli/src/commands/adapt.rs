@@ -95,6 +95,10 @@ pub(crate) struct AdaptArgs {
     /// VLM settings (also from the environment and `--vlm-config`).
     #[command(flatten)]
     pub vlm_config: ConfigOverrides,
+    /// Running the policy on a robot (with `--execute`; its record goes to `robot/` in the
+    /// output directory).
+    #[command(flatten)]
+    pub robot: super::robot::RobotArgs,
 }
 
 /// A run that stopped before it had an outcome of its own. The model's side ending it (no
@@ -137,6 +141,10 @@ fn stopped(
 /// 2 on bad input.
 pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     let options = options(&args)?;
+    anyhow::ensure!(
+        args.robot.robot.is_none() || args.execute,
+        "--robot runs the adapted policy on a robot: it needs --execute"
+    );
     if args.render_every != 0 {
         anyhow::ensure!(
             args.execute,
@@ -207,7 +215,73 @@ pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
     if let Some(error @ pipeline::synth::SynthError::Call { .. }) = &run.codegen_error {
         eprintln!("error: {error} (outputs written to {})", run.out_dir.display());
     }
+    if let Some(address) = &args.robot.robot {
+        return execute_on_robot(&args, address, &run, &options);
+    }
     Ok(ExitCode::from(run.exit_code()))
+}
+
+/// `--execute --robot`: the adapted policy on the robot, after its execution in the target
+/// scene (the dry run) reached the goal; exit 0 only if the adaptation succeeded and the
+/// policy ran to its end on the robot.
+fn execute_on_robot(
+    args: &AdaptArgs,
+    address: &nesy_robot::RobotAddress,
+    run: &pipeline::AdaptRun,
+    options: &AdaptOptions,
+) -> anyhow::Result<ExitCode> {
+    use super::robot::{DryRun, dry_run_verdict};
+    let Some(policy) = &run.policy else {
+        outln!("  robot     not contacted: no policy was synthesized")?;
+        return Ok(ExitCode::from(run.exit_code().max(1)));
+    };
+    let dry_run = match (&run.execution, args.robot.skip_dry_run) {
+        (_, true) => DryRun::Skipped,
+        (Some(execution), false) => {
+            if let Some(why) = dry_run_verdict(&execution.result) {
+                outln!("  robot     not contacted: {why}")?;
+                return Ok(ExitCode::from(run.exit_code().max(1)));
+            }
+            DryRun::Passed {
+                scene: &execution.scene_path,
+                result: &execution.result,
+            }
+        }
+        (None, false) => anyhow::bail!(
+            "--robot needs the dry run in simulation, and this target has no scene to run it on ({}); \
+             give the camera target a scene.json, or pass --skip-dry-run",
+            run.not_executed.as_deref().unwrap_or("not executed")
+        ),
+    };
+    let expected = match &run.execution {
+        Some(execution) => Some(
+            nesy_sim::scene::SceneSpec::from_file(&execution.scene_path)
+                .with_context(|| format!("reading {}", execution.scene_path.display()))?
+                .embodiment,
+        ),
+        None => None,
+    };
+    let run_dir = run.out_dir.join("robot");
+    let policy_file = run.out_dir.join("policy.py").display().to_string();
+    let robot_run = super::robot::RobotRun {
+        source: &policy.code,
+        policy_file: &policy_file,
+        limits: &options.limits,
+        dry_run,
+        run_dir: &run_dir,
+        expected,
+    };
+    let result = super::robot::run_on_robot(&args.robot, address, robot_run)?;
+    let stop = super::robot::describe_stop(&result.outcome)
+        .map(|s| format!(", {s}"))
+        .unwrap_or_default();
+    outln!(
+        "  robot     {} at {address} ({} API calls{stop}); record {}",
+        result.outcome.kind(),
+        result.trace.len(),
+        run_dir.display()
+    )?;
+    Ok(ExitCode::from(if result.is_ok() { run.exit_code() } else { 1 }))
 }
 
 fn options(args: &AdaptArgs) -> anyhow::Result<AdaptOptions> {

@@ -7,6 +7,8 @@ pub(crate) mod demo;
 pub(crate) mod prompts;
 pub(crate) mod record;
 pub(crate) mod render;
+pub(crate) mod robot;
+pub(crate) mod robot_server;
 pub(crate) mod rollout;
 pub(crate) mod run;
 pub(crate) mod scenarios;

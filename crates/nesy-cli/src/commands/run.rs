@@ -13,9 +13,9 @@ pub(crate) struct RunArgs {
     /// The policy's Python source.
     #[arg(long)]
     pub policy: PathBuf,
-    /// Scene file (`scene.json`).
-    #[arg(long)]
-    pub scene: PathBuf,
+    /// Scene file (`scene.json`). With `--robot`, the scene of the dry run in simulation.
+    #[arg(long, required_unless_present = "robot")]
+    pub scene: Option<PathBuf>,
     /// Override the scene's end effector.
     #[arg(long, value_parser = parse_embodiment)]
     pub embodiment: Option<Embodiment>,
@@ -39,9 +39,15 @@ pub(crate) struct RunArgs {
     /// Maximum number of robot action calls.
     #[arg(long, default_value_t = 200)]
     pub max_actions: usize,
+    /// Where a robot run's record goes (default `robot-runs/<UTC time>`).
+    #[arg(long, value_name = "DIR", requires = "robot")]
+    pub robot_run_dir: Option<PathBuf>,
+    /// Running on a robot.
+    #[command(flatten)]
+    pub robot: super::robot::RobotArgs,
 }
 
-fn parse_embodiment(text: &str) -> Result<Embodiment, String> {
+pub(crate) fn parse_embodiment(text: &str) -> Result<Embodiment, String> {
     match text {
         "finger" => Ok(Embodiment::Finger),
         "vacuum" => Ok(Embodiment::Vacuum),
@@ -70,14 +76,18 @@ pub(crate) fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         }
         (_, None) => anyhow::bail!("--render-every needs --out DIR, where execution.mcap and rollout.mp4 go"),
     };
+    let policy_file = args.policy.display().to_string();
+    if let Some(address) = &args.robot.robot {
+        return run_on_robot(&args, address, &source, &policy_file, &limits);
+    }
+    let scene = args.scene.as_ref().context("--scene is needed without --robot")?;
     let spec = EpisodeSpec::Scene {
-        path: std::path::absolute(&args.scene).unwrap_or(args.scene.clone()),
+        path: std::path::absolute(scene).unwrap_or(scene.clone()),
         embodiment: args.embodiment,
     };
     let worker = WorkerCommand::current_exe().context("locating the nesy executable")?;
     let mut result = run_policy(&worker, &source, &spec, &limits)
-        .with_context(|| format!("running {} on {}", args.policy.display(), args.scene.display()))?;
-    let policy_file = args.policy.display().to_string();
+        .with_context(|| format!("running {} on {}", args.policy.display(), scene.display()))?;
     result.name_policy_file(&policy_file);
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&result)?)?;
@@ -87,19 +97,95 @@ pub(crate) fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     if let Some(dir) = rollout_dir
         && !matches!(result.outcome, Outcome::Rejected { .. })
     {
-        let rollout = super::rollout::record_rollout(
-            &args.scene,
-            args.embodiment,
-            &result.trace,
-            &dir,
-            args.render_every,
-        )?;
+        let rollout =
+            super::rollout::record_rollout(scene, args.embodiment, &result.trace, &dir, args.render_every)?;
         super::rollout::announce(&rollout, "recording: ", args.json)?;
     }
     Ok(if result.is_ok() {
         ExitCode::SUCCESS
     } else if matches!(result.outcome, Outcome::Rejected { .. }) {
         ExitCode::from(crate::EXIT_BAD_INPUT)
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+/// `nesy run --robot`: the dry run in simulation on `--scene` (unless `--skip-dry-run`), then
+/// the same program on the robot; exit 0 if it ran to its end there, 1 if the dry run or the
+/// robot run failed, 2 on bad input.
+fn run_on_robot(
+    args: &RunArgs,
+    address: &nesy_robot::RobotAddress,
+    source: &str,
+    policy_file: &str,
+    limits: &Limits,
+) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(
+        args.render_every == 0,
+        "--render-every records a simulated run; it does not apply with --robot"
+    );
+    let worker = WorkerCommand::current_exe().context("locating the nesy executable")?;
+    let dry_result;
+    let dry_run = match (&args.scene, args.robot.skip_dry_run) {
+        (_, true) => {
+            outln!("dry run: skipped (--skip-dry-run)")?;
+            super::robot::DryRun::Skipped
+        }
+        (None, false) => anyhow::bail!(
+            "--robot needs --scene for the dry run in simulation (or --skip-dry-run to go without one)"
+        ),
+        (Some(scene), false) => {
+            let spec = EpisodeSpec::Scene {
+                path: std::path::absolute(scene).unwrap_or(scene.clone()),
+                embodiment: args.embodiment,
+            };
+            let mut result = run_policy(&worker, source, &spec, limits)
+                .with_context(|| format!("dry run of {policy_file} on {}", scene.display()))?;
+            result.name_policy_file(policy_file);
+            outln!("dry run on {}:", scene.display())?;
+            print_summary(&result, policy_file)?;
+            if let Some(why) = super::robot::dry_run_verdict(&result) {
+                outln!("robot: not contacted, {why}")?;
+                return Ok(ExitCode::from(1));
+            }
+            dry_result = result;
+            super::robot::DryRun::Passed {
+                scene,
+                result: &dry_result,
+            }
+        }
+    };
+    let expected = match (args.embodiment, &args.scene) {
+        (Some(embodiment), _) => Some(embodiment),
+        (None, Some(scene)) => Some(
+            nesy_sim::scene::SceneSpec::from_file(scene)
+                .with_context(|| format!("reading {}", scene.display()))?
+                .embodiment,
+        ),
+        (None, None) => None,
+    };
+    let run_dir = args
+        .robot_run_dir
+        .clone()
+        .unwrap_or_else(super::robot::default_run_dir);
+    let run = super::robot::RobotRun {
+        source,
+        policy_file,
+        limits,
+        dry_run,
+        run_dir: &run_dir,
+        expected,
+    };
+    let result = super::robot::run_on_robot(&args.robot, address, run)?;
+    outln!("on the robot at {address}:")?;
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&result)?)?;
+    } else {
+        print_summary(&result, policy_file)?;
+    }
+    outln!("record: {}", run_dir.display())?;
+    Ok(if result.is_ok() {
+        ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
     })
@@ -140,6 +226,10 @@ fn print_summary(result: &ExecutionResult, policy_file: &str) -> std::io::Result
         }
         Outcome::Memory { .. } => outln!("  out of memory")?,
         Outcome::Killed { reason } => outln!("  {reason}")?,
+        Outcome::RobotStopped { .. } => outln!(
+            "  {}",
+            super::robot::describe_stop(&result.outcome).unwrap_or_default()
+        )?,
     }
     match &result.subtasks {
         Some(subtasks) => {

@@ -20,6 +20,7 @@ mod cassette_cli;
 mod demo_import;
 mod execution_recording;
 mod real_model;
+mod robot_bridge;
 mod run_cli;
 mod scenarios_cli;
 mod serve_cli;

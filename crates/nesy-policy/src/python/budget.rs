@@ -39,6 +39,16 @@ pub(crate) fn mark_progress() {
     LAST_PROGRESS_MS.store(elapsed.as_millis() as u64, Ordering::Release);
 }
 
+/// True while a robot API call is in flight. A call can take longer than the idle limit on a
+/// real robot (a slow move through the robot protocol); the policy is waiting for the robot
+/// then, not idle.
+static CALL_IN_FLIGHT: AtomicBool = AtomicBool::new(false);
+
+/// Marks the start (`true`) or end (`false`) of a robot API call.
+pub(crate) fn set_call_in_flight(in_flight: bool) {
+    CALL_IN_FLIGHT.store(in_flight, Ordering::Release);
+}
+
 /// How long since the last [`mark_progress`].
 fn since_progress() -> Duration {
     let last = progress_epoch() + Duration::from_millis(LAST_PROGRESS_MS.load(Ordering::Acquire));
@@ -167,7 +177,8 @@ impl Watchdog {
 fn watch(thread_id: std::ffi::c_long, deadline: Instant, idle: Duration, stop: &AtomicBool) {
     loop {
         let now = Instant::now();
-        let wait = if now < deadline && abort::current().is_none() {
+        let in_call = CALL_IN_FLIGHT.load(Ordering::Acquire);
+        let wait = if now < deadline && abort::current().is_none() && !in_call {
             (deadline - now)
                 .min(idle.saturating_sub(since_progress()))
                 .clamp(Duration::from_millis(1), WATCHDOG_PERIOD)
@@ -181,7 +192,7 @@ fn watch(thread_id: std::ffi::c_long, deadline: Instant, idle: Duration, stop: &
         }
         if Instant::now() >= deadline {
             abort::request(AbortReason::WallClock);
-        } else if since_progress() >= idle {
+        } else if !CALL_IN_FLIGHT.load(Ordering::Acquire) && since_progress() >= idle {
             abort::request(AbortReason::Idle);
         }
         let Some(reason) = abort::current() else { continue };

@@ -58,6 +58,12 @@ pyo3::create_exception!(
 );
 pyo3::create_exception!(
     robot,
+    RobotStoppedError,
+    RobotError,
+    "The robot stopped the motion itself (protective or emergency stop, operator, time limit); it stays where it stopped."
+);
+pyo3::create_exception!(
+    robot,
     SandboxViolation,
     PyBaseException,
     "The sandbox refused an operation; the episode is terminated."
@@ -83,6 +89,7 @@ fn api_error(err: ApiError) -> PyErr {
         ApiError::Collision { .. } => CollisionError::new_err(message),
         ApiError::InvalidArgument { .. } => InvalidArgumentError::new_err(message),
         ApiError::BudgetExhausted { .. } => BudgetExhaustedError::new_err(message),
+        ApiError::Stopped { .. } | ApiError::TimedOut { .. } => RobotStoppedError::new_err(message),
     }
 }
 
@@ -430,6 +437,7 @@ pub(crate) fn robot(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CollisionError", py.get_type::<CollisionError>())?;
     m.add("InvalidArgumentError", py.get_type::<InvalidArgumentError>())?;
     m.add("BudgetExhaustedError", py.get_type::<BudgetExhaustedError>())?;
+    m.add("RobotStoppedError", py.get_type::<RobotStoppedError>())?;
     m.add("SandboxViolation", py.get_type::<SandboxViolation>())?;
     m.add("TABLE_TOP_Z", super::convert::TABLE_TOP_Z)?;
     Ok(())

@@ -89,7 +89,9 @@ pub(crate) fn call<T: Send>(
     }
     let robot: &mut dyn Episode = &mut *episode.robot;
     let robot: &mut (dyn RobotApi + Send) = robot;
+    super::budget::set_call_in_flight(true);
     let value = py.detach(move || f(robot));
+    super::budget::set_call_in_flight(false);
     super::budget::mark_progress();
     if let Some(sink) = episode.sink.as_mut() {
         let trace = episode.robot.trace();

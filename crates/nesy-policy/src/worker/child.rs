@@ -1,16 +1,21 @@
 //! The worker side: read the request, lock the process down, run the episode, report.
 
 use std::fs::File;
-use std::io::{Read, Write};
+use std::io::{BufRead, BufReader, Read, Write};
 use std::os::fd::FromRawFd;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use super::protocol::{MAX_REQUEST_BYTES, RESULT_FD, WorkerMessage, WorkerRequest};
+use super::protocol::{
+    MAX_RELAY_LINE_BYTES, MAX_REQUEST_BYTES, RELAY_FD, RESULT_FD, RelayReply, WorkerEpisode, WorkerMessage,
+    WorkerRequest,
+};
 use super::{limits, seccomp};
-use crate::episode::EpisodeFactory;
+use crate::episode::{Episode, EpisodeEnd, EpisodeFactory};
 use crate::python::session::TraceSink;
+use crate::relay::{RelayLink, RelayedRobot};
 use crate::runner;
+use nesy_sim::api::{ApiCall, ApiError, ApiValue};
 
 /// Shared writer for the result channel (the trace sink and the final message use it).
 #[derive(Clone)]
@@ -34,12 +39,7 @@ pub fn worker_main(factory: &dyn EpisodeFactory) -> ExitCode {
     let started = Instant::now();
     // SAFETY: getppid has no preconditions.
     limits::die_with_parent(unsafe { libc::getppid() });
-    // SAFETY: fstat on a descriptor number we only inspect.
-    let has_channel = unsafe {
-        let mut st: libc::stat = std::mem::zeroed();
-        libc::fstat(RESULT_FD, &mut st) == 0 && (st.st_mode & libc::S_IFMT) == libc::S_IFIFO
-    };
-    if !has_channel {
+    if !is_pipe(RESULT_FD) {
         eprintln!("nesy policy-worker: fd {RESULT_FD} is not a pipe; this command is started by `nesy run`");
         return ExitCode::from(2);
     }
@@ -75,9 +75,26 @@ pub fn worker_main(factory: &dyn EpisodeFactory) -> ExitCode {
     if let Err(err) = limits::before_startup(request.limits.memory_bytes, cpu_seconds) {
         return fail(format!("cannot set resource limits: {err}"));
     }
-    let episode = match factory.build(&request.episode) {
-        Ok(episode) => episode,
-        Err(err) => return fail(err.to_string()),
+    let episode: Box<dyn Episode> = match &request.episode {
+        WorkerEpisode::Built { spec } => match factory.build(spec) {
+            Ok(episode) => episode,
+            Err(err) => return fail(err.to_string()),
+        },
+        WorkerEpisode::Relayed { embodiment } => {
+            if !is_pipe(RELAY_FD) {
+                return fail(format!(
+                    "a relayed episode needs the parent's answers on fd {RELAY_FD}"
+                ));
+            }
+            // SAFETY: fd 4 is an open pipe (checked above) handed to us by the parent; we own it.
+            let answers = BufReader::new(unsafe { File::from_raw_fd(RELAY_FD) });
+            let link = PipeLink {
+                channel: channel.clone(),
+                nonce: nonce.clone(),
+                answers,
+            };
+            Box::new(RelayedRobot::new(*embodiment, Box::new(link)))
+        }
     };
     if let Err(err) = crate::python::interpreter::initialize() {
         return fail(err.to_string());
@@ -118,6 +135,60 @@ pub fn worker_main(factory: &dyn EpisodeFactory) -> ExitCode {
     // Skip interpreter finalisation: nothing the policy left behind runs after its episode.
     // SAFETY: terminating the process.
     unsafe { libc::_exit(0) }
+}
+
+/// True if `fd` is an open pipe.
+fn is_pipe(fd: i32) -> bool {
+    // SAFETY: fstat on a descriptor number we only inspect.
+    unsafe {
+        let mut st: libc::stat = std::mem::zeroed();
+        libc::fstat(fd, &mut st) == 0 && (st.st_mode & libc::S_IFMT) == libc::S_IFIFO
+    }
+}
+
+/// A relayed episode's link to the parent: calls out on the message channel, answers back on
+/// [`RELAY_FD`].
+struct PipeLink {
+    channel: Channel,
+    nonce: String,
+    answers: BufReader<File>,
+}
+
+impl PipeLink {
+    fn read_reply(&mut self) -> Option<RelayReply> {
+        let mut line = String::new();
+        let read = (&mut self.answers)
+            .take(MAX_RELAY_LINE_BYTES)
+            .read_line(&mut line)
+            .ok()?;
+        if read == 0 {
+            return None;
+        }
+        serde_json::from_str(&line).ok()
+    }
+}
+
+impl RelayLink for PipeLink {
+    fn call(&mut self, call: &ApiCall) -> Option<Result<ApiValue, ApiError>> {
+        self.channel.send(&WorkerMessage::Call {
+            nonce: self.nonce.clone(),
+            call: call.clone(),
+        });
+        match self.read_reply()? {
+            RelayReply::Call { result } => Some(result),
+            RelayReply::Finish { .. } => None,
+        }
+    }
+
+    fn finish(&mut self) -> Option<EpisodeEnd> {
+        self.channel.send(&WorkerMessage::Finish {
+            nonce: self.nonce.clone(),
+        });
+        match self.read_reply()? {
+            RelayReply::Finish { end } => Some(end),
+            RelayReply::Call { .. } => None,
+        }
+    }
 }
 
 fn redirect_stdin_to_null() {

@@ -20,5 +20,7 @@ pub(crate) mod protocol;
 pub(crate) mod seccomp;
 
 pub use child::worker_main;
-pub use parent::{RunError, WORKER_SUBCOMMAND, WorkerCommand, run_policy, run_policy_without_static_checks};
+pub use parent::{
+    RunError, WORKER_SUBCOMMAND, WorkerCommand, run_policy, run_policy_without_static_checks, run_relayed,
+};
 pub use seccomp::install as install_seccomp_filter;

@@ -11,10 +11,12 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use super::protocol::{RESULT_FD, WorkerMessage, WorkerRequest};
+use super::protocol::{RELAY_FD, RESULT_FD, RelayReply, WorkerEpisode, WorkerMessage, WorkerRequest};
 use crate::episode::EpisodeSpec;
 use crate::limits::Limits;
+use crate::relay::{CallRelay, RelayStop, RobotStopReason};
 use crate::result::{CapturedText, ExecutionResult, Outcome, TimeLimit, WorkerReport};
+use nesy_core::Embodiment;
 use nesy_sim::api::TraceEntry;
 
 /// How to start a worker process.
@@ -114,7 +116,30 @@ pub fn run_policy(
     spec: &EpisodeSpec,
     limits: &Limits,
 ) -> Result<ExecutionResult, RunError> {
-    run(worker, source, spec, limits, true)
+    let episode = WorkerEpisode::Built { spec: spec.clone() };
+    run(worker, source, episode, limits, true, None)
+}
+
+/// Runs `source` in a fresh worker process under `limits` against a robot outside the
+/// worker: each call the policy makes is answered by `relay` in this process (see
+/// [`CallRelay`]), so the policy keeps every sandbox layer while the bridge talks to the
+/// robot. The first robot error ends the run: a later call is not relayed, and the outcome
+/// is [`Outcome::RobotStopped`] with [`RobotStopReason::AfterError`].
+pub fn run_relayed(
+    worker: &WorkerCommand,
+    source: &str,
+    embodiment: Embodiment,
+    limits: &Limits,
+    relay: &mut dyn CallRelay,
+) -> Result<ExecutionResult, RunError> {
+    run(
+        worker,
+        source,
+        WorkerEpisode::Relayed { embodiment },
+        limits,
+        true,
+        Some(relay),
+    )
 }
 
 /// Like [`run_policy`] with the static checks (layer 1) off, so tests can show that the
@@ -126,28 +151,38 @@ pub fn run_policy_without_static_checks(
     spec: &EpisodeSpec,
     limits: &Limits,
 ) -> Result<ExecutionResult, RunError> {
-    run(worker, source, spec, limits, false)
+    let episode = WorkerEpisode::Built { spec: spec.clone() };
+    run(worker, source, episode, limits, false, None)
 }
 
 fn run(
     worker: &WorkerCommand,
     source: &str,
-    spec: &EpisodeSpec,
+    episode: WorkerEpisode,
     limits: &Limits,
     static_checks: bool,
+    mut relay: Option<&mut dyn CallRelay>,
 ) -> Result<ExecutionResult, RunError> {
     let started = Instant::now();
     let nonce = nonce();
     let request = WorkerRequest {
         nonce: nonce.clone(),
         source: source.to_owned(),
-        episode: spec.clone(),
+        episode,
         limits: limits.clone(),
         static_checks,
     };
     let (read_end, write_end) = pipe()?;
-    let mut child = spawn_worker(worker, &write_end)?;
+    let answers = match relay {
+        Some(_) => Some(pipe()?),
+        None => None,
+    };
+    let mut child = spawn_worker(worker, &write_end, answers.as_ref().map(|(read, _)| read))?;
     drop(write_end);
+    let mut answers = answers.map(|(read, write)| {
+        drop(read);
+        File::from(write)
+    });
 
     let stdout = drain_capped(child.stdout.take().expect("piped"));
     let stderr = drain_capped(child.stderr.take().expect("piped"));
@@ -176,7 +211,16 @@ fn run(
     });
 
     let kill_at = started + Duration::from_millis(limits.wall_time_ms + limits.kill_grace_ms);
-    let heard = listen(&rx, &mut child, kill_at, limits);
+    let relay = match (relay.as_mut(), answers.as_mut()) {
+        (Some(relay), Some(answers)) => Some(Relaying {
+            relay: &mut **relay,
+            answers,
+            first_error: None,
+        }),
+        _ => None,
+    };
+    let heard = listen(&rx, &mut child, kill_at, limits, relay);
+    drop(answers);
     let status = wait_until(&mut child, kill_at.max(Instant::now()) + Duration::from_secs(2))?;
     let _ = writer.join();
     let _ = reader.join();
@@ -202,7 +246,9 @@ fn run(
         result.worker = Some(report);
         return Ok(result);
     }
-    let outcome = if heard.killed_by_parent {
+    let outcome = if let Some(stop) = heard.robot_stop {
+        stop
+    } else if heard.killed_by_parent {
         Outcome::Timeout {
             limit: if heard.idle_kill {
                 TimeLimit::Idle
@@ -226,10 +272,16 @@ fn run(
     })
 }
 
-/// Starts the worker process with the result channel's write end as its fd 3, in its own
-/// process group, killed with its parent.
-fn spawn_worker(worker: &WorkerCommand, write_end: &OwnedFd) -> Result<Child, RunError> {
+/// Starts the worker process with the result channel's write end as its fd 3 (and, for a
+/// relayed episode, the answers' read end as its fd 4), in its own process group, killed with
+/// its parent.
+fn spawn_worker(
+    worker: &WorkerCommand,
+    write_end: &OwnedFd,
+    answers: Option<&OwnedFd>,
+) -> Result<Child, RunError> {
     let write_raw = write_end.as_raw_fd();
+    let answers_raw = answers.map(|fd| fd.as_raw_fd());
     let parent_pid = std::process::id() as libc::pid_t;
     let mut command = Command::new(&worker.program);
     command
@@ -242,6 +294,11 @@ fn spawn_worker(worker: &WorkerCommand, write_end: &OwnedFd) -> Result<Child, Ru
     unsafe {
         command.pre_exec(move || {
             if libc::dup2(write_raw, RESULT_FD) < 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            if let Some(raw) = answers_raw
+                && libc::dup2(raw, RELAY_FD) < 0
+            {
                 return Err(std::io::Error::last_os_error());
             }
             libc::setpgid(0, 0);
@@ -266,11 +323,97 @@ struct Heard {
     setup_error: Option<String>,
     killed_by_parent: bool,
     idle_kill: bool,
+    /// Set when the relay stopped the run.
+    robot_stop: Option<Outcome>,
+}
+
+/// A relayed episode's side of the parent: the relay and the pipe its answers go back on.
+struct Relaying<'a> {
+    relay: &'a mut dyn CallRelay,
+    answers: &'a mut File,
+    /// The first call the robot answered with an error, and the error.
+    first_error: Option<String>,
+}
+
+impl Relaying<'_> {
+    /// Answers one call, or says why the run stops here.
+    fn call(&mut self, call: &nesy_sim::api::ApiCall) -> Result<(), Box<Outcome>> {
+        let label = call.label();
+        if let Some(first) = &self.first_error {
+            return Err(robot_stopped(
+                &label,
+                RelayStop {
+                    reason: RobotStopReason::AfterError,
+                    message: format!(
+                        "not sent: the robot already answered {first}, and its first error ends the run"
+                    ),
+                },
+            ));
+        }
+        let result = self
+            .relay
+            .answer(call)
+            .map_err(|stop| robot_stopped(&label, stop))?;
+        if let Err(error) = &result
+            && !crate::relay::can_report_error(call)
+        {
+            return Err(robot_stopped(
+                &label,
+                RelayStop {
+                    reason: RobotStopReason::UnexpectedError,
+                    message: format!(
+                        "the robot answered with an error ({error}), which this call cannot report to the policy"
+                    ),
+                },
+            ));
+        }
+        if let Err(error) = &result {
+            self.first_error = Some(format!("{label} with an error ({error})"));
+        }
+        self.reply(&RelayReply::Call { result }, &label)
+    }
+
+    /// Asks the robot for its end-of-episode report.
+    fn finish(&mut self) -> Result<(), Box<Outcome>> {
+        let end = self
+            .relay
+            .finish()
+            .map_err(|stop| robot_stopped("finish", stop))?;
+        self.reply(&RelayReply::Finish { end }, "finish")
+    }
+
+    fn reply(&mut self, reply: &RelayReply, label: &str) -> Result<(), Box<Outcome>> {
+        let mut line = serde_json::to_vec(reply).map_err(|e| internal(label, &e.to_string()))?;
+        line.push(b'\n');
+        self.answers
+            .write_all(&line)
+            .map_err(|e| internal(label, &format!("the worker is gone: {e}")))
+    }
+}
+
+fn robot_stopped(call: &str, stop: RelayStop) -> Box<Outcome> {
+    Box::new(Outcome::RobotStopped {
+        call: call.to_owned(),
+        reason: stop.reason,
+        message: stop.message,
+    })
+}
+
+fn internal(call: &str, message: &str) -> Box<Outcome> {
+    Box::new(Outcome::Killed {
+        reason: format!("relaying {call} failed: {message}"),
+    })
 }
 
 /// Collects the worker's messages until its result, its error, the end of the channel, the
 /// wall-clock limit `kill_at`, or the idle limit, killing its process group at a limit.
-fn listen(rx: &mpsc::Receiver<WorkerMessage>, child: &mut Child, kill_at: Instant, limits: &Limits) -> Heard {
+fn listen(
+    rx: &mpsc::Receiver<WorkerMessage>,
+    child: &mut Child,
+    kill_at: Instant,
+    limits: &Limits,
+    mut relay: Option<Relaying<'_>>,
+) -> Heard {
     // The watchdog inside the worker stops an idle policy that still runs bytecode; one stuck
     // in C code holds the interpreter lock, so the parent also kills a worker that has sent
     // nothing (no `Ready`, no API call) for the idle limit plus the grace.
@@ -282,6 +425,7 @@ fn listen(rx: &mpsc::Receiver<WorkerMessage>, child: &mut Child, kill_at: Instan
     let mut final_result = None;
     let mut setup_error = None;
     let mut killed_by_parent = false;
+    let mut robot_stop = None;
     loop {
         let now = Instant::now();
         let idle_at = last_heard + idle_grace;
@@ -299,6 +443,31 @@ fn listen(rx: &mpsc::Receiver<WorkerMessage>, child: &mut Child, kill_at: Instan
             Ok(WorkerMessage::Trace { entry, .. }) => {
                 trace.push(entry);
                 last_heard = Instant::now();
+            }
+            Ok(WorkerMessage::Call { call, .. }) => {
+                let answered = match relay.as_mut() {
+                    Some(relay) => relay.call(&call),
+                    None => Err(internal(call.name(), "the worker asked for a robot outside it")),
+                };
+                // The time the robot took is not the policy's idle time.
+                last_heard = Instant::now();
+                if let Err(outcome) = answered {
+                    kill_group(child);
+                    robot_stop = Some(*outcome);
+                    break;
+                }
+            }
+            Ok(WorkerMessage::Finish { .. }) => {
+                let answered = match relay.as_mut() {
+                    Some(relay) => relay.finish(),
+                    None => Err(internal("finish", "the worker asked for a robot outside it")),
+                };
+                last_heard = Instant::now();
+                if let Err(outcome) = answered {
+                    kill_group(child);
+                    robot_stop = Some(*outcome);
+                    break;
+                }
             }
             Ok(WorkerMessage::Result { result, .. }) => {
                 final_result = Some(*result);
@@ -319,6 +488,7 @@ fn listen(rx: &mpsc::Receiver<WorkerMessage>, child: &mut Child, kill_at: Instan
         setup_error,
         killed_by_parent,
         idle_kill,
+        robot_stop,
     }
 }
 
