@@ -3,21 +3,25 @@
 # environment's scripts directory) and the `nesy` package (the Python API, the robot server
 # base class and the examples).
 #
-#   scripts/build-wheel.sh [--release] [--out DIR]      (default: the dev profile, target/wheels)
+#   scripts/build-wheel.sh [--release | --static] [--out DIR]   (default: the dev profile, target/wheels)
 #
 # The binary embeds the system CPython (scripts/system-python), so the wheel is tagged for
-# that CPython and needs its libpython where it is installed; the static binary of
-# scripts/build-static.sh has no such need. maturin is taken from $MATURIN, from PATH, or
+# that CPython and needs its libpython where it is installed. `--static` puts the static
+# binary of scripts/build-static.sh in the wheel instead (built with the same environment,
+# scripts/static/env.sh): it needs no Python and no shared library where it is installed,
+# though maturin still tags the wheel for CPython 3.11, whose libpython it links. maturin is taken from $MATURIN, from PATH, or
 # installed once into target/maturin-venv from the package index.
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 profile=dev
+static=false
 out="$ROOT/target/wheels"
 while [ $# -gt 0 ]; do
   case "$1" in
     --release) profile=release ;;
+    --static) static=true ;;
     --out) out=$(realpath -m "$2"); shift ;;
-    *) echo "usage: scripts/build-wheel.sh [--release] [--out DIR]" >&2; exit 2 ;;
+    *) echo "usage: scripts/build-wheel.sh [--release | --static] [--out DIR]" >&2; exit 2 ;;
   esac
   shift
 done
@@ -32,6 +36,15 @@ if [ -z "$maturin" ]; then
   maturin="$venv/bin/maturin"
 fi
 mkdir -p "$out"
+if $static; then
+  cd "$ROOT"
+  # shellcheck source=scripts/static/env.sh
+  . scripts/static/env.sh
+  cd "$ROOT/python"
+  "$maturin" build --release --strip --target "$STATIC_TARGET" --features "$STATIC_FEATURES" \
+    --compatibility linux --interpreter /usr/bin/python3.11 --out "$out"
+  exit 0
+fi
 cd "$ROOT/python"
 # `--compatibility linux`: the binary links the system's libpython, which no manylinux
 # policy allows; the wheel is for machines with that CPython.

@@ -305,8 +305,8 @@ def run(
         calls answered by the robot); plus ``exit_code`` (0 when the policy ran to its end on
         the robot), ``contacted`` (``True``), ``run_dir`` and ``calls_log`` (the
         ``robot-calls.jsonl`` event log). When the robot was not contacted (the dry run
-        failed), the dict is ``{"contacted": False, "exit_code": ..., "run_dir": ...,
-        "output": <stdout>}``.
+        failed), the dict is ``{"contacted": False, "reason": ..., "dry_run": {...},
+        "exit_code": ..., "run_dir": ...}``.
 
     Raises:
         NesyError: exit code 2 with no result (bad input, a robot that could not be reached).
@@ -324,23 +324,20 @@ def run(
         result["exit_code"] = done.returncode
         return result
     run_dir = Path(robot_run_dir) if robot_run_dir is not None else Path(tempfile.mkdtemp(prefix="nesy-robot-run-"))
-    args += ["--robot", robot, "--robot-run-dir", run_dir]
+    args += ["--robot", robot, "--robot-run-dir", run_dir, "--json"]
     if skip_dry_run:
         args.append("--skip-dry-run")
     args += list(extra_args)
-    started = time.time()
     done = _invoke(args)
-    if done.returncode == 2:
-        raise _fail("nesy run --robot", done)
-    record = _fresh_json(run_dir / "robot-run.json", started)
+    # With --json the binary prints the run record, or {"contacted": false, ...} when the dry
+    # run kept the robot out.
+    record = _first_json(done.stdout)
     if record is None:
-        if done.returncode == 0:
-            raise _fail("nesy run --robot (no robot-run.json was written)", done)
-        return {"contacted": False, "exit_code": done.returncode, "run_dir": str(run_dir), "output": done.stdout}
+        raise _fail("nesy run --robot", done)
     record["exit_code"] = done.returncode
-    record["contacted"] = True
     record["run_dir"] = str(run_dir)
-    record["calls_log"] = str(run_dir / "robot-calls.jsonl")
+    if record.get("contacted"):
+        record["calls_log"] = str(run_dir / "robot-calls.jsonl")
     return record
 
 

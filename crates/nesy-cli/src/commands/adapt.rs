@@ -232,14 +232,18 @@ fn execute_on_robot(
 ) -> anyhow::Result<ExitCode> {
     use super::robot::{DryRun, dry_run_verdict};
     let Some(policy) = &run.policy else {
-        outln!("  robot     not contacted: no policy was synthesized")?;
+        eprintln!("robot not contacted: no policy was synthesized");
         return Ok(ExitCode::from(run.exit_code().max(1)));
     };
     let dry_run = match (&run.execution, args.robot.skip_dry_run) {
         (_, true) => DryRun::Skipped,
         (Some(execution), false) => {
             if let Some(why) = dry_run_verdict(&execution.result) {
-                outln!("  robot     not contacted: {why}")?;
+                if args.json {
+                    eprintln!("robot not contacted: {why}");
+                } else {
+                    outln!("  robot     not contacted: {why}")?;
+                }
                 return Ok(ExitCode::from(run.exit_code().max(1)));
             }
             DryRun::Passed {
@@ -271,16 +275,22 @@ fn execute_on_robot(
         run_dir: &run_dir,
         expected,
     };
-    let result = super::robot::run_on_robot(&args.robot, address, robot_run)?;
+    let (result, _record) = super::robot::run_on_robot(&args.robot, address, robot_run)?;
     let stop = super::robot::describe_stop(&result.outcome)
         .map(|s| format!(", {s}"))
         .unwrap_or_default();
-    outln!(
+    let line = format!(
         "  robot     {} at {address} ({} API calls{stop}); record {}",
         result.outcome.kind(),
         result.trace.len(),
         run_dir.display()
-    )?;
+    );
+    // With --json, stdout holds the run summary alone; the record is in robot/robot-run.json.
+    if args.json {
+        eprintln!("{}", line.trim_start());
+    } else {
+        outln!("{line}")?;
+    }
     Ok(ExitCode::from(if result.is_ok() { run.exit_code() } else { 1 }))
 }
 

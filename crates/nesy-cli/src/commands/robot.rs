@@ -106,7 +106,7 @@ pub(crate) fn run_on_robot(
     args: &RobotArgs,
     address: &RobotAddress,
     run: RobotRun<'_>,
-) -> anyhow::Result<ExecutionResult> {
+) -> anyhow::Result<(ExecutionResult, serde_json::Value)> {
     let RobotRun {
         source,
         policy_file,
@@ -166,6 +166,7 @@ pub(crate) fn run_on_robot(
         DryRun::Skipped => json!({"skipped": true}),
     };
     let record = json!({
+        "contacted": true,
         "policy": policy_file,
         "robot": {"address": address.to_string(), "welcome": welcome},
         "workspace": {"min": workspace.min, "max": workspace.max},
@@ -178,7 +179,22 @@ pub(crate) fn run_on_robot(
     let record_path = run_dir.join("robot-run.json");
     std::fs::write(&record_path, serde_json::to_string_pretty(&record)? + "\n")
         .with_context(|| format!("writing {}", record_path.display()))?;
-    Ok(result)
+    Ok((result, record))
+}
+
+/// What `--json` prints when the dry run kept the robot out: the dry run and why.
+pub(crate) fn not_contacted_json(scene: &Path, result: &ExecutionResult, why: &str) -> serde_json::Value {
+    json!({
+        "contacted": false,
+        "reason": why,
+        "dry_run": {
+            "skipped": false,
+            "scene": scene,
+            "outcome": result.outcome.kind(),
+            "subtasks": result.subtasks,
+            "api_calls": result.trace.len(),
+        },
+    })
 }
 
 /// Asks `send CALL to the robot? [y/N]` on the controlling terminal before each call.

@@ -128,7 +128,7 @@ fn run_on_robot(
     let dry_result;
     let dry_run = match (&args.scene, args.robot.skip_dry_run) {
         (_, true) => {
-            outln!("dry run: skipped (--skip-dry-run)")?;
+            say(args.json, "dry run: skipped (--skip-dry-run)")?;
             super::robot::DryRun::Skipped
         }
         (None, false) => anyhow::bail!(
@@ -142,10 +142,19 @@ fn run_on_robot(
             let mut result = run_policy(&worker, source, &spec, limits)
                 .with_context(|| format!("dry run of {policy_file} on {}", scene.display()))?;
             result.name_policy_file(policy_file);
-            outln!("dry run on {}:", scene.display())?;
-            print_summary(&result, policy_file)?;
+            if args.json {
+                eprintln!("dry run on {}: {}", scene.display(), result.outcome.kind());
+            } else {
+                outln!("dry run on {}:", scene.display())?;
+                print_summary(&result, policy_file)?;
+            }
             if let Some(why) = super::robot::dry_run_verdict(&result) {
-                outln!("robot: not contacted, {why}")?;
+                if args.json {
+                    let record = super::robot::not_contacted_json(scene, &result, &why);
+                    outln!("{}", serde_json::to_string_pretty(&record)?)?;
+                } else {
+                    outln!("robot: not contacted, {why}")?;
+                }
                 return Ok(ExitCode::from(1));
             }
             dry_result = result;
@@ -176,19 +185,29 @@ fn run_on_robot(
         run_dir: &run_dir,
         expected,
     };
-    let result = super::robot::run_on_robot(&args.robot, address, run)?;
-    outln!("on the robot at {address}:")?;
+    let (result, record) = super::robot::run_on_robot(&args.robot, address, run)?;
     if args.json {
-        outln!("{}", serde_json::to_string_pretty(&result)?)?;
+        outln!("{}", serde_json::to_string_pretty(&record)?)?;
     } else {
+        outln!("on the robot at {address}:")?;
         print_summary(&result, policy_file)?;
     }
-    outln!("record: {}", run_dir.display())?;
+    say(args.json, &format!("record: {}", run_dir.display()))?;
     Ok(if result.is_ok() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
     })
+}
+
+/// A line for the reader: on stdout, or on stderr when stdout carries `--json`'s object.
+fn say(json: bool, line: &str) -> std::io::Result<()> {
+    if json {
+        eprintln!("{line}");
+        Ok(())
+    } else {
+        outln!("{line}")
+    }
 }
 
 fn print_summary(result: &ExecutionResult, policy_file: &str) -> std::io::Result<()> {

@@ -214,6 +214,21 @@ fn a_policy_that_fails_its_dry_run_never_reaches_the_robot() {
         "{text}"
     );
     assert!(record.is_none());
+    // With --json, standard output is one JSON object saying so.
+    let output = common::nesy(&[
+        "run".into(),
+        "--policy".into(),
+        policy.display().to_string(),
+        "--scene".into(),
+        "fixtures/scenes/pick_place_finger.json".into(),
+        "--robot".into(),
+        server.address.clone(),
+        "--json".into(),
+    ]);
+    assert_eq!(output.status.code(), Some(1));
+    let printed: Value = serde_json::from_slice(&output.stdout).expect("stdout is one JSON object");
+    assert_eq!(printed["contacted"], false, "{printed}");
+    assert_eq!(printed["dry_run"]["outcome"], "ok", "{printed}");
     std::thread::sleep(Duration::from_millis(200));
     assert!(
         server.events().iter().all(|e| e["event"] != "connected"),
@@ -268,6 +283,26 @@ fn a_motion_outside_the_workspace_is_refused_before_it_is_sent() {
         .filter(|e| e["event"] == "request" && e["method"] == "move_to_position")
         .collect();
     assert_eq!(moves[0]["params"]["pos"], json!([0.4, 0.0, 0.7]));
+
+    // With --json, standard output is the run record itself.
+    let run_dir = dir.path().join("json-run");
+    let output = common::nesy(&[
+        "run".into(),
+        "--policy".into(),
+        policy.display().to_string(),
+        "--robot".into(),
+        server.address.clone(),
+        "--skip-dry-run".into(),
+        "--json".into(),
+        "--robot-run-dir".into(),
+        run_dir.display().to_string(),
+    ]);
+    assert_eq!(output.status.code(), Some(1));
+    let printed: Value = serde_json::from_slice(&output.stdout).expect("stdout is one JSON object");
+    let written: Value =
+        serde_json::from_str(&std::fs::read_to_string(run_dir.join("robot-run.json")).unwrap()).unwrap();
+    assert_eq!(printed, written);
+    assert_eq!(printed["contacted"], true);
 
     // A relative move is checked against the tool position the robot reports.
     let policy = write_policy(dir.path(), "move_parallel('up', 2.0)\n");
@@ -572,4 +607,98 @@ fn a_slow_motion_on_the_robot_is_not_idle_time() {
     let result = &record.expect("a run record")["result"];
     assert_eq!(result["outcome"]["kind"], "ok", "{result}");
     assert_eq!(result["trace"].as_array().unwrap().len(), 2, "{result}");
+}
+
+/// Runs a command on a pseudo-terminal, answering each `[y/N]` prompt with the next of the
+/// comma-separated answers in argv[1]; prints what the terminal showed and exits as the
+/// command did.
+const ANSWER_ON_A_TERMINAL: &str = r#"
+import os, pty, sys, time
+answers = sys.argv[1].split(",")
+pid, fd = pty.fork()
+if pid == 0:
+    os.execvp(sys.argv[2], sys.argv[2:])
+shown, deadline = b"", time.time() + 60
+while time.time() < deadline:
+    try:
+        chunk = os.read(fd, 4096)
+    except OSError:
+        break
+    if not chunk:
+        break
+    shown += chunk
+    while answers and b"[y/N]" in shown:
+        shown = shown.replace(b"[y/N]", b"[answered]", 1)
+        os.write(fd, (answers.pop(0) + "\n").encode())
+_, status = os.waitpid(pid, 0)
+sys.stdout.write(shown.decode(errors="replace"))
+sys.exit(os.waitstatus_to_exitcode(status))
+"#;
+
+#[test]
+fn with_confirm_each_call_waits_for_the_operator() {
+    let server = SimServer::start("fixtures/scenes/pick_place_finger.json");
+    let dir = common::scratch();
+    let driver = dir.path().join("answer.py");
+    std::fs::write(&driver, ANSWER_ON_A_TERMINAL).unwrap();
+    let policy = write_policy(dir.path(), "get_obj_names()\nopen_gripper()\nclose_gripper()\n");
+    let run_dir = dir.path().join("run");
+    let output = Command::new("python3")
+        .current_dir(common::workspace())
+        .arg(&driver)
+        .arg("y,n")
+        .arg(env!("CARGO_BIN_EXE_nesy"))
+        .arg("run")
+        .arg("--policy")
+        .arg(&policy)
+        .args([
+            "--robot",
+            &server.address,
+            "--skip-dry-run",
+            "--confirm",
+            "--robot-run-dir",
+        ])
+        .arg(&run_dir)
+        .output()
+        .expect("python3 runs the terminal driver");
+    let shown = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(1), "{shown}");
+    assert!(
+        shown.contains("send get_obj_names() to the robot? [answered] y"),
+        "{shown}"
+    );
+    assert!(
+        shown.contains("send open_gripper() to the robot? [answered] n"),
+        "{shown}"
+    );
+    let record: Value =
+        serde_json::from_str(&std::fs::read_to_string(run_dir.join("robot-run.json")).unwrap()).unwrap();
+    let outcome = &record["result"]["outcome"];
+    assert_eq!(outcome["reason"], "declined", "{outcome}");
+    assert_eq!(outcome["call"], "open_gripper()", "{outcome}");
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(server.requested_methods(), ["hello", "get_obj_names", "stop"]);
+
+    // Without a terminal there is no one to ask: refused before anything is sent.
+    let output = Command::new("setsid")
+        .current_dir(common::workspace())
+        .arg("--wait")
+        .arg(env!("CARGO_BIN_EXE_nesy"))
+        .arg("run")
+        .arg("--policy")
+        .arg(&policy)
+        .args([
+            "--robot",
+            &server.address,
+            "--skip-dry-run",
+            "--confirm",
+            "--robot-run-dir",
+        ])
+        .arg(dir.path().join("run2"))
+        .stdin(Stdio::null())
+        .output()
+        .expect("setsid runs nesy without a controlling terminal");
+    let text = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{text}");
+    assert!(text.contains("--confirm asks on the terminal"), "{text}");
 }
