@@ -65,6 +65,8 @@ pub(crate) enum Command {
     Scenarios(commands::scenarios::ScenariosArgs),
     /// Serve a folder of runs and their HTML reports to a browser (read-only, loopback by default).
     Serve(commands::serve::ServeArgs),
+    /// Make a task from a pair of scenes: its demonstration planned, executed and recorded.
+    Task(commands::task::TaskArgs),
     /// Verify a plan against a PDDL domain and problem, like VAL.
     Verify(commands::verify::VerifyArgs),
     /// Worker process of `nesy run` (internal).
@@ -120,6 +122,7 @@ pub(crate) fn run(cli: Cli) -> ExitCode {
         Command::Run(args) => commands::run::run(args),
         Command::Scenarios(args) => commands::scenarios::run(args),
         Command::Serve(args) => commands::serve::run(args),
+        Command::Task(args) => commands::task::run(args),
         Command::Verify(args) => commands::verify::run(args),
         Command::PolicyWorker(args) => commands::worker::run(args),
     };

@@ -8,9 +8,8 @@ use futures::FutureExt as _;
 use futures::future::BoxFuture;
 use nesy_core::Formula;
 use nesy_core::Symbol;
-use nesy_core::planner::{Heuristic, PlannerConfig, Search};
 use nesy_pipeline::synth::CodegenMode;
-use nesy_sim::domain::{WorldDomain, plan_to_goal};
+use nesy_sim::domain::{WorldDomain, control_planner_config, plan_to_goal};
 use nesy_vlm::VlmClient;
 
 use super::{
@@ -23,17 +22,6 @@ use crate::variant::Variant;
 /// The replanning control.
 #[derive(Debug, Clone, Copy)]
 pub struct Replan;
-
-/// The planner's settings for the control: greedy best-first search on h_FF with a 10 s
-/// wall limit (the authors give Fast Downward 10 s).
-pub(super) fn planner_config() -> PlannerConfig {
-    PlannerConfig {
-        search: Search::Gbfs,
-        heuristic: Heuristic::HFf,
-        time_limit: Some(std::time::Duration::from_secs(10)),
-        ..PlannerConfig::default()
-    }
-}
 
 /// The target's goal as the planner takes it: every scene goal's atoms, and the end effector
 /// open with nothing held ([`nesy_sim::scene::SceneSpec::symbolic_goal`]).
@@ -85,8 +73,15 @@ impl Method for Replan {
             let embodiment = inputs.target.sim_scene().map_err(fail)?.embodiment;
             let objects: Vec<Symbol> = inputs.target.objects.iter().map(|o| Symbol::new(o)).collect();
             let started = std::time::Instant::now();
-            let procedure = plan_to_goal(world, observed, &goal, embodiment, &objects, &planner_config())
-                .map_err(|e| MethodFailure::new(FailureKind::Unresolved, format!("no plan: {e}")))?;
+            let procedure = plan_to_goal(
+                world,
+                observed,
+                &goal,
+                embodiment,
+                &objects,
+                &control_planner_config(),
+            )
+            .map_err(|e| MethodFailure::new(FailureKind::Unresolved, format!("no plan: {e}")))?;
             let symbolic = started.elapsed().as_secs_f64();
             Ok(Specified {
                 spec: Specification::Procedure {

@@ -13,6 +13,7 @@ pub(crate) mod rollout;
 pub(crate) mod run;
 pub(crate) mod scenarios;
 pub(crate) mod serve;
+pub(crate) mod task;
 pub(crate) mod verify;
 pub(crate) mod worker;
 

@@ -24,4 +24,5 @@ mod robot_bridge;
 mod run_cli;
 mod scenarios_cli;
 mod serve_cli;
+mod task_cli;
 mod verify;

@@ -25,7 +25,7 @@ use crate::api::Embodiment;
 /// The domain file as committed.
 pub const NESY_WORLD_PDDL: &str = include_str!("../../../../assets/pddl/nesy-world.pddl");
 
-pub use plan::{Planning, plan_to_goal, printable};
+pub use plan::{Planning, control_planner_config, plan_to_goal, printable};
 pub use schemas::{Motion, Schema, SchemaKind, kind_of, schema, schema_names, schemas};
 
 /// Why the true domain could not be loaded (a defect of nesy's own files).

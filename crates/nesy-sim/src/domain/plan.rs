@@ -14,6 +14,18 @@ use nesy_core::{Atom, apply};
 use super::{WorldDomain, semantic};
 use crate::api::Embodiment;
 
+/// The planner settings for planning a whole task in the true domain (the `replan` control,
+/// `nesy task new`): greedy best-first search on h_FF with a 10 s wall limit, the limit the
+/// authors give Fast Downward.
+pub fn control_planner_config() -> PlannerConfig {
+    PlannerConfig {
+        search: planner::Search::Gbfs,
+        heuristic: planner::Heuristic::HFf,
+        time_limit: Some(std::time::Duration::from_secs(10)),
+        ..PlannerConfig::default()
+    }
+}
+
 /// The true domain grounded for planning: the schemas of one end effector over a typed
 /// universe of a scene's objects, with the planner's settings.
 pub struct Planning<'a> {

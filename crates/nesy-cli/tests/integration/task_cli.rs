@@ -1,0 +1,117 @@
+//! `nesy task new`: a task made from a hand-written pair of scenes, with no scripted expert,
+//! and the reasons it refuses one.
+
+use crate::common;
+
+use std::path::Path;
+
+use serde_json::Value;
+
+/// `nesy task new --source S --target T --out OUT --size 64`: exit code, stdout, stderr.
+fn task_new(source: &Path, target: &Path, out: &Path) -> (Option<i32>, String, String) {
+    let args: Vec<String> = [
+        "task".to_owned(),
+        "new".to_owned(),
+        "--source".to_owned(),
+        source.display().to_string(),
+        "--target".to_owned(),
+        target.display().to_string(),
+        "--out".to_owned(),
+        out.display().to_string(),
+        "--size".to_owned(),
+        "64".to_owned(),
+    ]
+    .to_vec();
+    let output = common::nesy(&args);
+    (
+        output.status.code(),
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
+
+/// The pick-and-place fixture scene with `edit` applied, written to `dir/name`.
+fn edited_scene(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> std::path::PathBuf {
+    let text =
+        std::fs::read_to_string(common::workspace().join("fixtures/scenes/pick_place_finger.json")).unwrap();
+    let mut scene: Value = serde_json::from_str(&text).unwrap();
+    edit(&mut scene);
+    let path = dir.join(name);
+    std::fs::write(&path, serde_json::to_string_pretty(&scene).unwrap()).unwrap();
+    path
+}
+
+#[test]
+fn a_task_from_a_hand_written_scene_pair_is_adapted_offline() {
+    let root = common::workspace();
+    let dir = common::scratch();
+    let out = dir.path().join("cubes-to-suction");
+    // The demonstration by the finger robot; the target asks the same of the vacuum robot.
+    let (code, stdout, stderr) = task_new(
+        &root.join("fixtures/scenes/pick_place_finger.json"),
+        &root.join("fixtures/scenes/pick_place_vacuum.json"),
+        &out,
+    );
+    assert_eq!(code, Some(0), "{stdout}{stderr}");
+    // The green cube sits on the blue one, so the plan cannot follow the goal's listed order.
+    assert!(stdout.contains("pick_place: partial_success"), "{stdout}");
+    assert!(stdout.contains("another order than it lists"), "{stdout}");
+    for file in [
+        "demo.mcap",
+        "source.json",
+        "target.json",
+        "plan.txt",
+        "policy.py",
+        "task.json",
+    ] {
+        assert!(out.join(file).is_file(), "{file} missing: {stdout}");
+    }
+    let task: Value = serde_json::from_str(&std::fs::read_to_string(out.join("task.json")).unwrap()).unwrap();
+    assert!(task["keyframes"].as_u64().unwrap() > 6, "{task}");
+    assert_eq!(task["name"], "cubes-to-suction");
+
+    // The recorded demo is a demonstration nesy adapts: the offline responder answers from
+    // its recorded calls and states, and the adapted policy reaches the target's goal.
+    let adapted = dir.path().join("adapted");
+    let (code, stdout, stderr) = common::adapt(
+        &out.join("demo.mcap"),
+        &out.join("target.json"),
+        "oracle",
+        &adapted,
+        &["--execute", "--codegen", "template"],
+    );
+    assert_eq!(code, Some(0), "{stdout}{stderr}");
+    assert!(stdout.starts_with("nesy adapt: SUCCEEDED"), "{stdout}");
+    assert!(stdout.contains("SR 1"), "{stdout}");
+}
+
+#[test]
+fn a_scene_without_goals_is_refused() {
+    let dir = common::scratch();
+    let source = edited_scene(dir.path(), "source.json", |scene| {
+        scene["goals"] = Value::Array(Vec::new())
+    });
+    let target = common::workspace().join("fixtures/scenes/pick_place_finger.json");
+    let (code, stdout, stderr) = task_new(&source, &target, &dir.path().join("out"));
+    assert_eq!(code, Some(2), "{stdout}{stderr}");
+    assert!(stderr.contains("the source scene has no `goals`"), "{stderr}");
+    assert!(!dir.path().join("out").exists());
+}
+
+#[test]
+fn a_goal_that_cannot_be_planned_is_refused_with_the_reason() {
+    let dir = common::scratch();
+    // Nothing in the true domain puts a cube inside another cube.
+    let source = edited_scene(dir.path(), "source.json", |scene| {
+        scene["goals"][0]["objects"] = serde_json::json!(["red_cube"]);
+        scene["goals"][0]["container"] = Value::String("blue_cube".into());
+    });
+    let target = common::workspace().join("fixtures/scenes/pick_place_finger.json");
+    let (code, stdout, stderr) = task_new(&source, &target, &dir.path().join("out"));
+    assert_eq!(code, Some(2), "{stdout}{stderr}");
+    assert!(
+        stderr.contains("the source scene's goal cannot be planned from its initial state"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("out").exists());
+}
