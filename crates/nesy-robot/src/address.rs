@@ -87,7 +87,18 @@ impl RobotAddress {
     pub fn listen(&self) -> std::io::Result<Listener> {
         match self {
             RobotAddress::Tcp(hostport) => Ok(Listener::Tcp(TcpListener::bind(hostport.as_str())?)),
-            RobotAddress::Unix(path) => Ok(Listener::Unix(UnixListener::bind(path)?, path.clone())),
+            RobotAddress::Unix(path) => match UnixListener::bind(path) {
+                Ok(listener) => Ok(Listener::Unix(listener, path.clone())),
+                // A socket file left by a server that is gone (nothing answers on it) is
+                // replaced; one a live server holds is not.
+                Err(err)
+                    if err.kind() == std::io::ErrorKind::AddrInUse && UnixStream::connect(path).is_err() =>
+                {
+                    std::fs::remove_file(path)?;
+                    Ok(Listener::Unix(UnixListener::bind(path)?, path.clone()))
+                }
+                Err(err) => Err(err),
+            },
         }
     }
 }
@@ -99,6 +110,15 @@ pub enum Listener {
     Tcp(TcpListener),
     /// Unix socket, with its path.
     Unix(UnixListener, PathBuf),
+}
+
+impl Drop for Listener {
+    /// A Unix socket's file goes with its listener.
+    fn drop(&mut self) {
+        if let Listener::Unix(_, path) = self {
+            let _ = std::fs::remove_file(path);
+        }
+    }
 }
 
 impl Listener {
@@ -175,6 +195,21 @@ impl Write for Stream {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_stale_unix_socket_is_replaced_and_a_live_one_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("robot.sock");
+        let address = RobotAddress::Unix(path.clone());
+        // A socket file nobody listens on any more.
+        drop(std::os::unix::net::UnixListener::bind(&path).unwrap());
+        assert!(path.exists());
+        let live = address.listen().expect("the stale socket is replaced");
+        let err = address.listen().expect_err("a live server's socket is kept");
+        assert_eq!(err.kind(), std::io::ErrorKind::AddrInUse);
+        drop(live);
+        assert!(!path.exists(), "the listener removes its socket file");
+    }
 
     #[test]
     fn addresses_read_and_print() {
