@@ -31,6 +31,7 @@ import math
 import os
 import queue
 import socket
+import stat
 import threading
 import time
 from typing import Any, Callable, Dict, Iterable, List, Optional, Tuple, Union
@@ -734,7 +735,19 @@ class RobotServer:
     def _listen(self, kind: str, where: Any) -> socket.socket:
         if kind == "unix":
             if os.path.exists(where):
-                raise FileExistsError("{} already exists; remove it or choose another socket path".format(where))
+                # A socket file left by a server that is gone (nothing answers on it) is
+                # replaced; one a live server holds, or any other file, is not.
+                probe = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+                try:
+                    probe.connect(where)
+                    live = True
+                except OSError:
+                    live = False
+                finally:
+                    probe.close()
+                if live or not stat.S_ISSOCK(os.stat(where).st_mode):
+                    raise FileExistsError("{} is in use; stop the server holding it or choose another socket path".format(where))
+                os.remove(where)
             sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
             try:
                 sock.bind(where)
