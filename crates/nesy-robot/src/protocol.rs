@@ -349,14 +349,14 @@ mod schema_tests {
         assert_eq!(kinds.len(), errors.len(), "one schema entry per error kind");
         for error in errors {
             let wire = serde_json::to_value(&error).unwrap();
-            assert_eq!(wire["kind"], error.kind());
+            let kind = &wire["kind"];
             let entry = kinds
                 .iter()
-                .find(|k| k["properties"]["kind"]["const"] == error.kind())
-                .unwrap_or_else(|| panic!("no schema entry for {}", error.kind()));
+                .find(|k| &k["properties"]["kind"]["const"] == kind)
+                .unwrap_or_else(|| panic!("no schema entry for {kind}"));
             let fields: BTreeSet<&String> = wire.as_object().unwrap().keys().collect();
             let described: BTreeSet<&String> = entry["properties"].as_object().unwrap().keys().collect();
-            assert_eq!(fields, described, "{}", error.kind());
+            assert_eq!(fields, described, "{kind}");
             assert_eq!(serde_json::from_value::<ApiError>(wire).unwrap(), error);
         }
     }

@@ -371,25 +371,6 @@ pub enum ApiError {
     },
 }
 
-impl ApiError {
-    /// The error's kind as the JSON `kind` field names it (`infeasible`, `collision`, ...).
-    pub fn kind(&self) -> &'static str {
-        match self {
-            ApiError::WrongEmbodiment { .. } => "wrong_embodiment",
-            ApiError::UnknownObject { .. } => "unknown_object",
-            ApiError::Infeasible { .. } => "infeasible",
-            ApiError::OutOfWorkspace { .. } => "out_of_workspace",
-            ApiError::IkFailed { .. } => "ik_failed",
-            ApiError::InvalidArgument { .. } => "invalid_argument",
-            ApiError::NoEmptySpace { .. } => "no_empty_space",
-            ApiError::Collision { .. } => "collision",
-            ApiError::BudgetExhausted { .. } => "budget_exhausted",
-            ApiError::Stopped { .. } => "stopped",
-            ApiError::TimedOut { .. } => "timed_out",
-        }
-    }
-}
-
 /// One entry of an execution trace.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TraceEntry {

@@ -216,7 +216,7 @@ pub(crate) fn run(args: AdaptArgs) -> anyhow::Result<ExitCode> {
         eprintln!("error: {error} (outputs written to {})", run.out_dir.display());
     }
     if let Some(address) = &args.robot.robot {
-        return execute_on_robot(&args, address, &run, &options);
+        return execute_on_robot(&args, address, &run, &target, &options);
     }
     Ok(ExitCode::from(run.exit_code()))
 }
@@ -228,6 +228,7 @@ fn execute_on_robot(
     args: &AdaptArgs,
     address: &nesy_robot::RobotAddress,
     run: &pipeline::AdaptRun,
+    target: &TargetInput,
     options: &AdaptOptions,
 ) -> anyhow::Result<ExitCode> {
     use super::robot::{DryRun, dry_run_verdict};
@@ -257,14 +258,6 @@ fn execute_on_robot(
             run.not_executed.as_deref().unwrap_or("not executed")
         ),
     };
-    let expected = match &run.execution {
-        Some(execution) => Some(
-            nesy_sim::scene::SceneSpec::from_file(&execution.scene_path)
-                .with_context(|| format!("reading {}", execution.scene_path.display()))?
-                .embodiment,
-        ),
-        None => None,
-    };
     let run_dir = run.out_dir.join("robot");
     let policy_file = run.out_dir.join("policy.py").display().to_string();
     let robot_run = super::robot::RobotRun {
@@ -273,7 +266,7 @@ fn execute_on_robot(
         limits: &options.limits,
         dry_run,
         run_dir: &run_dir,
-        expected,
+        expected: Some(target.embodiment),
     };
     let (result, _record) = super::robot::run_on_robot(&args.robot, address, robot_run)?;
     let stop = super::robot::describe_stop(&result.outcome)

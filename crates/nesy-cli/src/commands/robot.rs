@@ -156,13 +156,7 @@ pub(crate) fn run_on_robot(
     let mut result = ran.with_context(|| format!("running {policy_file} on the robot at {address}"))?;
     result.name_policy_file(policy_file);
     let dry = match dry_run {
-        DryRun::Passed { scene, result } => json!({
-            "skipped": false,
-            "scene": scene,
-            "outcome": result.outcome.kind(),
-            "subtasks": result.subtasks,
-            "api_calls": result.trace.len(),
-        }),
+        DryRun::Passed { scene, result } => passed_dry_run_json(scene, result),
         DryRun::Skipped => json!({"skipped": true}),
     };
     let record = json!({
@@ -187,13 +181,18 @@ pub(crate) fn not_contacted_json(scene: &Path, result: &ExecutionResult, why: &s
     json!({
         "contacted": false,
         "reason": why,
-        "dry_run": {
-            "skipped": false,
-            "scene": scene,
-            "outcome": result.outcome.kind(),
-            "subtasks": result.subtasks,
-            "api_calls": result.trace.len(),
-        },
+        "dry_run": passed_dry_run_json(scene, result),
+    })
+}
+
+/// A dry run that ran, as the records show it.
+fn passed_dry_run_json(scene: &Path, result: &ExecutionResult) -> serde_json::Value {
+    json!({
+        "skipped": false,
+        "scene": scene,
+        "outcome": result.outcome.kind(),
+        "subtasks": result.subtasks,
+        "api_calls": result.trace.len(),
     })
 }
 

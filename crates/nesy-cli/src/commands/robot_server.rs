@@ -45,8 +45,9 @@ pub(crate) fn run(args: RobotServerArgs) -> anyhow::Result<ExitCode> {
         path: scene.clone(),
         embodiment: args.embodiment,
     };
-    // Build one episode up front so that a bad scene is reported before anyone connects.
-    SimEpisodes.build(&spec).map_err(anyhow::Error::from)?;
+    // The first session's episode is built up front, so that a bad scene is reported before
+    // anyone connects.
+    let mut ready = Some(SimEpisodes.build(&spec).map_err(anyhow::Error::from)?);
     let options = ServerOptions {
         robot_name: format!("nesy simulator: {}", args.scene.display()),
         heartbeat_timeout: Duration::from_millis(super::seconds_to_ms(
@@ -72,7 +73,10 @@ pub(crate) fn run(args: RobotServerArgs) -> anyhow::Result<ExitCode> {
         json!({"address": address.to_string(), "scene": scene}),
     );
     loop {
-        let episode = SimEpisodes.build(&spec).map_err(anyhow::Error::from)?;
+        let episode = match ready.take() {
+            Some(episode) => episode,
+            None => SimEpisodes.build(&spec).map_err(anyhow::Error::from)?,
+        };
         let end = serve_session(&listener, episode, &options, &log).context("serving a session")?;
         log.event("session_ended", json!({"end": format!("{end:?}")}));
         if args.once {

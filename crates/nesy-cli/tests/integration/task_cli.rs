@@ -9,25 +9,14 @@ use serde_json::Value;
 
 /// `nesy task new --source S --target T --out OUT --size 64`: exit code, stdout, stderr.
 fn task_new(source: &Path, target: &Path, out: &Path) -> (Option<i32>, String, String) {
-    let args: Vec<String> = [
-        "task".to_owned(),
-        "new".to_owned(),
-        "--source".to_owned(),
+    let (source, target, out) = (
         source.display().to_string(),
-        "--target".to_owned(),
         target.display().to_string(),
-        "--out".to_owned(),
         out.display().to_string(),
-        "--size".to_owned(),
-        "64".to_owned(),
-    ]
-    .to_vec();
-    let output = common::nesy(&args);
-    (
-        output.status.code(),
-        String::from_utf8_lossy(&output.stdout).into_owned(),
-        String::from_utf8_lossy(&output.stderr).into_owned(),
-    )
+    );
+    common::run(&[
+        "task", "new", "--source", &source, "--target", &target, "--out", &out, "--size", "64",
+    ])
 }
 
 /// The pick-and-place fixture scene with `edit` applied, written to `dir/name`.

@@ -354,20 +354,18 @@ impl Relaying<'_> {
             .relay
             .answer(call)
             .map_err(|stop| robot_stopped(&label, stop))?;
-        if let Err(error) = &result
-            && !crate::relay::can_report_error(call)
-        {
-            return Err(robot_stopped(
-                &label,
-                RelayStop {
-                    reason: RobotStopReason::UnexpectedError,
-                    message: format!(
-                        "the robot answered with an error ({error}), which this call cannot report to the policy"
-                    ),
-                },
-            ));
-        }
         if let Err(error) = &result {
+            if !crate::relay::can_report_error(call) {
+                return Err(robot_stopped(
+                    &label,
+                    RelayStop {
+                        reason: RobotStopReason::UnexpectedError,
+                        message: format!(
+                            "the robot answered with an error ({error}), which this call cannot report to the policy"
+                        ),
+                    },
+                ));
+            }
             self.first_error = Some(format!("{label} with an error ({error})"));
         }
         self.reply(&RelayReply::Call { result }, &label)
