@@ -275,6 +275,51 @@ impl Formula {
     }
 }
 
+impl AtomPattern {
+    /// The pattern with every constant argument passed through `rename` (variables stay).
+    pub fn rename_constants(&self, rename: &impl Fn(Symbol) -> Symbol) -> AtomPattern {
+        AtomPattern {
+            pred: self.pred,
+            args: self
+                .args
+                .iter()
+                .map(|t| match t {
+                    Term::Const(c) => Term::Const(rename(*c)),
+                    Term::Var(_) => *t,
+                })
+                .collect(),
+        }
+    }
+}
+
+impl Formula {
+    /// The formula with every object constant passed through `rename`: how one asset's
+    /// schemas are made from another's whose parts are named differently.
+    pub fn rename_constants(&self, rename: &impl Fn(Symbol) -> Symbol) -> Formula {
+        let term = |t: &Term| match t {
+            Term::Const(c) => Term::Const(rename(*c)),
+            Term::Var(_) => *t,
+        };
+        match self {
+            Formula::Atom(p) => Formula::Atom(p.rename_constants(rename)),
+            Formula::Eq(a, b) => Formula::Eq(term(a), term(b)),
+            Formula::Not(f) => Formula::Not(Box::new(f.rename_constants(rename))),
+            Formula::And(fs) => Formula::And(fs.iter().map(|f| f.rename_constants(rename)).collect()),
+            Formula::Or(fs) => Formula::Or(fs.iter().map(|f| f.rename_constants(rename)).collect()),
+            Formula::Imply(a, b) => Formula::Imply(
+                Box::new(a.rename_constants(rename)),
+                Box::new(b.rename_constants(rename)),
+            ),
+            Formula::Forall(vars, body) => {
+                Formula::Forall(vars.clone(), Box::new(body.rename_constants(rename)))
+            }
+            Formula::Exists(vars, body) => {
+                Formula::Exists(vars.clone(), Box::new(body.rename_constants(rename)))
+            }
+        }
+    }
+}
+
 fn terms_constants(terms: &[Term], out: &mut Vec<Symbol>) {
     for t in terms {
         if let Term::Const(c) = t
@@ -444,6 +489,25 @@ impl Effect {
             Effect::When(c, es) => Effect::When(
                 c.substitute(bindings),
                 es.iter().map(|e| e.substitute(bindings)).collect(),
+            ),
+        }
+    }
+}
+
+impl Effect {
+    /// The effect with every object constant passed through `rename`
+    /// ([`Formula::rename_constants`]).
+    pub fn rename_constants(&self, rename: &impl Fn(Symbol) -> Symbol) -> Effect {
+        match self {
+            Effect::Add(p) => Effect::Add(p.rename_constants(rename)),
+            Effect::Del(p) => Effect::Del(p.rename_constants(rename)),
+            Effect::Forall(vars, es) => Effect::Forall(
+                vars.clone(),
+                es.iter().map(|e| e.rename_constants(rename)).collect(),
+            ),
+            Effect::When(c, es) => Effect::When(
+                c.rename_constants(rename),
+                es.iter().map(|e| e.rename_constants(rename)).collect(),
             ),
         }
     }

@@ -109,6 +109,31 @@ impl Operator {
         out
     }
 
+    /// The operator named `name` with every object constant of its preconditions and
+    /// effects passed through `rename` (parameters and arguments stay).
+    ///
+    /// ```
+    /// use nesy_core::{Operator, Symbol};
+    /// use nesy_core::text::parse_formula;
+    ///
+    /// let open = Operator::new("open-top-drawer", vec![parse_formula("(Closed top_drawer)").unwrap()], vec![]);
+    /// let front = open.with_constants_renamed("open-front-top-drawer", &|c| Symbol::new(&format!("front_{c}")));
+    /// assert_eq!(front.pre[0].to_string(), "(Closed front_top_drawer)");
+    /// ```
+    pub fn with_constants_renamed(
+        &self,
+        name: impl Into<String>,
+        rename: &impl Fn(Symbol) -> Symbol,
+    ) -> Operator {
+        Operator {
+            name: name.into(),
+            params: self.params.clone(),
+            args: self.args.clone(),
+            pre: self.pre.iter().map(|f| f.rename_constants(rename)).collect(),
+            eff: self.eff.iter().map(|e| e.rename_constants(rename)).collect(),
+        }
+    }
+
     /// Binds a lifted schema's parameters to objects, checking count and types against the
     /// universe, and substitutes them structurally.
     pub fn instantiate(&self, args: &[Symbol], universe: &Universe) -> Result<Operator, GroundError> {

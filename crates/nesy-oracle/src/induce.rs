@@ -15,11 +15,13 @@ use serde::{Deserialize, Serialize};
 use nesy_core::Embodiment;
 use nesy_reasoner::InductionContext;
 use nesy_sim::api::ApiCall;
-use nesy_sim::domain::{WorldDomain, semantic};
+use nesy_sim::domain::{WorldDomain, schema_instance, semantic};
 
 /// The robot API function a schema of the true domain stands for, on an end effector.
 pub fn api_function(schema: &str, embodiment: Embodiment) -> Option<&'static str> {
     let vacuum = embodiment == Embodiment::Vacuum;
+    // An asset's schema (`open-front-top-drawer`) calls what the table's schema calls.
+    let schema = schema_instance(schema).map_or(schema, |i| i.schema.name);
     let s = schema.strip_prefix("suction-").unwrap_or(schema);
     let release = if vacuum {
         "deactivate_vacuum"
@@ -101,12 +103,14 @@ struct Candidate {
 }
 
 /// The handle a handle schema works with, from its name (`grasp-hinge-handle` →
-/// `hinge_handle`); the schemas cannot say it in the vocabulary, which has no predicate
-/// for "the tool is at the handle".
-pub(crate) fn schema_handle(schema: &str) -> Option<&'static str> {
+/// `hinge_handle`, `grasp-front-top-drawer-handle` → `front_top_drawer_handle`); the schemas
+/// cannot say it in the vocabulary, which has no predicate for "the tool is at the handle".
+pub(crate) fn schema_handle(schema: &str) -> Option<String> {
+    let instance = schema_instance(schema)?;
     ["hinge_handle", "bottom_drawer_handle", "top_drawer_handle"]
         .into_iter()
-        .find(|h| schema.contains(&h.replace('_', "-")))
+        .find(|h| instance.schema.name.contains(&h.replace('_', "-")))
+        .map(|h| instance.asset_part(h))
 }
 
 /// The loose object a call works on: the one `move_gripper_to` names, else the one held
@@ -219,7 +223,7 @@ pub fn induce(
             // Handle schemas need their handle in the scene, and the call's handle when it
             // names one (move_gripper_to, grasp_handle, attach_vacuum_handle).
             Some(h) => {
-                universe.contains(Symbol::new(h))
+                universe.contains(Symbol::new(&h))
                     && (!s.name.contains("move-to-")
                         && !s.name.starts_with("grasp-")
                         && !s.name.starts_with("attach-")
@@ -232,7 +236,8 @@ pub fn induce(
     let schemas: Vec<Operator> = schemas
         .into_iter()
         .filter(|s| {
-            let name = s.name.strip_prefix("suction-").unwrap_or(&s.name);
+            let base = schema_instance(&s.name).map_or(s.name.as_str(), |i| i.schema.name);
+            let name = base.strip_prefix("suction-").unwrap_or(base);
             match (name, direction) {
                 ("open-hinge-lid" | "close-hinge-lid", Some(d)) => name == d,
                 _ => true,

@@ -104,3 +104,46 @@ fn a_goal_that_cannot_be_planned_is_refused_with_the_reason() {
     );
     assert!(!dir.path().join("out").exists());
 }
+
+#[test]
+fn a_task_between_two_cabinets_is_adapted_to_cabinets_at_right_angles() {
+    let root = common::workspace();
+    let dir = common::scratch();
+    let out = dir.path().join("two-cabinets");
+    // The demonstration: two cabinets side by side, a cube for each one's bottom drawer. The
+    // target: the cabinets at right angles (their bottom drawers open into each other's
+    // way) and the blue cube stacked on the red one.
+    let (code, stdout, stderr) = task_new(
+        &root.join("fixtures/scenes/drawers_side_by_side_finger.json"),
+        &root.join("fixtures/scenes/drawers_perpendicular_stacked_finger.json"),
+        &out,
+    );
+    assert_eq!(code, Some(0), "{stdout}{stderr}");
+    let plan = std::fs::read_to_string(out.join("plan.txt")).unwrap();
+    assert!(plan.contains("OpenSideBottomDrawer"), "{plan}");
+    assert!(
+        plan.contains(
+            "(not (and (Blocks front_bottom_drawer side_bottom_drawer) (Open front_bottom_drawer)))"
+        ),
+        "opening one cabinet's drawer needs the other's in its way shut: {plan}"
+    );
+
+    let adapted = dir.path().join("adapted");
+    let vocabulary = root.join("fixtures/vocabulary/blocking-drawers.toml");
+    let (code, stdout, stderr) = common::adapt(
+        &out.join("demo.mcap"),
+        &out.join("target.json"),
+        "oracle",
+        &adapted,
+        &[
+            "--execute",
+            "--codegen",
+            "template",
+            "--vocabulary",
+            vocabulary.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(code, Some(0), "{stdout}{stderr}");
+    assert!(stdout.contains("MoveToSurroundRedCube: unmet"), "{stdout}");
+    assert!(stdout.contains("SR 1"), "{stdout}");
+}

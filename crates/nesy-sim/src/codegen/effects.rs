@@ -12,7 +12,7 @@
 use nesy_core::Operator;
 use nesy_core::{Effect, Formula};
 
-use crate::domain::{SchemaKind as Kind, kind_of, schemas};
+use crate::domain::{SchemaKind as Kind, instance_name, kind_of, schemas, split_asset_part};
 use crate::scene::parts;
 
 /// A ground literal: predicate and arguments.
@@ -55,7 +55,7 @@ fn positive_pre(pre: &[Formula]) -> Vec<Lit> {
 }
 
 /// The handles, the part each one moves (the observer may name either) and the schemas'
-/// word for it.
+/// word for it (bare names; an asset named with a prefix has them under its prefix).
 const HANDLES: [(&str, &str, &str); 3] = [
     (parts::HINGE_HANDLE, parts::HINGE_LID, "hinge"),
     (parts::BOTTOM_DRAWER_HANDLE, parts::BOTTOM_DRAWER, "bottom-drawer"),
@@ -72,7 +72,7 @@ fn is_surrounding(pred: &str) -> bool {
 
 /// The schema name and arguments an operator performs, judged from its effects and
 /// preconditions; `None` if they match no schema (e.g. an action without physical effects).
-pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(&'static str, Vec<String>)> {
+pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(String, Vec<String>)> {
     let ev = Evidence {
         adds: lits(&op.eff, true),
         dels: lits(&op.eff, false),
@@ -95,13 +95,20 @@ pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(&'
     // retreat, or an approach to a handle, which the grasp that follows makes itself). An
     // operator with no effects at all says nothing and stays unknown.
     if ev.adds.is_empty() && ev.dels.is_empty() && !op.eff.is_empty() {
-        return Some(("retreat", Vec::new()));
+        return Some(("retreat".to_owned(), Vec::new()));
     }
     None
 }
 
-/// A schema name with its arguments, or `None` when the operator matches no schema.
-type Verdict = Option<(&'static str, Vec<String>)>;
+/// A schema name (for an asset named with a prefix, the schema's name for it) with its
+/// arguments, or `None` when the operator matches no schema.
+type Verdict = Option<(String, Vec<String>)>;
+
+/// A verdict for the table's schema `name` working on no asset, or on the asset of `part`.
+fn named(name: &str, part: Option<&str>, args: Vec<String>) -> Verdict {
+    let prefix = part.and_then(split_asset_part).map_or("", |(prefix, _)| prefix);
+    Some((instance_name(name, prefix), args))
+}
 
 /// True if the object is a loose one the robot picks and places.
 fn is_item(o: &str) -> bool {
@@ -170,16 +177,17 @@ impl Evidence<'_> {
         ];
         for (x, opened) in changes {
             if let Some(x) = x {
-                let schema = match (x.as_str(), opened) {
-                    (parts::HINGE_LID, true) => "open-hinge-lid",
-                    (parts::HINGE_LID, false) => "close-hinge-lid",
-                    (parts::BOTTOM_DRAWER, true) => "open-bottom-drawer",
-                    (parts::BOTTOM_DRAWER, false) => "close-bottom-drawer",
-                    (parts::TOP_DRAWER, true) => "open-top-drawer",
-                    (parts::TOP_DRAWER, false) => "close-top-drawer",
+                let bare = split_asset_part(&x).map(|(_, bare)| bare);
+                let schema = match (bare, opened) {
+                    (Some(parts::HINGE_LID), true) => "open-hinge-lid",
+                    (Some(parts::HINGE_LID), false) => "close-hinge-lid",
+                    (Some(parts::BOTTOM_DRAWER), true) => "open-bottom-drawer",
+                    (Some(parts::BOTTOM_DRAWER), false) => "close-bottom-drawer",
+                    (Some(parts::TOP_DRAWER), true) => "open-top-drawer",
+                    (Some(parts::TOP_DRAWER), false) => "close-top-drawer",
                     _ => continue,
                 };
-                return Some(Some((schema, Vec::new())));
+                return Some(named(schema, Some(&x), Vec::new()));
             }
         }
         None
@@ -188,25 +196,25 @@ impl Evidence<'_> {
     /// Handles: approached, grasped, let go.
     fn handle_action(&self) -> Option<Verdict> {
         for (handle, part, what) in HANDLES {
+            let of_it = |o: &str| split_asset_part(o).is_some_and(|(_, bare)| bare == handle || bare == part);
             let on = |v: &[Lit], pred: fn(&str) -> bool| {
                 v.iter()
-                    .any(|(p, a)| pred(p) && a.len() == 1 && (a[0] == handle || a[0] == part))
+                    .find(|(p, a)| pred(p) && a.len() == 1 && of_it(&a[0]))
+                    .map(|(_, a)| a[0].clone())
             };
-            let schema = if on(&self.adds, is_holding) {
-                Some(format!("grasp-{what}-handle"))
-            } else if on(&self.dels, is_holding) {
-                Some(format!("release-{what}-handle"))
-            } else if on(&self.adds, is_surrounding) {
-                Some(format!("move-to-{what}-handle"))
+            let schema = if let Some(o) = on(&self.adds, is_holding) {
+                Some((format!("grasp-{what}-handle"), o))
+            } else if let Some(o) = on(&self.dels, is_holding) {
+                Some((format!("release-{what}-handle"), o))
             } else {
-                None
+                on(&self.adds, is_surrounding).map(|o| (format!("move-to-{what}-handle"), o))
             };
-            if let Some(name) = schema {
+            if let Some((name, object)) = schema {
                 return Some(
                     schemas()
                         .iter()
                         .find(|s| s.name == name)
-                        .map(|s| (s.name, Vec::new())),
+                        .and_then(|s| named(s.name, Some(&object), Vec::new())),
                 );
             }
         }
@@ -236,11 +244,12 @@ impl Evidence<'_> {
         else {
             return Some(None);
         };
-        Some(match (rest.as_str(), kind_of(&rest)) {
-            (parts::HINGE_BODY, _) => Some(("drop-into-hinge-body", vec![x])),
-            (parts::BOTTOM_DRAWER, _) => Some(("drop-into-bottom-drawer", vec![x])),
-            (_, Some(Kind::Surface)) => Some(("put-down", vec![x, rest])),
-            (_, Some(Kind::Box)) => Some(("release-into", vec![x, rest])),
+        let bare = split_asset_part(&rest).map(|(_, bare)| bare);
+        Some(match (bare, kind_of(&rest)) {
+            (Some(parts::HINGE_BODY), _) => named("drop-into-hinge-body", Some(&rest), vec![x]),
+            (Some(parts::BOTTOM_DRAWER), _) => named("drop-into-bottom-drawer", Some(&rest), vec![x]),
+            (_, Some(Kind::Surface)) => named("put-down", None, vec![x, rest]),
+            (_, Some(Kind::Box)) => named("release-into", None, vec![x, rest]),
             _ => None,
         })
     }
@@ -248,10 +257,10 @@ impl Evidence<'_> {
     /// An item grasped, or the hand brought around one.
     fn grasp_or_approach(&self) -> Option<Verdict> {
         if let Some(x) = self.add1(&|p| is_holding(p)).filter(|x| is_item(x)) {
-            return Some(Some(("grasp", vec![x])));
+            return Some(named("grasp", None, vec![x]));
         }
         if let Some(x) = self.add1(&|p| is_surrounding(p)).filter(|x| is_item(x)) {
-            return Some(Some(("move-to-surround", vec![x])));
+            return Some(named("move-to-surround", None, vec![x]));
         }
         None
     }
@@ -259,9 +268,9 @@ impl Evidence<'_> {
     /// An item brought over, into or onto a place.
     fn carry_to_place(&self) -> Option<Verdict> {
         if let Some((x, place)) = self.add2("OverOf").into_iter().find(|(x, _)| is_item(x)) {
-            return Some(match place.as_str() {
-                parts::HINGE_BODY => Some(("carry-over-hinge-body", vec![x])),
-                parts::BOTTOM_DRAWER => Some(("carry-over-bottom-drawer", vec![x])),
+            return Some(match split_asset_part(&place).map(|(_, bare)| bare) {
+                Some(parts::HINGE_BODY) => named("carry-over-hinge-body", Some(&place), vec![x]),
+                Some(parts::BOTTOM_DRAWER) => named("carry-over-bottom-drawer", Some(&place), vec![x]),
                 _ => None,
             });
         }
@@ -274,9 +283,9 @@ impl Evidence<'_> {
             // carried in.
             return Some(
                 if b == parts::LEFT_CHESS_BOX || b == parts::RIGHT_CHESS_BOX || !self.held(&x) {
-                    Some(("sweep-into", vec![x, b]))
+                    named("sweep-into", None, vec![x, b])
                 } else {
-                    Some(("carry-into", vec![x, b]))
+                    named("carry-into", None, vec![x, b])
                 },
             );
         }
@@ -285,7 +294,7 @@ impl Evidence<'_> {
             .into_iter()
             .find(|(x, s)| is_item(x) && kind_of(s) == Some(Kind::Surface) && self.held(x))
         {
-            return Some(Some(("carry-onto", vec![x, s])));
+            return Some(named("carry-onto", None, vec![x, s]));
         }
         None
     }
@@ -300,7 +309,11 @@ impl Evidence<'_> {
                 && self.held(&a[0])
         }) && self.objects.iter().any(|o| o == parts::FLOOR)
         {
-            return Some(Some(("carry-onto", vec![a[0].clone(), parts::FLOOR.to_owned()])));
+            return Some(named(
+                "carry-onto",
+                None,
+                vec![a[0].clone(), parts::FLOOR.to_owned()],
+            ));
         }
         None
     }

@@ -25,7 +25,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::api::Embodiment;
 use crate::api::MAX_FINGER_DEPTH;
-use crate::domain::{Motion, Schema, SchemaKind as Kind, kind_of, schema, schemas};
+use crate::domain::{
+    Motion, Schema, SchemaInstance, SchemaKind as Kind, asset_of, asset_prefixes, instance_name, kind_of,
+    schema_instance, schemas,
+};
 use crate::scene::{TABLE_TOP, parts};
 use crate::world::FLOOR_AABB;
 use Motion::*;
@@ -94,7 +97,9 @@ def clear_angle(name):
 pub struct ResolvedAction {
     /// The action's name as given (for one step of a joined action, the part naming it).
     pub name: String,
-    /// The schema it names.
+    /// The schema it names: the table's name, or for an asset named with a prefix the
+    /// schema's name for that asset (`open-front-top-drawer`, see
+    /// [`crate::domain::SchemaInstance`]).
     pub schema: String,
     /// What it does.
     pub motion: Motion,
@@ -163,14 +168,25 @@ fn match_args(rest: &str, params: &[Kind], objects: &[String]) -> Option<Vec<Str
 /// arguments among `objects`.
 pub fn resolve_action(name: &str, objects: &[String]) -> Option<ResolvedAction> {
     let key = camel(name);
-    let mut schemas: Vec<&Schema> = schemas().iter().collect();
-    schemas.sort_by_key(|s| std::cmp::Reverse(camel(s.name).len()));
-    schemas.into_iter().find_map(|schema| {
-        let rest = key.strip_prefix(camel(schema.name).as_str())?;
+    // The table's schemas, and each asset schema under the name it has for every asset of
+    // the scene named with a prefix (`OpenFrontTopDrawer`).
+    let prefixes = asset_prefixes(objects.iter().map(String::as_str));
+    let mut named: Vec<(String, &Schema)> = schemas().iter().map(|s| (s.name.to_owned(), s)).collect();
+    for prefix in &prefixes {
+        named.extend(
+            schemas()
+                .iter()
+                .filter(|s| asset_of(s.name).is_some())
+                .map(|s| (instance_name(s.name, prefix), s)),
+        );
+    }
+    named.sort_by_key(|(n, _)| std::cmp::Reverse(camel(n).len()));
+    named.into_iter().find_map(|(schema_name, schema)| {
+        let rest = key.strip_prefix(camel(&schema_name).as_str())?;
         let args = match_args(rest, schema.params, objects)?;
         Some(ResolvedAction {
             name: name.to_owned(),
-            schema: schema.name.to_owned(),
+            schema: schema_name,
             motion: schema.motion,
             args,
         })
@@ -197,10 +213,10 @@ pub fn resolve_steps(name: &str, objects: &[String]) -> Option<Vec<ResolvedActio
 /// names no schema: how operators named freely by a model are compiled.
 pub fn resolve_by_effects(op: &Operator, objects: &[String]) -> Option<ResolvedAction> {
     let (name, args) = effects::schema_by_effects(op, objects)?;
-    let schema = schema(name);
+    let schema = schema_instance(&name)?.schema;
     (schema.params.len() == args.len()).then(|| ResolvedAction {
         name: op.name.clone(),
-        schema: name.to_owned(),
+        schema: name,
         motion: schema.motion,
         args,
     })
@@ -286,14 +302,14 @@ impl Emitter<'_> {
         }
     }
 
-    fn move_to_handle(&mut self, handle: &str, sideways: bool) {
+    fn move_to_handle(&mut self, asset: &SchemaInstance, handle: &str, sideways: bool) {
         if sideways {
             // The suction tool reaches the bottom handle pointing at the cabinet: from above
             // its wrist would sweep cylinders off the cabinet's front edge (as the expert).
             self.line(&format!(
                 "pointing = \"right\" if get_obj_pos({:?})[1] < get_obj_pos({:?})[1] else \"left\"",
-                parts::BOTTOM_DRAWER_HANDLE,
-                parts::DRAWER_BODY
+                asset.asset_part(parts::BOTTOM_DRAWER_HANDLE),
+                asset.asset_part(parts::DRAWER_BODY)
             ));
             self.line(&format!("move_gripper_to({handle:?}, pointing_to=pointing)"));
             self.pointing = true;
@@ -334,18 +350,34 @@ impl Emitter<'_> {
         }
     }
 
-    fn drawer_directions(&mut self) {
-        // Drawers slide out toward the side their handles are on (as the expert decides).
+    /// The policy variables `along_y` (the cabinet's drawers slide along y) and `outward`
+    /// (the sign of the direction they open in along that axis): drawers slide out toward
+    /// the side their handles are on (as the expert decides).
+    fn drawer_axis(&mut self, asset: &SchemaInstance) {
         self.line(&format!(
-            "handle_y = get_obj_pos({:?})[1]",
-            parts::BOTTOM_DRAWER_HANDLE
+            "handle = get_obj_pos({:?})",
+            asset.asset_part(parts::BOTTOM_DRAWER_HANDLE)
         ));
-        self.line(&format!("cabinet_y = get_obj_pos({:?})[1]", parts::DRAWER_BODY));
-        self.line("open_dir = \"left\" if handle_y < cabinet_y else \"right\"");
-        self.line("close_dir = \"right\" if open_dir == \"left\" else \"left\"");
         self.line(&format!(
-            "travel = get_obj_size({:?})[1] * {DRAWER_PULL_FRACTION}",
-            parts::BOTTOM_DRAWER
+            "cabinet = get_obj_pos({:?})",
+            asset.asset_part(parts::DRAWER_BODY)
+        ));
+        self.line("along_y = abs(handle[1] - cabinet[1]) >= abs(handle[0] - cabinet[0])");
+        self.line("outward = -1.0 if handle[1 if along_y else 0] < cabinet[1 if along_y else 0] else 1.0");
+    }
+
+    fn drawer_directions(&mut self, asset: &SchemaInstance) {
+        self.drawer_axis(asset);
+        self.line("if along_y:");
+        self.line("    open_dir = \"left\" if outward < 0 else \"right\"");
+        self.line("else:");
+        self.line("    open_dir = \"back\" if outward < 0 else \"front\"");
+        self.line(
+            "close_dir = {\"left\": \"right\", \"right\": \"left\", \"back\": \"front\", \"front\": \"back\"}[open_dir]",
+        );
+        self.line(&format!(
+            "travel = get_obj_size({:?})[1 if along_y else 0] * {DRAWER_PULL_FRACTION}",
+            asset.asset_part(parts::BOTTOM_DRAWER)
         ));
     }
 }
@@ -353,12 +385,20 @@ impl Emitter<'_> {
 /// Whether the handle action at `i` is followed, before any other handle is taken, by
 /// pulling the bottom drawer open.
 fn opens_bottom_drawer(actions: &[ResolvedAction], i: usize) -> bool {
-    let handle = schema(&actions[i].schema).part;
-    handle == Some(parts::BOTTOM_DRAWER_HANDLE)
+    let asset = instance(&actions[i]);
+    let handle = asset.part();
+    asset.schema.part == Some(parts::BOTTOM_DRAWER_HANDLE)
         && actions[i + 1..]
             .iter()
-            .take_while(|a| a.motion != GraspHandle || schema(&a.schema).part == handle)
-            .any(|a| a.motion == OpenDrawer && schema(&a.schema).part == Some(parts::BOTTOM_DRAWER))
+            .take_while(|a| a.motion != GraspHandle || instance(a).part() == handle)
+            .any(|a| {
+                a.motion == OpenDrawer && instance(a).part() == Some(asset.asset_part(parts::BOTTOM_DRAWER))
+            })
+}
+
+/// The schema instance a resolved action names (resolution only makes names that have one).
+fn instance(action: &ResolvedAction) -> SchemaInstance {
+    schema_instance(&action.schema).expect("resolved actions name schema instances")
 }
 
 fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
@@ -400,7 +440,9 @@ impl Emitter<'_> {
     /// The calls for action `i` of the procedure.
     fn action(&mut self, i: usize, a: &ResolvedAction) {
         let arg = |k: usize| a.args.get(k).map(String::as_str).unwrap_or_default();
-        let part = schema(&a.schema).part.unwrap_or_default();
+        let asset = instance(a);
+        let part = asset.part().unwrap_or_default();
+        let part = part.as_str();
         match a.motion {
             MoveToObject => self.move_to_object(i, arg(0)),
             Take => {
@@ -420,8 +462,8 @@ impl Emitter<'_> {
                 self.carry_onto(arg(0), surface);
             }
             CarryInto => self.carry_into(arg(0), arg(1)),
-            CarryOverHinge => self.carry_over_hinge(arg(0)),
-            CarryOverDrawer => self.carry_over_drawer(arg(0)),
+            CarryOverHinge => self.carry_over_hinge(&asset, arg(0)),
+            CarryOverDrawer => self.carry_over_drawer(&asset, arg(0)),
             Push => self.push(i, arg(0), arg(1)),
             Retreat => {
                 let up = format!("move_parallel(\"up\", {DRAWER_RETREAT}");
@@ -433,10 +475,10 @@ impl Emitter<'_> {
             }
             MoveToHandle => {
                 let sideways = self.vacuum && opens_bottom_drawer(self.actions, i);
-                self.move_to_handle(part, sideways)
+                self.move_to_handle(&asset, part, sideways)
             }
-            GraspHandle => self.grasp_handle(i, part),
-            OpenLid | CloseLid => self.swing_lid(i, a.motion),
+            GraspHandle => self.grasp_handle(i, &asset, part),
+            OpenLid | CloseLid => self.swing_lid(i, &asset, a.motion),
             ReleaseHandle => {
                 if self.vacuum {
                     self.line("detach_vacuum_handle()");
@@ -445,7 +487,7 @@ impl Emitter<'_> {
                 }
             }
             OpenDrawer | CloseDrawer => {
-                self.drawer_directions();
+                self.drawer_directions(&asset);
                 let dir = if a.motion == OpenDrawer {
                     "open_dir"
                 } else {
@@ -535,11 +577,12 @@ impl Emitter<'_> {
         }
     }
 
-    fn carry_over_hinge(&mut self, x: &str) {
-        let k = self.next_drop(parts::HINGE_BODY);
+    fn carry_over_hinge(&mut self, asset: &SchemaInstance, x: &str) {
+        let body = asset.asset_part(parts::HINGE_BODY);
+        let k = self.next_drop(&body);
         let dy = HINGE_SPOTS[k % HINGE_SPOTS.len()];
         let hang = self.hang(&format!("get_obj_size({x:?})[2]"));
-        self.line(&format!("body = get_obj_bbox({:?})", parts::HINGE_BODY));
+        self.line(&format!("body = get_obj_bbox({body:?})"));
         self.line(&reachable_move(
             &format!(
                 "[(body[0][0] + body[1][0]) / 2, (body[0][1] + body[1][1]) / 2 + {dy}, body[1][2] + {hang} + {HINGE_DROP_CLEARANCE}]"
@@ -548,19 +591,16 @@ impl Emitter<'_> {
         ));
     }
 
-    fn carry_over_drawer(&mut self, x: &str) {
-        let k = self.next_drop(parts::BOTTOM_DRAWER);
-        let [dx, dy] = DRAWER_SPOTS[k % DRAWER_SPOTS.len()];
-        self.line(&format!(
-            "outward = -1.0 if get_obj_pos({:?})[1] < get_obj_pos({:?})[1] else 1.0",
-            parts::BOTTOM_DRAWER_HANDLE,
-            parts::DRAWER_BODY
-        ));
-        self.line(&format!("drawer = get_obj_pos({:?})", parts::BOTTOM_DRAWER));
+    fn carry_over_drawer(&mut self, asset: &SchemaInstance, x: &str) {
+        let drawer = asset.asset_part(parts::BOTTOM_DRAWER);
+        let k = self.next_drop(&drawer);
+        // A spot is an offset across the cabinet and one along the way its drawers open.
+        let [across, along] = DRAWER_SPOTS[k % DRAWER_SPOTS.len()];
+        self.drawer_axis(asset);
+        self.line(&format!("drawer = get_obj_pos({drawer:?})"));
         self.line(&reachable_move(
             &format!(
-                "[drawer[0] + {dx}, drawer[1] + {dy} * outward, drawer[2] + get_obj_size({:?})[2] + get_obj_size({x:?})[2] + {DRAWER_DROP_CLEARANCE}]",
-                parts::BOTTOM_DRAWER
+                "[drawer[0] + ({across} if along_y else {along} * outward), drawer[1] + ({along} * outward if along_y else {across}), drawer[2] + get_obj_size({drawer:?})[2] + get_obj_size({x:?})[2] + {DRAWER_DROP_CLEARANCE}]"
             ),
             "",
         ));
@@ -586,13 +626,13 @@ impl Emitter<'_> {
         ));
     }
 
-    fn grasp_handle(&mut self, i: usize, part: &str) {
+    fn grasp_handle(&mut self, i: usize, asset: &SchemaInstance, part: &str) {
         let moved = i > 0
             && self.actions[i - 1].motion == MoveToHandle
-            && schema(&self.actions[i - 1].schema).part == Some(part);
+            && instance(&self.actions[i - 1]).part().as_deref() == Some(part);
         if !moved {
             let sideways = self.vacuum && opens_bottom_drawer(self.actions, i);
-            self.move_to_handle(part, sideways);
+            self.move_to_handle(asset, part, sideways);
         }
         if self.vacuum {
             self.line(&format!("attach_vacuum_handle({part:?})"));
@@ -601,7 +641,7 @@ impl Emitter<'_> {
         }
     }
 
-    fn swing_lid(&mut self, i: usize, motion: Motion) {
+    fn swing_lid(&mut self, i: usize, asset: &SchemaInstance, motion: Motion) {
         // A demonstration records one action per waypoint of a swing, and a waypoint that has
         // not moved the lid yet may read either way: a run of lid actions is one arc, in the
         // direction of the run's last action.
@@ -615,8 +655,14 @@ impl Emitter<'_> {
         } else {
             &LID_CLOSING_ARC
         };
-        self.line(&format!("body = get_obj_bbox({:?})", parts::HINGE_BODY));
-        self.line(&format!("lid = get_obj_bbox({:?})", parts::HINGE_LID));
+        self.line(&format!(
+            "body = get_obj_bbox({:?})",
+            asset.asset_part(parts::HINGE_BODY)
+        ));
+        self.line(&format!(
+            "lid = get_obj_bbox({:?})",
+            asset.asset_part(parts::HINGE_LID)
+        ));
         self.line("lid_y = (lid[0][1] + lid[1][1]) / 2");
         self.line("reach = max(lid[1][0] - lid[0][0], lid[1][2] - lid[0][2])");
         self.line(&format!("for degrees in {arc:?}:"));

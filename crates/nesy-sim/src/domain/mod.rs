@@ -11,6 +11,7 @@ mod schemas;
 
 use std::sync::OnceLock;
 
+use nesy_core::Atom;
 use nesy_core::Operator;
 use nesy_core::State;
 use nesy_core::Symbol;
@@ -21,12 +22,17 @@ use nesy_core::{AtomPattern, Effect, Formula};
 use nesy_core::{TypeError, Universe};
 
 use crate::api::Embodiment;
+use crate::perception;
+use crate::scene::parts;
 
 /// The domain file as committed.
 pub const NESY_WORLD_PDDL: &str = include_str!("../../../../assets/pddl/nesy-world.pddl");
 
 pub use plan::{Planning, control_planner_config, plan_to_goal, printable};
-pub use schemas::{Motion, Schema, SchemaKind, kind_of, schema, schema_names, schemas};
+pub use schemas::{
+    Motion, Schema, SchemaInstance, SchemaKind, asset_of, asset_prefixes, instance_name, is_asset_part,
+    kind_of, schema, schema_instance, schema_names, schemas, split_asset_part,
+};
 
 /// Why the true domain could not be loaded (a defect of nesy's own files).
 #[derive(Debug, Clone, thiserror::Error)]
@@ -108,15 +114,62 @@ impl WorldDomain {
         Ok(WorldDomain { domain })
     }
 
-    /// The schemas of one end effector whose constants are all objects of the scene.
+    /// The schemas of one end effector for a scene: those whose constants are all objects
+    /// of the scene, then, for each asset named with a prefix (`front_drawer_body`), the
+    /// asset's schemas with its parts renamed ([`SchemaInstance`]). With two or more assets,
+    /// opening a lid or drawer also needs every other asset's moving link that would stand
+    /// in its way to be shut: `(not (and (Blocks o x) (Open o)))` for each other link `o`
+    /// (the observer states `Blocks` where the scene's geometry has it). A scene with one
+    /// asset under the bare names gets the domain file's schemas unchanged.
     pub fn schemas_for(&self, embodiment: Embodiment, universe: &Universe) -> Vec<Operator> {
-        self.domain
+        let own: Vec<&Operator> = self
+            .domain
             .actions
             .iter()
             .filter(|a| schema_embodiment(a) == embodiment)
+            .collect();
+        let mut out: Vec<Operator> = own
+            .iter()
             .filter(|a| a.constants().iter().all(|c| universe.contains(*c)))
-            .cloned()
-            .collect()
+            .map(|a| (*a).clone())
+            .collect();
+        let names: Vec<&str> = universe.objects().iter().map(|(o, _)| o.as_str()).collect();
+        for prefix in asset_prefixes(names.iter().copied()) {
+            for action in &own {
+                let Some((_, asset_parts)) = asset_of(&action.name) else {
+                    continue;
+                };
+                let renamed = action.with_constants_renamed(instance_name(&action.name, &prefix), &|c| {
+                    if asset_parts.contains(&c.as_str()) {
+                        Symbol::new(&format!("{prefix}{c}"))
+                    } else {
+                        c
+                    }
+                });
+                if renamed.constants().iter().all(|c| universe.contains(*c)) {
+                    out.push(renamed);
+                }
+            }
+        }
+        let links: Vec<&str> = names
+            .iter()
+            .copied()
+            .filter(|o| MOVING_LINKS.iter().any(|link| parts::has_part_suffix(o, link)))
+            .collect();
+        let assets = names
+            .iter()
+            .filter(|o| {
+                [parts::HINGE_BODY, parts::DRAWER_BODY]
+                    .iter()
+                    .any(|b| parts::has_part_suffix(o, b))
+            })
+            .count();
+        if assets >= 2 {
+            for op in &mut out {
+                add_blocking_preconditions(op, &links);
+            }
+        }
+        out
     }
 
     /// A typed universe of the scene's objects (see [`object_type`]); the robot's own
@@ -169,6 +222,44 @@ impl WorldDomain {
     }
 }
 
+/// The moving links of the articulated assets (bare names).
+const MOVING_LINKS: [&str; 3] = [parts::HINGE_LID, parts::TOP_DRAWER, parts::BOTTOM_DRAWER];
+
+/// Adds to a schema that opens a lid or drawer `x` the precondition that no other asset's
+/// moving link `o` among `links` that stands in its way is open:
+/// `(not (and (Blocks o x) (Open o)))`.
+fn add_blocking_preconditions(op: &mut Operator, links: &[&str]) {
+    let Some(instance) = schema_instance(&op.name) else {
+        return;
+    };
+    let opened = match instance.schema.motion {
+        Motion::OpenDrawer => instance.part(),
+        Motion::OpenLid => Some(instance.asset_part(parts::HINGE_LID)),
+        _ => None,
+    };
+    let Some(opened) = opened else {
+        return;
+    };
+    let prefix_of = |link: &str| {
+        MOVING_LINKS
+            .iter()
+            .find_map(|bare| link.strip_suffix(bare))
+            .unwrap_or_default()
+            .to_owned()
+    };
+    let own = prefix_of(&opened);
+    let mut pre: Vec<Formula> = op.pre.to_vec();
+    for other in links.iter().filter(|o| prefix_of(o) != own) {
+        let blocks = Atom::new(perception::observer::BLOCKS, &[*other, opened.as_str()]);
+        let open = Atom::new("Open", &[other]);
+        pre.push(Formula::Not(Box::new(Formula::And(vec![
+            Formula::atom(blocks),
+            Formula::atom(open),
+        ]))));
+    }
+    op.pre = pre.into();
+}
+
 /// The robot's own entry in a scene's object list (`gripper` or `vacuum_gripper`), which is
 /// not an object of the domain.
 fn is_robot_entry(name: &str) -> bool {
@@ -184,7 +275,7 @@ pub fn object_type(name: &str) -> &'static str {
         "floor" | "board" => "surface",
         "toy_box" => "box",
         n if n.ends_with("chess_box") => "box",
-        n if n.starts_with("hinge_") || n.contains("drawer") => "part",
+        n if is_asset_part(n) => "part",
         _ => "item",
     }
 }

@@ -56,6 +56,7 @@ pub enum SchemaKind {
 
 /// One schema of the true domain: name, what it does, its parameters, and the part it
 /// works on (handles, drawers).
+#[derive(Debug, PartialEq, Eq)]
 pub struct Schema {
     /// The schema's name in the domain file, e.g. `carry-into`.
     pub name: &'static str,
@@ -238,13 +239,158 @@ pub fn schema(name: &str) -> &'static Schema {
 }
 
 /// The schema argument kind an object can fill, from its name: the world's fixed names are
-/// surfaces, boxes or parts no schema takes as an argument; every other name is a loose item.
+/// surfaces, boxes or parts no schema takes as an argument (an articulated asset's parts
+/// under any prefix too); every other name is a loose item.
 pub fn kind_of(object: &str) -> Option<SchemaKind> {
     match object {
         parts::FLOOR | parts::BOARD => Some(SchemaKind::Surface),
         parts::TOY_BOX | parts::LEFT_CHESS_BOX | parts::RIGHT_CHESS_BOX => Some(SchemaKind::Box),
         parts::GRIPPER | parts::VACUUM_GRIPPER => None,
-        o if parts::HINGE_BOX_PARTS.contains(&o) || parts::DRAWER_CABINET_PARTS.contains(&o) => None,
+        o if is_asset_part(o) => None,
         _ => Some(SchemaKind::Item),
     }
+}
+
+/// True when `object` names a part of a hinge box or a drawer cabinet, bare or prefixed.
+pub fn is_asset_part(object: &str) -> bool {
+    parts::HINGE_BOX_PARTS
+        .iter()
+        .chain(&parts::DRAWER_CABINET_PARTS)
+        .any(|part| parts::has_part_suffix(object, part))
+}
+
+/// An asset part's prefix and bare name (`front_top_drawer` → `("front_", "top_drawer")`);
+/// `None` for every other object.
+pub fn split_asset_part(object: &str) -> Option<(&str, &'static str)> {
+    // Longest bare names first, so `top_drawer_handle` is not read as a `top_drawer`.
+    let mut bare: Vec<&'static str> = parts::HINGE_BOX_PARTS
+        .iter()
+        .chain(&parts::DRAWER_CABINET_PARTS)
+        .copied()
+        .collect();
+    bare.sort_by_key(|b| std::cmp::Reverse(b.len()));
+    bare.into_iter()
+        .find(|b| parts::has_part_suffix(object, b))
+        .map(|b| (&object[..object.len() - b.len()], b))
+}
+
+/// The words by which a schema's name names the articulated asset it works on, with that
+/// asset's parts (the constants its schemas mention).
+const ASSET_WORDS: [(&str, &[&str]); 3] = [
+    ("hinge", &parts::HINGE_BOX_PARTS),
+    ("bottom-drawer", &parts::DRAWER_CABINET_PARTS),
+    ("top-drawer", &parts::DRAWER_CABINET_PARTS),
+];
+
+/// Where a schema's name names its asset (byte offset of the asset word), and the asset's
+/// parts; `None` for the schemas of loose objects.
+pub fn asset_of(schema_name: &str) -> Option<(usize, &'static [&'static str])> {
+    ASSET_WORDS
+        .iter()
+        .filter_map(|(word, asset_parts)| {
+            let at = schema_name
+                .match_indices(word)
+                .map(|(i, _)| i)
+                .find(|&i| i == 0 || schema_name.as_bytes()[i - 1] == b'-')?;
+            Some((at, *asset_parts))
+        })
+        .min_by_key(|(at, _)| *at)
+}
+
+/// A schema of the table working on one articulated asset of a scene. The benchmark's
+/// assets carry the bare part names (`top_drawer`); a scene with several names each asset's
+/// parts with a prefix (`front_top_drawer`), and the schema for that asset is named with the
+/// prefix's words before the asset word: `open-front-top-drawer` is `open-top-drawer` for
+/// the cabinet whose parts start with `front_`.
+///
+/// ```
+/// use nesy_sim::domain::{instance_name, schema_instance};
+///
+/// assert_eq!(instance_name("open-top-drawer", "front_"), "open-front-top-drawer");
+/// let open = schema_instance("suction-open-front-top-drawer").unwrap();
+/// assert_eq!((open.schema.name, open.prefix.as_str()), ("suction-open-top-drawer", "front_"));
+/// assert_eq!(open.part().as_deref(), Some("front_top_drawer"));
+/// assert_eq!(schema_instance("grasp").unwrap().prefix, "");
+/// assert!(schema_instance("open-front-drawer").is_none());
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SchemaInstance {
+    /// The table's schema.
+    pub schema: &'static Schema,
+    /// The prefix of the asset's part names (`""` for the bare names, else ending in `_`).
+    pub prefix: String,
+}
+
+impl SchemaInstance {
+    /// The part it works on, with the asset's prefix.
+    pub fn part(&self) -> Option<String> {
+        self.schema.part.map(|part| self.asset_part(part))
+    }
+
+    /// A part of the same asset, by its bare name (`parts::BOTTOM_DRAWER`), with the prefix.
+    pub fn asset_part(&self, part: &str) -> String {
+        format!("{}{part}", self.prefix)
+    }
+
+    /// Its name in the scene's domain.
+    pub fn name(&self) -> String {
+        instance_name(self.schema.name, &self.prefix)
+    }
+}
+
+/// The name of schema `schema_name` for the asset whose parts carry `prefix` (`""` or ending
+/// in `_`): the prefix's words go before the asset word. Schemas of loose objects and the bare
+/// prefix keep their name.
+pub fn instance_name(schema_name: &str, prefix: &str) -> String {
+    match asset_of(schema_name) {
+        Some((at, _)) if !prefix.is_empty() => format!(
+            "{}{}{}",
+            &schema_name[..at],
+            prefix.replace('_', "-"),
+            &schema_name[at..]
+        ),
+        _ => schema_name.to_owned(),
+    }
+}
+
+/// The table's schema and asset prefix a schema name stands for (see [`SchemaInstance`]);
+/// `None` when it names no schema of the table for any asset.
+pub fn schema_instance(name: &str) -> Option<SchemaInstance> {
+    if let Some(schema) = SCHEMAS.iter().find(|s| s.name == name) {
+        return Some(SchemaInstance {
+            schema,
+            prefix: String::new(),
+        });
+    }
+    SCHEMAS.iter().find_map(|schema| {
+        let (at, _) = asset_of(schema.name)?;
+        let (head, tail) = schema.name.split_at(at);
+        let middle = name.strip_prefix(head)?.strip_suffix(tail)?;
+        let words_only = middle.len() > 1
+            && middle.ends_with('-')
+            && !middle.starts_with('-')
+            && !middle.contains("--")
+            && middle.chars().all(|c| c.is_ascii_alphanumeric() || c == '-');
+        words_only.then(|| SchemaInstance {
+            schema,
+            prefix: middle.replace('-', "_"),
+        })
+    })
+}
+
+/// The prefixes of the articulated assets among `objects` that are named with one (their base
+/// part, `front_drawer_body` or `left_hinge_body`, gives it), in the order listed.
+pub fn asset_prefixes<'a>(objects: impl IntoIterator<Item = &'a str>) -> Vec<String> {
+    let mut prefixes = Vec::new();
+    for object in objects {
+        for base in [parts::HINGE_BODY, parts::DRAWER_BODY] {
+            if let Some(prefix) = object.strip_suffix(base)
+                && prefix.ends_with('_')
+                && !prefixes.iter().any(|p| p == prefix)
+            {
+                prefixes.push(prefix.to_owned());
+            }
+        }
+    }
+    prefixes
 }

@@ -77,7 +77,16 @@ pub struct Snapshot {
     pub held: Option<String>,
     /// The grasped handle.
     pub grasped_handle: Option<String>,
+    /// Pairs of moving links where the first, open, stands in the way of the second's
+    /// opening (two cabinets at right angles), stated as [`BLOCKS`].
+    pub blocking: Vec<(String, String)>,
 }
+
+/// The relation between two moving links of different assets that open into each other's
+/// way: `(Blocks a b)` when `a`, open, stops `b` from opening. It depends only on where the
+/// assets stand, so it holds in every state of a scene. Not one of the paper's fifteen
+/// predicates: a task whose scenes have it declares it in its vocabulary file.
+pub const BLOCKS: &str = "Blocks";
 
 /// How much (low, high) a container's box grows before `InsideOf` tests it
 /// (`docs/benchmark.md` §5's table).
@@ -120,6 +129,7 @@ pub fn snapshot(sim: &Sim) -> Snapshot {
         closed: sim.is_closed(),
         held: sim.held_object().map(str::to_owned),
         grasped_handle: sim.grasped_handle().map(str::to_owned),
+        blocking: sim.blocking_pairs(),
     }
 }
 
@@ -200,6 +210,9 @@ pub fn observe_snapshot(s: &Snapshot) -> State {
     push_drawer_over_handle(s, &mut atoms);
     push_over_of(s, &inside, &on_top, &mut atoms);
     push_fine_grained(s, &mut atoms);
+    for (a, b) in &s.blocking {
+        atoms.push(Atom::new(BLOCKS, &[a, b]));
+    }
     State::from_atoms(atoms)
 }
 
@@ -432,6 +445,7 @@ mod tests {
             closed: false,
             held: None,
             grasped_handle: None,
+            blocking: Vec::new(),
         }
     }
 

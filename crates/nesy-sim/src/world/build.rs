@@ -405,8 +405,10 @@ impl Sim {
             hooks: Vec::new(),
             action_pause_steps: 0,
             contact_stop: None,
+            blocking: Vec::new(),
         };
         sim.check_interpenetration()?;
+        sim.blocking = sim.articulation_blocking();
         for _ in 0..sim.config.settle_steps {
             sim.physics_control_step(&sim.q.clone(), &sim.q.clone());
         }

@@ -23,6 +23,10 @@ use crate::api::TraceEntry;
 use crate::world::objects::{self, PartRole};
 use crate::world::{Part, Sim, SimHook};
 
+/// Positions along a joint's travel at which [`Sim::articulation_blocking`] checks it
+/// against another asset's open link (every 5 mm of a drawer's 12 cm).
+const BLOCKING_SAMPLES: usize = 24;
+
 /// Joint resolution (m for drawers, rad for lids) to which the contact position is found.
 pub(crate) const CONTACT_RESOLUTION: f64 = 1e-4;
 
@@ -187,6 +191,68 @@ impl Sim {
             }
         }
         (clear, Some(stop(obstacle)))
+    }
+
+    /// The solid colliders of articulation `ai`'s moving parts posed at joint position `q`.
+    fn articulation_colliders_at(&self, ai: usize, q: f64) -> Vec<Blocker<'_>> {
+        let a = &self.articulations[ai];
+        let body_pose = a.frame * objects::joint_motion(a.joint, q);
+        a.parts
+            .iter()
+            .flat_map(|&part| {
+                self.parts[part].colliders.iter().filter_map(move |&c| {
+                    let collider = &self.world.colliders[c];
+                    if collider.is_sensor() {
+                        return None;
+                    }
+                    let local = collider.position_wrt_parent().copied().unwrap_or(Pose::IDENTITY);
+                    let pose = body_pose * local;
+                    Some(Blocker {
+                        part,
+                        shape: collider.shape(),
+                        pose,
+                        aabb: collider.shape().compute_aabb(&pose),
+                    })
+                })
+            })
+            .collect()
+    }
+
+    /// Pairs of moving links (part indices) of different assets where the first, fully
+    /// open, stands in the way of the second: the second cannot travel from closed to open
+    /// without meeting it (two cabinets at right angles whose drawers open into each other's
+    /// way). The pairs are what the observer states as `Blocks`; the contact itself is
+    /// simulated while a drawer moves ([`Sim::travel_until_contact`]).
+    pub(crate) fn articulation_blocking(&self) -> Vec<(usize, usize)> {
+        let mut pairs = Vec::new();
+        for (ai, a) in self.articulations.iter().enumerate() {
+            let owner = self.parts[a.link].object;
+            let open = self.articulation_colliders_at(ai, a.limits.1);
+            for (bi, b) in self.articulations.iter().enumerate() {
+                if bi == ai || self.parts[b.link].object == owner {
+                    continue;
+                }
+                let (closed, full) = b.limits;
+                let meets = (1..=BLOCKING_SAMPLES).any(|k| {
+                    let q = closed + (full - closed) * k as f64 / BLOCKING_SAMPLES as f64;
+                    self.blocked_at(bi, q, &open).is_some()
+                });
+                if meets {
+                    pairs.push((a.link, b.link));
+                }
+            }
+        }
+        pairs
+    }
+
+    /// The pairs of moving links of different assets that stand in the way of one another's
+    /// opening, by name: `(a, b)` when `a`, fully open, leaves `b` no way from closed to
+    /// open (found when the scene is built; the observer states them as `Blocks`).
+    pub fn blocking_pairs(&self) -> Vec<(String, String)> {
+        self.blocking
+            .iter()
+            .map(|&(a, b)| (self.parts[a].name.clone(), self.parts[b].name.clone()))
+            .collect()
     }
 
     /// How deep each of the robot's links and the carried object presses into each piece of

@@ -207,6 +207,9 @@ pub struct Sim {
     /// Set when a link the arm drives met other furniture during the current motion; the
     /// motion ends at the next control step.
     pub(crate) contact_stop: Option<contact::ContactStop>,
+    /// Pairs of moving links (part indices) of different assets where the first, open,
+    /// stands in the way of the second's opening; found once when the scene is built.
+    pub(crate) blocking: Vec<(usize, usize)>,
 }
 
 impl Sim {

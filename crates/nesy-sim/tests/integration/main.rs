@@ -16,6 +16,7 @@ mod furniture;
 mod kinematics;
 mod refusals;
 mod scenarios;
+mod scene_domain;
 mod schema;
 mod sweep_random;
 mod tasks;
