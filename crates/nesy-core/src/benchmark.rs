@@ -219,16 +219,25 @@ pub fn iteration_budget(factor: Factor, complexity: Complexity) -> usize {
 ///   e.g. `gap_obst_plus2_03_s1`. Its demonstration has one subtask and its target `1 + k`,
 ///   so its complexity is [`Complexity::of_subtask_count`] of `1 + k`: the budget follows
 ///   the task that has to be solved.
+/// - A scenario of a real-world task's family starts with `family_<name>_`, e.g.
+///   `family_drawers_03_s1`; the families are filed under Obstruction at low complexity.
 ///
 /// ```
 /// use nesy_core::benchmark::{parse_scenario_id, Complexity, Factor};
 /// assert_eq!(parse_scenario_id("comb_high_07_s1"), Some((Factor::Comb, Complexity::High)));
 /// assert_eq!(parse_scenario_id("gap_obst_plus3_00_s0"), Some((Factor::Obst, Complexity::High)));
+/// assert_eq!(parse_scenario_id("family_drawers_03_s1"), Some((Factor::Obst, Complexity::Low)));
 /// assert_eq!(parse_scenario_id("pick_place"), None);
 /// ```
 pub fn parse_scenario_id(id: &str) -> Option<(Factor, Complexity)> {
     let mut parts = id.split(['_', '-', '/']);
     let first = parts.next()?;
+    // The real-world tasks' families are filed under Obstruction at low complexity
+    // (`nesy_sim::tasks::scenario::generate_family_file`).
+    if first == "family" {
+        parts.next()?;
+        return Some((Factor::Obst, Complexity::Low));
+    }
     if first == "gap" {
         let factor = Factor::from_name(parts.next()?)?;
         let added: usize = parts.next()?.strip_prefix("plus")?.parse().ok()?;

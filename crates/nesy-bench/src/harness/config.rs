@@ -150,11 +150,12 @@ pub fn load_suite(dir: Option<&Path>) -> Result<Vec<ConfigFile>, BenchError> {
     })
 }
 
-/// The suite a run uses: the folder's when given, else the complexity-gap suite for a study
-/// that runs on it, else the 440.
+/// The suite a run uses: the folder's when given, else the complexity-gap suite or a
+/// real-world task's family for a study that runs on it, else the 440.
 pub fn run_suite(dir: Option<&Path>, study: Option<Study>) -> Result<Vec<ConfigFile>, BenchError> {
     match (dir, study) {
         (None, Some(s)) if s.uses_gap_suite() => Ok(scenario::generate_gap_suite()),
+        (None, Some(s)) if let Some(family) = s.family() => Ok(vec![scenario::generate_family_file(family)]),
         _ => load_suite(dir),
     }
 }

@@ -34,6 +34,9 @@ pub fn final_records(run: &Path) -> Result<HashMap<String, UnitRecord>, BenchErr
 
 /// One scenario's inputs, loaded once and shared by its units.
 pub(super) struct ScenarioInputs {
+    /// The predicates the scenario's task is stated in: the built-ins, or a real-world task
+    /// family's vocabulary.
+    pub(super) vocabulary: Arc<nesy_core::Vocabulary>,
     pub(super) demo: Arc<DemoInput>,
     pub(super) keyframes: Arc<DemoKeyframes>,
     pub(super) target: Arc<TargetInput>,
@@ -88,12 +91,18 @@ pub(super) async fn scenario_inputs(
         let cache = shared.cache.clone();
         let s = scenario.clone();
         cpu(shared, move || -> Result<ScenarioInputs, String> {
+            let vocabulary = match s.family {
+                Some(family) => family
+                    .vocabulary()
+                    .map_err(|e| format!("the {family} family's vocabulary: {e}"))?,
+                None => nesy_core::Vocabulary::new(),
+            };
             let cached = cache.ensure(&s, 1).map_err(|e| e.to_string())?;
-            let demo =
-                DemoInput::load(&cached.demo, &nesy_core::Vocabulary::new()).map_err(|e| e.to_string())?;
+            let demo = DemoInput::load(&cached.demo, &vocabulary).map_err(|e| e.to_string())?;
             let target = TargetInput::load(Some(&cached.target), &demo).map_err(|e| e.to_string())?;
             let keyframes = DemoKeyframes::from_demo(&demo).map_err(|e| e.to_string())?;
             Ok(ScenarioInputs {
+                vocabulary: Arc::new(vocabulary),
                 demo: Arc::new(demo),
                 keyframes: Arc::new(keyframes),
                 target: Arc::new(target),

@@ -429,6 +429,7 @@ async fn prepare_unit(
     };
     let setting = derive_setting(&inputs.demo, &inputs.target, &options);
     let unit_inputs = UnitInputs {
+        vocabulary: inputs.vocabulary.clone(),
         demo: inputs.demo.clone(),
         keyframes: inputs.keyframes.clone(),
         target: inputs.target.clone(),

@@ -13,7 +13,6 @@ use futures::future::BoxFuture;
 use nesy_baselines::{
     Baseline, BaselineError, BaselineInputs, BaselinePlan, Fidelity, Keyframe, SceneObservation, SceneViews,
 };
-use nesy_core::Vocabulary;
 use nesy_pipeline::synth::CodegenMode;
 use nesy_reasoner::Views;
 use nesy_vlm::{Image, VlmClient};
@@ -262,7 +261,7 @@ fn baseline_inputs(inputs: &UnitInputs, fidelity: Fidelity) -> Result<BaselineIn
         target_objects: target.objects.clone(),
         target_state,
         target_observation,
-        vocabulary: Vocabulary::new(),
+        vocabulary: (*inputs.vocabulary).clone(),
         end_effector_in_state: inputs.setting.embodiment_in_state
             || inputs.setting.factor == nesy_core::benchmark::Factor::Comb,
         budget: inputs.setting.budget,

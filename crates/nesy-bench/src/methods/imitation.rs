@@ -6,7 +6,6 @@
 
 use futures::FutureExt as _;
 use futures::future::BoxFuture;
-use nesy_core::Vocabulary;
 use nesy_core::adapt::{AdaptConfig, Trace, construct_world_model, identify};
 use nesy_core::verify_procedure;
 use nesy_pipeline::states::StatesMode;
@@ -69,20 +68,20 @@ impl Method for Imitation {
                 .map_err(|e| MethodFailure::new(FailureKind::Method, e.to_string()))?
                 .with_keyframes(inputs.keyframes.clone())
                 .with_embodiments(setting.source_embodiment, setting.target_embodiment);
-            let vocabulary = Vocabulary::new();
+            let vocabulary = &inputs.vocabulary;
             let states = states::symbolic_states(
                 &reasoner,
                 &inputs.demo,
                 &inputs.target,
                 setting,
                 StatesMode::Observed,
-                &vocabulary,
+                vocabulary,
                 &NoProgress,
             )
             .await
             .map_err(|e| MethodFailure::new(FailureKind::Method, e.to_string()))?;
             let (demonstration, target) =
-                adaptation_inputs(&inputs.demo, &inputs.target, setting, &states, &vocabulary);
+                adaptation_inputs(&inputs.demo, &inputs.target, setting, &states, vocabulary);
             let started = std::time::Instant::now();
             let mut trace = Trace::default();
             let world =

@@ -17,6 +17,7 @@ use std::sync::Arc;
 
 use futures::future::BoxFuture;
 use nesy_core::Operator;
+use nesy_core::Vocabulary;
 use nesy_core::adapt::Adaptation;
 use nesy_pipeline::states::StateSource;
 use nesy_pipeline::synth::CodegenMode;
@@ -94,6 +95,8 @@ pub struct MethodInfo {
 
 /// Everything a method sees of one unit.
 pub struct UnitInputs {
+    /// The predicates the task is stated in (the built-ins, or a real-world task family's).
+    pub vocabulary: Arc<Vocabulary>,
     /// The source demonstration.
     pub demo: Arc<DemoInput>,
     /// The demonstration's decoded views and recorded calls, for the reasoner.

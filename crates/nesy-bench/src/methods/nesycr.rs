@@ -6,7 +6,6 @@ use std::sync::Arc;
 
 use futures::FutureExt as _;
 use futures::future::BoxFuture;
-use nesy_core::Vocabulary;
 use nesy_core::adapt::{Ablation, AdaptConfig, Outcome, TransitionCheck};
 use nesy_pipeline::states::StatesMode;
 use nesy_pipeline::synth::CodegenMode;
@@ -231,20 +230,20 @@ impl Method for NeSyCr {
             } else {
                 reasoner
             };
-            let vocabulary = Vocabulary::new();
+            let vocabulary = &inputs.vocabulary;
             let states = states::symbolic_states(
                 &reasoner,
                 &inputs.demo,
                 &inputs.target,
                 setting,
                 settings.states,
-                &vocabulary,
+                vocabulary,
                 &NoProgress,
             )
             .await
             .map_err(pipeline_failure)?;
             let (demonstration, mut target) =
-                adaptation_inputs(&inputs.demo, &inputs.target, setting, &states, &vocabulary);
+                adaptation_inputs(&inputs.demo, &inputs.target, setting, &states, vocabulary);
             if settings.target_goal {
                 // The target task's goal as its scene states it: what the target instruction
                 // asks for, including subtasks the demonstration never shows.

@@ -160,7 +160,11 @@ fn write_provenance(md: &mut String, manifest: &Manifest) {
         manifest.repeats,
         manifest.units.len(),
         if manifest.selection.patterns.is_empty() {
-            "all 440".to_owned()
+            match manifest.study {
+                Some(study) if study.uses_gap_suite() => "all of the complexity-gap suite".to_owned(),
+                Some(study) if let Some(family) = study.family() => format!("all of the {family} family"),
+                _ => "all 440".to_owned(),
+            }
         } else {
             manifest.selection.patterns.join(", ")
         }

@@ -4,8 +4,11 @@
 //!   (MP4 with H.264), a folder of frames (one view, or one subfolder per view) or the
 //!   authors' demo format (`data.json` and `frames/<view>/frame_<i>.jpg`), choosing keyframes
 //!   and writing a contact sheet of the choice.
+//! - `frames RECORDING --out SHEET.png` writes a contact sheet of a recording's keyframes.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
 use std::process::ExitCode;
 
 use nesy_import::{AutoSettings, DEFAULT_VIEW, ImportOptions, KeyframeMode, MIN_MOTION, MIN_REST_S};
@@ -81,6 +84,23 @@ pub(crate) enum DemoAction {
         #[arg(long)]
         json: bool,
     },
+    /// Write a contact sheet of a recording's keyframes (a demo, or the `execution.mcap` of
+    /// `nesy adapt --execute --render-every N`), each captioned with the call that led to it:
+    /// a run's key steps at a glance.
+    Frames {
+        /// The recording (`demo.mcap` or `execution.mcap`).
+        recording: PathBuf,
+        /// The sheet to write (PNG).
+        #[arg(long, value_name = "FILE")]
+        out: PathBuf,
+        /// The camera view (`top`, `front`, `back`, or a real demo's own).
+        #[arg(long, value_name = "NAME", default_value = "front")]
+        view: String,
+        /// Only the keyframes after these robot-API calls, comma-separated
+        /// (`move_parallel,open_gripper`), with the first and the last keyframe.
+        #[arg(long, value_name = "CALL,...", value_delimiter = ',')]
+        after: Option<Vec<String>>,
+    },
 }
 
 fn parse_mode(text: &str) -> Result<KeyframeMode, String> {
@@ -89,6 +109,15 @@ fn parse_mode(text: &str) -> Result<KeyframeMode, String> {
 
 /// Runs `nesy demo`.
 pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
+    if let DemoAction::Frames {
+        recording,
+        out,
+        view,
+        after,
+    } = args.action
+    {
+        return frames(&recording, &out, &view, after.as_deref());
+    }
     let DemoAction::Import {
         source,
         out,
@@ -102,7 +131,10 @@ pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         demonstrator,
         truth,
         json,
-    } = args.action;
+    } = args.action
+    else {
+        unreachable!("frames is handled above");
+    };
     let keyframes = keyframes.unwrap_or(if nesy_import::is_video(&source) {
         KeyframeMode::Auto
     } else {
@@ -170,5 +202,51 @@ pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
             seconds(&m.extra)
         )?;
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `nesy demo frames`: the chosen keyframes of a recording, captioned, on one sheet.
+fn frames(recording: &Path, out: &Path, view: &str, after: Option<&[String]>) -> anyhow::Result<ExitCode> {
+    let demo = nesy_sim::demo::read_mcap(recording)?;
+    let last = demo.keyframes.len().saturating_sub(1);
+    let chosen: Vec<&nesy_sim::demo::Keyframe> = demo
+        .keyframes
+        .iter()
+        .filter(|k| match after {
+            None => true,
+            Some(calls) => {
+                k.index == 0
+                    || k.index == last
+                    || k.action
+                        .as_ref()
+                        .is_some_and(|a| calls.iter().any(|c| c.trim() == a.call.name()))
+            }
+        })
+        .collect();
+    let mut cells = Vec::with_capacity(chosen.len());
+    for keyframe in chosen {
+        let images = keyframe.views.get(view).with_context(|| {
+            format!(
+                "{}: keyframe {} has no view {view:?}",
+                recording.display(),
+                keyframe.index
+            )
+        })?;
+        let picture = nesy_import::decode(&images.raw)
+            .map_err(|e| anyhow::anyhow!("{}: keyframe {}: {e}", recording.display(), keyframe.index))?;
+        let caption = match &keyframe.action {
+            Some(entry) => format!("{} {}", keyframe.index, entry.call.label()),
+            None => format!("{} start", keyframe.index),
+        };
+        cells.push((picture, caption));
+    }
+    let sheet = nesy_import::contact_sheet(&cells);
+    std::fs::write(out, sheet.to_png()).with_context(|| format!("writing {}", out.display()))?;
+    outln!(
+        "{} ({} keyframes of {})",
+        out.display(),
+        cells.len(),
+        demo.keyframes.len()
+    )?;
     Ok(ExitCode::SUCCESS)
 }

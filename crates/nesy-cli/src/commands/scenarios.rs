@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
-use nesy_sim::tasks::scenario::{self, ConfigFile, CountTable, Scenario, Side};
+use nesy_sim::tasks::scenario::{self, ConfigFile, CountTable, Family, Scenario, Side};
 
 /// Arguments of `nesy scenarios`.
 #[derive(Debug, clap::Args)]
@@ -20,14 +20,19 @@ pub(crate) struct ScenariosArgs {
 #[derive(Debug, clap::Subcommand)]
 pub(crate) enum ScenariosAction {
     /// Write the 15 configuration files (`<factor>_<complexity>.json`), or with `--gap` the
-    /// four files of the auxiliary complexity-gap suite (`gap_obst_plus<k>.json`).
+    /// four files of the auxiliary complexity-gap suite (`gap_obst_plus<k>.json`), or with
+    /// `--family NAME` a real-world task's family (`family_<name>.json`).
     Generate {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
         /// Write the complexity-gap suite (Figure 4(b); not part of the 440) instead.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "family")]
         gap: bool,
+        /// Write a real-world task's family instead: `drawers` (Table 2's task; not part of
+        /// the 440).
+        #[arg(long, value_parser = parse_family)]
+        family: Option<Family>,
     },
     /// Print the table of scenario counts (the paper's Table 6).
     List {
@@ -120,15 +125,23 @@ pub(crate) fn load_suite(suite: Option<&std::path::Path>) -> anyhow::Result<Vec<
     }
 }
 
+/// A family named on the command line.
+fn parse_family(name: &str) -> Result<Family, String> {
+    Family::from_name(name).ok_or_else(|| {
+        let known: Vec<&str> = Family::ALL.iter().map(|f| f.as_str()).collect();
+        format!("expected one of {}", known.join(", "))
+    })
+}
+
 /// Runs `nesy scenarios`.
 pub(crate) fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
     match args.action {
-        ScenariosAction::Generate { out, gap } => {
+        ScenariosAction::Generate { out, gap, family } => {
             let started = Instant::now();
-            let files = if gap {
-                scenario::generate_gap_suite()
-            } else {
-                scenario::generate_suite()
+            let files = match (gap, family) {
+                (_, Some(family)) => vec![scenario::generate_family_file(family)],
+                (true, None) => scenario::generate_gap_suite(),
+                (false, None) => scenario::generate_suite(),
             };
             let all = scenario::scenarios(&files);
             // Generating every scene checks that the whole suite is usable.

@@ -513,6 +513,102 @@ fn the_complexity_gap_study_reports_sr_and_pd_by_added_subtasks() {
     assert_eq!(results.matches("\"added_subtasks\":0").count(), 4, "{results}");
 }
 
+/// `--study drawers` on one scenario of the drawers family: the demonstration opens both
+/// cabinets' drawers at once, which the target's cabinets at right angles forbid. Replayed
+/// unadapted, the second drawer is stopped by contact with the first and the failure names
+/// both; NeSyCR finds the violated `Blocks` precondition and closes one drawer before opening
+/// the other; the planner control succeeds too. The key steps of the adapted run's recording
+/// go on one sheet with `nesy demo frames`.
+#[test]
+fn the_drawers_study_fails_imitation_on_the_interference_and_adapts_around_it() {
+    let scratch = common::scratch();
+    let run = scratch.path().join("drawers");
+    let demos = scratch.path().join("demos");
+    let out = study_run(
+        &run,
+        "drawers",
+        "family_drawers_03_s0",
+        &demos,
+        &["--record-executions"],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(lines(&run), 3);
+    let records: Vec<serde_json::Value> = std::fs::read_dir(run.join("results"))
+        .unwrap()
+        .flatten()
+        .flat_map(|e| {
+            std::fs::read_to_string(e.path())
+                .unwrap()
+                .lines()
+                .map(|l| serde_json::from_str(l).unwrap())
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let of = |method: &str| {
+        records
+            .iter()
+            .find(|r| r["variant"] == method)
+            .unwrap_or_else(|| panic!("{method}: {records:?}"))
+    };
+    assert_eq!(of("nesycr")["status"], "succeeded", "{}", of("nesycr"));
+    assert_eq!(of("replan")["status"], "succeeded", "{}", of("replan"));
+    let imitation = of("imitation");
+    assert_eq!(imitation["status"], "execution_failed", "{imitation}");
+    let error = imitation["error"].as_str().unwrap();
+    assert!(
+        error.contains("side_bottom_drawer ran into front_bottom_drawer"),
+        "the failure names the interference: {error}"
+    );
+    let report = std::fs::read_to_string(run.join("report.md")).unwrap();
+    assert!(report.contains("## Drawers that block each other"), "{report}");
+    assert!(report.contains("scenarios: family_drawers_03_s0"), "{report}");
+    let adaptation =
+        std::fs::read_to_string(run.join("units/family_drawers_03_s0/nesycr/adaptation.json")).unwrap();
+    assert!(
+        adaptation.contains("Blocks front_bottom_drawer side_bottom_drawer"),
+        "{adaptation}"
+    );
+
+    let recording = run.join("units/family_drawers_03_s0/nesycr/execution.mcap");
+    let sheet = scratch.path().join("key-steps.png");
+    let frames = common::nesy(&[
+        "demo".into(),
+        "frames".into(),
+        recording.display().to_string(),
+        "--out".into(),
+        sheet.display().to_string(),
+        "--view".into(),
+        "top".into(),
+        "--after".into(),
+        "move_parallel,open_gripper".into(),
+    ]);
+    let stdout = String::from_utf8_lossy(&frames.stdout);
+    assert_eq!(
+        frames.status.code(),
+        Some(0),
+        "{stdout}{}",
+        String::from_utf8_lossy(&frames.stderr)
+    );
+    assert!(stdout.contains("keyframes of"), "{stdout}");
+    assert!(std::fs::read(&sheet).unwrap().starts_with(b"\x89PNG"));
+    let missing = common::nesy(&[
+        "demo".into(),
+        "frames".into(),
+        recording.display().to_string(),
+        "--out".into(),
+        sheet.display().to_string(),
+        "--view".into(),
+        "wrist".into(),
+    ]);
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("has no view \"wrist\""));
+}
+
 /// On a demonstration recorded with a keyframe after every action, no transition hides a
 /// step, so the reference responder reads none as two. On `obst_high_04_s1` a closing lid
 /// pushes the black knight onto the board; read as a hidden release followed by carrying the

@@ -129,7 +129,7 @@ fn a_task_between_two_cabinets_is_adapted_to_cabinets_at_right_angles() {
     );
 
     let adapted = dir.path().join("adapted");
-    let vocabulary = root.join("fixtures/vocabulary/blocking-drawers.toml");
+    let vocabulary = root.join("assets/vocabulary/blocking-drawers.toml");
     let (code, stdout, stderr) = common::adapt(
         &out.join("demo.mcap"),
         &out.join("target.json"),

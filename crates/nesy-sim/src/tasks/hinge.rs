@@ -59,10 +59,10 @@ pub(crate) fn layout(config: &SubtaskConfig, [ox, oy]: [f64; 2]) -> SubtaskLayou
     SubtaskLayout {
         objects,
         articulations: vec![(parts::HINGE_LID.into(), lid)],
-        goal: SubtaskGoal::PutInHinge {
+        goals: vec![SubtaskGoal::PutInHinge {
             objects: fruits.iter().map(|(f, _, _)| FRUITS[*f].0.to_owned()).collect(),
             container: parts::HINGE_BODY.into(),
             lid: parts::HINGE_LID.into(),
-        },
+        }],
     }
 }

@@ -13,6 +13,7 @@
 //! and `variant` (and its offset), and the obstruction on a separate stream of the same
 //! variant, so a source and a target that share a variant differ only by the obstruction.
 
+mod drawers;
 pub mod experts;
 pub mod goal;
 mod hinge;
@@ -108,7 +109,8 @@ pub enum TaskError {
 pub(crate) struct SubtaskLayout {
     pub objects: Vec<ObjectSpec>,
     pub articulations: Vec<(String, f64)>,
-    pub goal: SubtaskGoal,
+    /// One goal, or one per container a subtask fills (a drawer in each of two cabinets).
+    pub goals: Vec<SubtaskGoal>,
 }
 
 /// An object resting at `(x, y)` with its lowest point at `z`.
@@ -149,6 +151,7 @@ pub(crate) fn layout(config: &SubtaskConfig, offset: [f64; 2]) -> SubtaskLayout 
         SubtaskKind::Sweep => sweep::layout(config, offset),
         SubtaskKind::PutInHinge => hinge::layout(config, offset),
         SubtaskKind::PutInPrismatic => prismatic::layout(config, offset),
+        SubtaskKind::SortIntoDrawers => drawers::layout(config, offset),
     }
 }
 
@@ -242,7 +245,7 @@ impl TaskConfig {
             let part = layout(config, *offset);
             objects.extend(part.objects);
             articulations.extend(part.articulations);
-            goals.push(part.goal);
+            goals.extend(part.goals);
         }
         let goal_label = goals.iter().flat_map(SubtaskGoal::label).collect();
         let scene = SceneSpec {

@@ -62,9 +62,9 @@ pub(crate) fn layout(config: &SubtaskConfig, [ox, oy]: [f64; 2]) -> SubtaskLayou
     SubtaskLayout {
         objects,
         articulations: Vec::new(),
-        goal: SubtaskGoal::PickPlace {
+        goals: vec![SubtaskGoal::PickPlace {
             objects: cubes.into_iter().map(|(name, _, _)| name).collect(),
             container: parts::TOY_BOX.into(),
-        },
+        }],
     }
 }

@@ -65,9 +65,9 @@ pub(crate) fn layout(config: &SubtaskConfig, [ox, oy]: [f64; 2]) -> SubtaskLayou
             (parts::BOTTOM_DRAWER.into(), bottom),
             (parts::TOP_DRAWER.into(), top),
         ],
-        goal: SubtaskGoal::PutInPrismatic {
+        goals: vec![SubtaskGoal::PutInPrismatic {
             objects: names,
             drawer: parts::BOTTOM_DRAWER.into(),
-        },
+        }],
     }
 }

@@ -49,6 +49,109 @@ pub const GAP_FACTOR: Factor = Factor::Obst;
 pub const GAP_ADDED: [u8; 4] = [0, 1, 2, 3];
 /// Configurations per added-subtask count in the complexity-gap suite.
 pub const GAP_CONFIGURATIONS: usize = 10;
+/// Configurations of a real-world task's family (each evaluated with every seed of [`SEEDS`]).
+pub const FAMILY_CONFIGURATIONS: usize = 10;
+
+/// A family of scenarios for one of the paper's real-world tasks (auxiliary, not part of
+/// the 440): seeded scene pairs in the demonstrator's and the deployment's settings as the
+/// paper describes each. The file is `family_<name>.json` and the ids
+/// `family_<name>_<NN>_s<seed>`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Family {
+    /// Table 2: cubes sorted into two cabinets' drawers, demonstrated with the cabinets side
+    /// by side and deployed with them at right angles (one bottom drawer cannot open while
+    /// the other stands open) and the cubes stacked (`sort_into_drawers`).
+    Drawers,
+}
+
+impl Family {
+    /// Every family.
+    pub const ALL: [Family; 1] = [Family::Drawers];
+
+    /// The name in file names, ids and on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Family::Drawers => "drawers",
+        }
+    }
+
+    /// The family called `name`.
+    pub fn from_name(name: &str) -> Option<Family> {
+        Family::ALL.into_iter().find(|f| f.as_str() == name)
+    }
+
+    /// The subtask its scenes are made of.
+    pub fn subtask(self) -> SubtaskKind {
+        match self {
+            Family::Drawers => SubtaskKind::SortIntoDrawers,
+        }
+    }
+
+    /// The vocabulary its tasks are stated in: the benchmark's fifteen predicates and the
+    /// relations its scenes need (`Blocks` for the drawers), from `assets/vocabulary/`.
+    pub fn vocabulary(self) -> Result<nesy_core::Vocabulary, nesy_core::VocabularyFileError> {
+        let text = match self {
+            Family::Drawers => include_str!("../../../../assets/vocabulary/blocking-drawers.toml"),
+        };
+        nesy_core::parse_vocabulary_file(text)
+    }
+
+    /// Its file's name: `family_<name>.json`.
+    pub fn file_name(self) -> String {
+        format!("family_{}.json", self.as_str())
+    }
+}
+
+impl std::fmt::Display for Family {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// The id of a real-world task's scenario.
+pub fn family_scenario_id(family: Family, episode_id: u64, seed: u64) -> String {
+    format!("family_{}_{episode_id:02}_s{seed}", family.as_str())
+}
+
+/// Generates a real-world task's family: [`FAMILY_CONFIGURATIONS`] configurations, each
+/// demonstrated at obstruction level 0 and deployed at level 2 of the family's subtask by
+/// the finger robot, with the object count cycling through the multi levels. Filed under
+/// the Obstruction factor (the deployment adds a physical constraint), low complexity.
+pub fn generate_family_file(family: Family) -> ConfigFile {
+    let tag = format!("scenarios/family/{}", family.as_str());
+    let episodes = (0..FAMILY_CONFIGURATIONS)
+        .map(|i| {
+            let mut rng = Stream::new(&tag, i as u64);
+            let variant = rng.index(SEED_STRIDE as usize) as u64;
+            let side = |obst_level: u8| {
+                vec![SubtaskConfig {
+                    kind: family.subtask(),
+                    variant,
+                    obst_level,
+                    multi_level: (i % 3) as u8,
+                }]
+            };
+            EpisodeConfig {
+                episode_id: i as u64,
+                source_subtasks: side(0),
+                target_subtasks: side(2),
+                source_embodiment: Embodiment::Finger,
+                target_embodiment: Embodiment::Finger,
+                embodiment_in_state: false,
+            }
+        })
+        .collect();
+    ConfigFile {
+        schema_version: CONFIG_SCHEMA_VERSION,
+        factor: Factor::Obst,
+        complexity: Complexity::Low,
+        seeds: SEEDS.to_vec(),
+        added_subtasks: None,
+        family: Some(family),
+        episodes,
+    }
+}
 
 /// One source/target configuration (the authors' episode).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -86,6 +189,10 @@ pub struct ConfigFile {
     /// (0–3); absent in the files of the 440 suite.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub added_subtasks: Option<u8>,
+    /// In a real-world task's file, the task ([`Family`]); absent in the files of the 440
+    /// suite.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub family: Option<Family>,
     /// The episodes.
     pub episodes: Vec<EpisodeConfig>,
 }
@@ -275,6 +382,7 @@ pub fn generate_file(factor: Factor, complexity: Complexity) -> ConfigFile {
         complexity,
         seeds: SEEDS.to_vec(),
         added_subtasks: None,
+        family: None,
         episodes,
     }
 }
@@ -333,6 +441,7 @@ pub fn generate_gap_file(added: u8) -> ConfigFile {
         complexity: Complexity::Low,
         seeds: SEEDS.to_vec(),
         added_subtasks: Some(added),
+        family: None,
         episodes,
     }
 }
@@ -362,9 +471,10 @@ impl ConfigFile {
     /// The file's name in a suite folder: [`config_file_name`], or [`gap_file_name`] for a
     /// complexity-gap file.
     pub fn file_name(&self) -> String {
-        match self.added_subtasks {
-            None => config_file_name(self.factor, self.complexity),
-            Some(added) => gap_file_name(self.factor, added),
+        match (self.family, self.added_subtasks) {
+            (Some(family), _) => family.file_name(),
+            (None, None) => config_file_name(self.factor, self.complexity),
+            (None, Some(added)) => gap_file_name(self.factor, added),
         }
     }
 
@@ -436,6 +546,29 @@ impl ConfigFile {
                     )
                 })?;
             }
+            // A family's file holds its own subtask; the others, the benchmark's four.
+            for (side, list) in [
+                ("source_subtasks", &episode.source_subtasks),
+                ("target_subtasks", &episode.target_subtasks),
+            ] {
+                for (k, subtask) in list.iter().enumerate() {
+                    let fits = match self.family {
+                        Some(family) => subtask.kind == family.subtask(),
+                        None => SubtaskKind::ALL.contains(&subtask.kind),
+                    };
+                    if !fits {
+                        let expected = match self.family {
+                            Some(family) => format!("{} (the {family} family's subtask)", family.subtask()),
+                            None => "one of the benchmark's four subtasks".to_owned(),
+                        };
+                        return Err(invalid(
+                            format!("episodes[{e}].{side}[{k}].kind"),
+                            &expected,
+                            subtask.kind.to_string(),
+                        ));
+                    }
+                }
+            }
             let key = |s: &SubtaskConfig| (s.kind, s.variant);
             let mut a: Vec<_> = episode.source_subtasks.iter().map(key).collect();
             let mut b: Vec<_> = episode.target_subtasks.iter().map(key).collect();
@@ -487,8 +620,8 @@ pub fn write_suite(files: &[ConfigFile], dir: &Path) -> Result<Vec<std::path::Pa
         .collect()
 }
 
-/// Reads every `<factor>_<complexity>.json` and `gap_<factor>_plus<k>.json` present in `dir`
-/// (at least one must exist).
+/// Reads every `<factor>_<complexity>.json`, `gap_<factor>_plus<k>.json` and
+/// `family_<name>.json` present in `dir` (at least one must exist).
 pub fn read_suite(dir: &Path) -> Result<Vec<ConfigFile>, ScenarioError> {
     let mut files = Vec::new();
     for factor in Factor::ALL {
@@ -529,12 +662,28 @@ pub fn read_suite(dir: &Path) -> Result<Vec<ConfigFile>, ScenarioError> {
         }
         files.push(file);
     }
+    for family in Family::ALL {
+        let path = dir.join(family.file_name());
+        if !path.exists() {
+            continue;
+        }
+        let file = ConfigFile::from_file(&path)?;
+        if file.family != Some(family) {
+            return Err(ScenarioError::Invalid {
+                path: path.display().to_string(),
+                field: "family".into(),
+                expected: format!("{family} (from the file name)"),
+                found: file.family.map_or("absent".to_owned(), |f| f.to_string()),
+            });
+        }
+        files.push(file);
+    }
     if files.is_empty() {
         return Err(ScenarioError::Io {
             path: dir.display().to_string(),
             source: std::io::Error::new(
                 std::io::ErrorKind::NotFound,
-                "no <factor>_<complexity>.json or gap_<factor>_plus<k>.json configuration files (write them with `nesy scenarios generate`)",
+                "no <factor>_<complexity>.json, gap_<factor>_plus<k>.json or family_<name>.json configuration files (write them with `nesy scenarios generate`)",
             ),
         });
     }
@@ -557,6 +706,8 @@ pub struct Scenario {
     /// Subtasks the target has beyond the demonstration's, in the complexity-gap suite
     /// (`None` in the 440).
     pub added_subtasks: Option<u8>,
+    /// The real-world task whose family it belongs to (`None` in the 440).
+    pub family: Option<Family>,
     /// The configuration.
     pub episode: EpisodeConfig,
     /// The seed.
@@ -656,13 +807,15 @@ pub fn scenarios(files: &[ConfigFile]) -> Vec<Scenario> {
         .flat_map(|file| {
             file.episodes.iter().flat_map(move |episode| {
                 file.seeds.iter().map(move |&seed| Scenario {
-                    id: match file.added_subtasks {
-                        Some(added) => gap_scenario_id(file.factor, added, episode.episode_id, seed),
-                        None => scenario_id(file.factor, file.complexity, episode.episode_id, seed),
+                    id: match (file.family, file.added_subtasks) {
+                        (Some(family), _) => family_scenario_id(family, episode.episode_id, seed),
+                        (None, Some(added)) => gap_scenario_id(file.factor, added, episode.episode_id, seed),
+                        (None, None) => scenario_id(file.factor, file.complexity, episode.episode_id, seed),
                     },
                     factor: file.factor,
                     complexity: file.complexity,
                     added_subtasks: file.added_subtasks,
+                    family: file.family,
                     episode: episode.clone(),
                     seed,
                 })
@@ -690,6 +843,9 @@ pub struct CountTable {
     /// when none were counted. These are kept out of `by_factor`: their file complexity is a
     /// placeholder, not a row of Table 6.
     pub gap: Vec<(u8, usize)>,
+    /// `(family, scenarios)` of the real-world tasks' families, in [`Family::ALL`] order;
+    /// empty when none were counted. Kept out of `by_factor` too.
+    pub families: Vec<(Family, usize)>,
 }
 
 impl CountTable {
@@ -701,7 +857,7 @@ impl CountTable {
                 let mut row = [0; 3];
                 for s in scenarios
                     .iter()
-                    .filter(|s| s.factor == f && s.added_subtasks.is_none())
+                    .filter(|s| s.factor == f && s.added_subtasks.is_none() && s.family.is_none())
                 {
                     row[s.complexity as usize] += 1;
                 }
@@ -712,9 +868,20 @@ impl CountTable {
         for added in scenarios.iter().filter_map(|s| s.added_subtasks) {
             *gap.entry(added).or_default() += 1;
         }
+        let families = Family::ALL
+            .into_iter()
+            .map(|family| {
+                (
+                    family,
+                    scenarios.iter().filter(|s| s.family == Some(family)).count(),
+                )
+            })
+            .filter(|(_, n)| *n > 0)
+            .collect();
         CountTable {
             by_factor,
             gap: gap.into_iter().collect(),
+            families,
         }
     }
 
@@ -742,11 +909,21 @@ impl CountTable {
 
     /// The table as text: one row per factor, then the paper's grouping, then totals; then,
     /// if any were counted, the complexity-gap scenarios by added subtasks, labelled as not
-    /// part of the 440. A suite of complexity-gap files only prints that part alone.
+    /// part of the 440, and the real-world tasks' families likewise. A suite of auxiliary
+    /// files only prints those parts.
     pub fn render(&self) -> String {
         let mut out = String::new();
-        if self.totals().iter().sum::<usize>() > 0 || self.gap.is_empty() {
+        if self.totals().iter().sum::<usize>() > 0 || (self.gap.is_empty() && self.families.is_empty()) {
             self.render_main(&mut out);
+        }
+        if !self.families.is_empty() {
+            if !out.is_empty() {
+                out.push('\n');
+            }
+            out.push_str("real-world task families (auxiliary; not part of the 440)\n");
+            for &(family, n) in &self.families {
+                out.push_str(&format!("{:<34}{n:>7}\n", family.as_str()));
+            }
         }
         if !self.gap.is_empty() {
             if !out.is_empty() {

@@ -145,7 +145,7 @@ pub(crate) fn layout(config: &SubtaskConfig, [ox, oy]: [f64; 2]) -> SubtaskLayou
     SubtaskLayout {
         objects,
         articulations: Vec::new(),
-        goal: SubtaskGoal::Sweep {
+        goals: vec![SubtaskGoal::Sweep {
             placements: pieces
                 .iter()
                 .map(|p| Placement {
@@ -153,6 +153,6 @@ pub(crate) fn layout(config: &SubtaskConfig, [ox, oy]: [f64; 2]) -> SubtaskLayou
                     container: p.home_box().into(),
                 })
                 .collect(),
-        },
+        }],
     }
 }

@@ -11,6 +11,7 @@ mod codegen_domain;
 mod demo;
 mod demo_goal;
 mod determinism;
+mod drawers_family;
 mod experts;
 mod furniture;
 mod kinematics;

@@ -104,7 +104,27 @@ pub fn run<R: RobotApi + ?Sized>(robot: &mut R, scene: &SceneSpec) -> Result<(),
         .filter(|o| o.kind.is_loose())
         .map(|o| o.name.clone())
         .collect();
-    for goal in &scene.goals {
+    let mut goals = scene.goals.iter().peekable();
+    while let Some(goal) = goals.next() {
+        // Loads for the bottom drawers of several cabinets in a row are made together when
+        // the cabinets stand side by side (see `prismatic::run_side_by_side`).
+        if let SubtaskGoal::PutInPrismatic { objects, drawer } = goal {
+            let mut loads: Vec<(&[String], &str)> = vec![(objects, drawer)];
+            while let Some(SubtaskGoal::PutInPrismatic { objects, drawer }) = goals.peek() {
+                loads.push((objects, drawer));
+                goals.next();
+            }
+            let mut hand = Hand::new(robot, goal.kind(), &loose);
+            let drawers: Vec<&str> = loads.iter().map(|(_, d)| *d).collect();
+            if loads.len() > 1 && prismatic::side_by_side(&mut hand, &drawers)? {
+                prismatic::run_side_by_side(&mut hand, &loads)?;
+            } else {
+                for (objects, drawer) in loads {
+                    prismatic::run(&mut hand, objects, drawer)?;
+                }
+            }
+            continue;
+        }
         run_subtask(robot, goal, &loose)?;
     }
     Ok(())

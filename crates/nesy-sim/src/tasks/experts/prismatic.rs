@@ -2,8 +2,9 @@
 //! and the bottom one opened first if needed, and the bottom drawer closed at the end.
 
 use super::ExpertError;
-use super::hand::{Bbox, Hand, centre, overlaps, size};
+use super::hand::{Bbox, Hand, centre, overlaps, overlaps_xy, size};
 use crate::api::{DEFAULT_LIFT_CLEARANCE, Direction, RobotApi};
+use crate::domain::split_asset_part;
 use crate::scene::parts;
 use crate::tasks::layout::{DRAWER_DROP_CLEARANCE, DRAWER_PULL_FRACTION, DRAWER_RETREAT, DRAWER_SPOTS};
 
@@ -31,7 +32,7 @@ fn clear_handle_approach<R: RobotApi + ?Sized>(
     // the closed hinge box was taken back out to clear the way).
     let mut containers = Vec::new();
     for name in &names {
-        if CONTAINERS.contains(&name.as_str()) {
+        if CONTAINERS.contains(&bare_name(name)) {
             containers.push(hand.bbox(name)?);
         }
     }
@@ -85,15 +86,17 @@ fn furniture_in_the_way<R: RobotApi + ?Sized>(
 ) -> Result<bool, ExpertError> {
     let corridor = approach_corridor(hand, handle, pointing)?;
     for name in hand.robot.get_obj_names() {
-        let drawer = name == parts::TOP_DRAWER || name == parts::BOTTOM_DRAWER;
-        if CONTAINERS.contains(&name.as_str()) && !drawer && overlaps(&hand.bbox(&name)?, &corridor) {
+        let bare = bare_name(&name);
+        let drawer = bare == parts::TOP_DRAWER || bare == parts::BOTTOM_DRAWER;
+        if CONTAINERS.contains(&bare) && !drawer && overlaps(&hand.bbox(&name)?, &corridor) {
             return Ok(true);
         }
     }
     Ok(false)
 }
 
-/// The containers whose walls shield what lies inside them from a passing arm.
+/// The containers whose walls shield what lies inside them from a passing arm (bare names;
+/// an asset named with a prefix has them under its prefix).
 const CONTAINERS: [&str; 6] = [
     parts::HINGE_BODY,
     parts::TOY_BOX,
@@ -103,6 +106,222 @@ const CONTAINERS: [&str; 6] = [
     parts::RIGHT_CHESS_BOX,
 ];
 
+/// A name without the prefix of the asset it belongs to (`front_top_drawer` → `top_drawer`).
+fn bare_name(name: &str) -> &str {
+    split_asset_part(name).map_or(name, |(_, bare)| bare)
+}
+
+/// One cabinet as the expert sees it: its parts' prefix and the way its drawers slide out.
+struct Cabinet {
+    /// The prefix of its part names (`""` or ending in `_`).
+    prefix: String,
+    /// The axis its drawers slide along (0: x, 1: y).
+    axis: usize,
+    /// The sign of the way out along that axis.
+    outward: f64,
+}
+
+impl Cabinet {
+    /// The cabinet whose bottom drawer is `drawer`: drawers open toward the side their
+    /// handles are on.
+    fn of<R: RobotApi + ?Sized>(hand: &mut Hand<'_, R>, drawer: &str) -> Result<Cabinet, ExpertError> {
+        let prefix = drawer
+            .strip_suffix(parts::BOTTOM_DRAWER)
+            .unwrap_or_default()
+            .to_owned();
+        let body = centre(&hand.bbox(&format!("{prefix}{}", parts::DRAWER_BODY))?);
+        let handle = centre(&hand.bbox(&format!("{prefix}{}", parts::BOTTOM_DRAWER_HANDLE))?);
+        let axis = if (handle[1] - body[1]).abs() >= (handle[0] - body[0]).abs() {
+            1
+        } else {
+            0
+        };
+        let outward = if handle[axis] < body[axis] { -1.0 } else { 1.0 };
+        Ok(Cabinet {
+            prefix,
+            axis,
+            outward,
+        })
+    }
+
+    /// One of its parts, by its bare name.
+    fn part(&self, bare: &str) -> String {
+        format!("{}{bare}", self.prefix)
+    }
+
+    /// The direction that pulls its drawers open, and the one that pushes them shut.
+    fn directions(&self) -> (Direction, Direction) {
+        match (self.axis, self.outward < 0.0) {
+            (1, true) => (Direction::Left, Direction::Right),
+            (1, false) => (Direction::Right, Direction::Left),
+            (_, true) => (Direction::Back, Direction::Front),
+            (_, false) => (Direction::Front, Direction::Back),
+        }
+    }
+
+    /// Toward the cabinet, the pointing that keeps the hand in front of a handle; only a
+    /// cabinet whose drawers slide along y can be reached that way (the tool points down,
+    /// left or right).
+    fn sideways(&self) -> Option<Direction> {
+        (self.axis == 1).then_some(if self.outward < 0.0 {
+            Direction::Right
+        } else {
+            Direction::Left
+        })
+    }
+
+    /// Whether a drawer with box `b` stands open out of the body with box `body`.
+    fn is_open(&self, body: &Bbox, b: &Bbox) -> bool {
+        if self.outward < 0.0 {
+            b[0][self.axis] < body[0][self.axis] - 0.03
+        } else {
+            b[1][self.axis] > body[1][self.axis] + 0.03
+        }
+    }
+
+    /// Whether the drawer `name` stands open.
+    fn drawer_open<R: RobotApi + ?Sized>(
+        &self,
+        hand: &mut Hand<'_, R>,
+        name: &str,
+    ) -> Result<bool, ExpertError> {
+        let body = hand.bbox(&self.part(parts::DRAWER_BODY))?;
+        Ok(self.is_open(&body, &hand.bbox(name)?))
+    }
+
+    /// How far a drawer is pulled or pushed.
+    fn travel<R: RobotApi + ?Sized>(&self, hand: &mut Hand<'_, R>, drawer: &str) -> Result<f64, ExpertError> {
+        Ok(size(&hand.bbox(drawer)?)[self.axis] * DRAWER_PULL_FRACTION)
+    }
+
+    /// The pointing the bottom handle is grasped with: the fingers from above, as in the
+    /// authors' demo; the suction tool pointing at the cabinet, because from above its wrist
+    /// (6 cm above the tip and wider than the 2.5 cm between the handle and the cabinet face)
+    /// pushed cylinders standing at the cabinet's front edge down through its top. Where a
+    /// container stands in the sideways corridor, the suction tool comes from above too,
+    /// after the corridor above the handle is cleared.
+    fn bottom_pointing<R: RobotApi + ?Sized>(
+        &self,
+        hand: &mut Hand<'_, R>,
+    ) -> Result<Direction, ExpertError> {
+        Ok(match self.sideways() {
+            Some(sideways)
+                if hand.vacuum
+                    && !furniture_in_the_way(hand, &self.part(parts::BOTTOM_DRAWER_HANDLE), sideways)? =>
+            {
+                sideways
+            }
+            _ => Direction::Down,
+        })
+    }
+}
+
+/// Makes the cabinet's bottom drawer ready to fill: an open top drawer (which covers the
+/// bottom handle) is closed, a closed bottom drawer opened.
+fn open_bottom<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    cabinet: &Cabinet,
+    drawer: &str,
+) -> Result<(), ExpertError> {
+    let (open_dir, close_dir) = cabinet.directions();
+    let travel = cabinet.travel(hand, drawer)?;
+    let top = cabinet.part(parts::TOP_DRAWER);
+    let top_handle = cabinet.part(parts::TOP_DRAWER_HANDLE);
+    // The open top drawer is closed with the tool pointing at the cabinet: from above, the
+    // finger hand, wide along the bar, swept cylinders off the cabinet top on the way in.
+    if cabinet.drawer_open(hand, &top)? {
+        let pointing = match cabinet.sideways() {
+            Some(sideways) if !furniture_in_the_way(hand, &top_handle, sideways)? => sideways,
+            _ => Direction::Down,
+        };
+        clear_handle_approach(hand, &top_handle, pointing)?;
+        hand.grab_handle_pointing(&top_handle, pointing)?;
+        hand.slide_pointing(close_dir, travel, pointing)?;
+        hand.let_go_handle()?;
+    }
+    let pointing = cabinet.bottom_pointing(hand)?;
+    if !cabinet.drawer_open(hand, drawer)? {
+        let handle = cabinet.part(parts::BOTTOM_DRAWER_HANDLE);
+        clear_handle_approach(hand, &handle, pointing)?;
+        hand.grab_handle_pointing(&handle, pointing)?;
+        hand.slide_pointing(open_dir, travel, pointing)?;
+        hand.let_go_handle()?;
+        hand.slide_pointing(Direction::Up, DRAWER_RETREAT, pointing)?;
+    }
+    Ok(())
+}
+
+/// Drops the objects into the open drawer, one spot each; an object something rests on is
+/// uncovered first.
+fn fill<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    cabinet: &Cabinet,
+    objects: &[String],
+    drawer: &str,
+) -> Result<(), ExpertError> {
+    for (k, object) in objects.iter().enumerate() {
+        uncover(hand, object)?;
+        let h = hand.pick(object)?;
+        let b = hand.bbox(drawer)?;
+        let (c, s) = (centre(&b), size(&b));
+        // A spot is an offset across the cabinet and one along the way its drawers open.
+        let [across, along] = DRAWER_SPOTS[k % DRAWER_SPOTS.len()];
+        let (x, y) = if cabinet.axis == 1 {
+            (c[0] + across, c[1] + along * cabinet.outward)
+        } else {
+            (c[0] + along * cabinet.outward, c[1] + across)
+        };
+        hand.move_to(
+            [x, y, c[2] + s[2] + h + DRAWER_DROP_CLEARANCE],
+            DEFAULT_LIFT_CLEARANCE,
+        )?;
+        hand.release()?;
+    }
+    Ok(())
+}
+
+/// Moves aside, topmost first, every loose object that rests on `object`.
+fn uncover<R: RobotApi + ?Sized>(hand: &mut Hand<'_, R>, object: &str) -> Result<(), ExpertError> {
+    loop {
+        let me = hand.bbox(object)?;
+        let mut above = None;
+        for other in hand.robot.get_obj_names() {
+            if other == object || !hand.is_loose(&other) {
+                continue;
+            }
+            let b = hand.bbox(&other)?;
+            let resting = (b[0][2] - me[1][2]).abs() < 0.01 && overlaps_xy(&b, &me, 0.0);
+            if resting {
+                above = Some(other);
+                break;
+            }
+        }
+        match above {
+            Some(top) => {
+                uncover(hand, &top)?;
+                hand.move_aside(&top)?;
+            }
+            None => return Ok(()),
+        }
+    }
+}
+
+/// Pushes the cabinet's bottom drawer shut.
+fn close_bottom<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    cabinet: &Cabinet,
+    drawer: &str,
+) -> Result<(), ExpertError> {
+    let (_, close_dir) = cabinet.directions();
+    let travel = cabinet.travel(hand, drawer)?;
+    let pointing = cabinet.bottom_pointing(hand)?;
+    let handle = cabinet.part(parts::BOTTOM_DRAWER_HANDLE);
+    clear_handle_approach(hand, &handle, pointing)?;
+    hand.grab_handle_pointing(&handle, pointing)?;
+    hand.slide_pointing(close_dir, travel, pointing)?;
+    hand.let_go_handle()
+}
+
 /// Cylinders into the bottom drawer: an open top drawer (which covers the bottom handle) is
 /// closed, a closed bottom drawer opened, the cylinders dropped in, the drawer closed.
 pub(super) fn run<R: RobotApi + ?Sized>(
@@ -110,75 +329,48 @@ pub(super) fn run<R: RobotApi + ?Sized>(
     cylinders: &[String],
     drawer: &str,
 ) -> Result<(), ExpertError> {
-    let body = hand.bbox(parts::DRAWER_BODY)?;
-    let body_y = centre(&body)[1];
-    let handle_y = centre(&hand.bbox(parts::BOTTOM_DRAWER_HANDLE)?)[1];
-    // Drawers open toward the side their handles are on.
-    let (open_dir, close_dir, outward) = if handle_y < body_y {
-        (Direction::Left, Direction::Right, -1.0)
-    } else {
-        (Direction::Right, Direction::Left, 1.0)
-    };
-    let is_open = |b: &Bbox| {
-        if outward < 0.0 {
-            b[0][1] < body[0][1] - 0.03
-        } else {
-            b[1][1] > body[1][1] + 0.03
-        }
-    };
-    let travel = size(&hand.bbox(drawer)?)[1] * DRAWER_PULL_FRACTION;
-    // Toward the cabinet: the pointing that keeps the hand in front of the handle.
-    let sideways = if outward < 0.0 {
-        Direction::Right
-    } else {
-        Direction::Left
-    };
-    // The open top drawer is closed with the tool pointing at the cabinet: from above, the
-    // finger hand, wide along the bar, swept cylinders off the cabinet top on the way in.
-    if is_open(&hand.bbox(parts::TOP_DRAWER)?) {
-        let pointing = if furniture_in_the_way(hand, parts::TOP_DRAWER_HANDLE, sideways)? {
-            Direction::Down
-        } else {
-            sideways
-        };
-        clear_handle_approach(hand, parts::TOP_DRAWER_HANDLE, pointing)?;
-        hand.grab_handle_pointing(parts::TOP_DRAWER_HANDLE, pointing)?;
-        hand.slide_pointing(close_dir, travel, pointing)?;
-        hand.let_go_handle()?;
+    let cabinet = Cabinet::of(hand, drawer)?;
+    open_bottom(hand, &cabinet, drawer)?;
+    fill(hand, &cabinet, cylinders, drawer)?;
+    close_bottom(hand, &cabinet, drawer)
+}
+
+/// Whether the bottom drawers `drawers` (of different cabinets) all slide out the same way,
+/// so that the cabinets stand side by side and none opens into another's way.
+pub(super) fn side_by_side<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    drawers: &[&str],
+) -> Result<bool, ExpertError> {
+    let mut ways = Vec::new();
+    for drawer in drawers {
+        let cabinet = Cabinet::of(hand, drawer)?;
+        ways.push((cabinet.axis, cabinet.outward > 0.0, cabinet.prefix));
     }
-    // The bottom handle: the fingers from above, as in the authors' demo; the suction tool
-    // pointing at the cabinet, because from above its wrist (6 cm above the tip and wider
-    // than the 2.5 cm between the handle and the cabinet face) pushed cylinders standing at
-    // the cabinet's front edge down through its top.
-    // Where a container stands in the sideways corridor, the suction tool comes from above
-    // too, after the corridor above the handle is cleared.
-    let pointing = if hand.vacuum && !furniture_in_the_way(hand, parts::BOTTOM_DRAWER_HANDLE, sideways)? {
-        sideways
-    } else {
-        Direction::Down
-    };
-    if !is_open(&hand.bbox(drawer)?) {
-        clear_handle_approach(hand, parts::BOTTOM_DRAWER_HANDLE, pointing)?;
-        hand.grab_handle_pointing(parts::BOTTOM_DRAWER_HANDLE, pointing)?;
-        hand.slide_pointing(open_dir, travel, pointing)?;
-        hand.let_go_handle()?;
-        hand.slide_pointing(Direction::Up, DRAWER_RETREAT, pointing)?;
+    let distinct_cabinets = ways
+        .iter()
+        .enumerate()
+        .all(|(i, w)| ways[..i].iter().all(|o| o.2 != w.2));
+    Ok(distinct_cabinets && ways.windows(2).all(|w| w[0].0 == w[1].0 && w[0].1 == w[1].1))
+}
+
+/// Loads into the bottom drawers of cabinets standing side by side the way a person sorts
+/// things into them: every drawer opened first, then each one filled, then every one closed.
+pub(super) fn run_side_by_side<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    loads: &[(&[String], &str)],
+) -> Result<(), ExpertError> {
+    let mut cabinets = Vec::new();
+    for (_, drawer) in loads {
+        cabinets.push(Cabinet::of(hand, drawer)?);
     }
-    for (k, cylinder) in cylinders.iter().enumerate() {
-        let h = hand.pick(cylinder)?;
-        let b = hand.bbox(drawer)?;
-        let (c, s) = (centre(&b), size(&b));
-        let [dx, dy] = DRAWER_SPOTS[k % DRAWER_SPOTS.len()];
-        let x = c[0] + dx;
-        let y = c[1] + dy * outward;
-        hand.move_to(
-            [x, y, c[2] + s[2] + h + DRAWER_DROP_CLEARANCE],
-            DEFAULT_LIFT_CLEARANCE,
-        )?;
-        hand.release()?;
+    for ((_, drawer), cabinet) in loads.iter().zip(&cabinets) {
+        open_bottom(hand, cabinet, drawer)?;
     }
-    clear_handle_approach(hand, parts::BOTTOM_DRAWER_HANDLE, pointing)?;
-    hand.grab_handle_pointing(parts::BOTTOM_DRAWER_HANDLE, pointing)?;
-    hand.slide_pointing(close_dir, travel, pointing)?;
-    hand.let_go_handle()
+    for ((objects, drawer), cabinet) in loads.iter().zip(&cabinets) {
+        fill(hand, cabinet, objects, drawer)?;
+    }
+    for ((_, drawer), cabinet) in loads.iter().zip(&cabinets) {
+        close_bottom(hand, cabinet, drawer)?;
+    }
+    Ok(())
 }
