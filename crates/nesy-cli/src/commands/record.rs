@@ -17,7 +17,7 @@ use nesy_sim::perception::render::{
 };
 use nesy_sim::tasks::scenario::{self, Side};
 
-use super::scenarios::{SideArg, load_suite};
+use super::scenarios::{SideArg, suite_of};
 
 /// Arguments of `nesy record`.
 #[derive(Debug, clap::Args)]
@@ -113,7 +113,7 @@ pub(crate) fn run(args: RecordArgs) -> anyhow::Result<ExitCode> {
     if !(16..=4096).contains(&args.size) {
         anyhow::bail!("--size must be between 16 and 4096 pixels, got {}", args.size);
     }
-    let files = load_suite(args.suite.as_deref())?;
+    let files = suite_of(args.suite.as_deref(), &args.scenario)?;
     let scenario = scenario::find(&files, &args.scenario)?;
     let side: Side = args.side.into();
     let scene = scenario.generate(side)?.scene;

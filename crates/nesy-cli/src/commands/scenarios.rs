@@ -66,6 +66,11 @@ pub(crate) enum ScenariosAction {
         /// Write the problem here instead of printing it.
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
+        /// Also write the domain of this scene here: the domain file's schemas, and each
+        /// asset's under its own part names when the scene names them with prefixes (with
+        /// the `Blocks` precondition between assets); a planner takes this with the problem.
+        #[arg(long, value_name = "FILE")]
+        domain_out: Option<PathBuf>,
         /// Read the configurations from this directory instead of generating them.
         #[arg(long)]
         suite: Option<PathBuf>,
@@ -125,6 +130,15 @@ pub(crate) fn load_suite(suite: Option<&std::path::Path>) -> anyhow::Result<Vec<
     }
 }
 
+/// The suite that holds scenario `id`: the folder's, or the generated suite its id names
+/// (the 440, the complexity-gap suite or a real-world task's family).
+pub(crate) fn suite_of(suite: Option<&std::path::Path>, id: &str) -> anyhow::Result<Vec<ConfigFile>> {
+    match suite {
+        Some(dir) => Ok(scenario::read_suite(dir)?),
+        None => Ok(scenario::generated_suite_of(id)),
+    }
+}
+
 /// A family named on the command line.
 fn parse_family(name: &str) -> Result<Family, String> {
     Family::from_name(name).ok_or_else(|| {
@@ -175,15 +189,30 @@ pub(crate) fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         ScenariosAction::Show { id, side, suite } => {
-            let files = load_suite(suite.as_deref())?;
+            let files = suite_of(suite.as_deref(), &id)?;
             let scenario = scenario::find(&files, &id)?;
             outln!("{}", scenario.generate(side.into())?.scene.to_json_pretty())?;
             Ok(ExitCode::SUCCESS)
         }
-        ScenariosAction::Pddl { id, side, out, suite } => {
-            let files = load_suite(suite.as_deref())?;
+        ScenariosAction::Pddl {
+            id,
+            side,
+            out,
+            domain_out,
+            suite,
+        } => {
+            let files = suite_of(suite.as_deref(), &id)?;
             let scenario = scenario::find(&files, &id)?;
             let text = pddl_problem(&scenario, side.into())?;
+            if let Some(path) = domain_out {
+                let scene = scenario.generate(side.into())?.scene;
+                let names = scene.part_names();
+                let world = nesy_sim::domain::WorldDomain::builtin()?;
+                let domain = world.scene_domain(names.iter().map(String::as_str).chain(["floor"]));
+                std::fs::write(&path, domain.to_string())
+                    .with_context(|| format!("writing {}", path.display()))?;
+                eprintln!("{}", path.display());
+            }
             match out {
                 Some(path) => {
                     std::fs::write(&path, &text).with_context(|| format!("writing {}", path.display()))?;

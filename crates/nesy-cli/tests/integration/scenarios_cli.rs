@@ -159,6 +159,40 @@ fn record_writes_a_demo_that_reads_back_and_the_target_scene() {
     );
 }
 
+/// The real-world tasks' families are found by id without a suite folder: `nesy record`
+/// demonstrates one with the scripted expert and `scenarios show` prints its scenes.
+#[test]
+fn a_family_scenario_is_recorded_and_shown_by_its_id() {
+    let dir = common::scratch();
+    let out = dir.path().join("demo");
+    let id = "family_drawers_01_s1";
+    let (code, stdout, stderr) = common::run(&[
+        "record",
+        "--scenario",
+        id,
+        "--out",
+        out.to_str().unwrap(),
+        "--size",
+        "32",
+        "--threads",
+        "1",
+    ]);
+    assert_eq!(code, Some(0), "{stdout}{stderr}");
+    let said = format!("{stdout}{stderr}");
+    assert!(
+        said.contains("put_in_prismatic: full_success, put_in_prismatic: full_success"),
+        "{said}"
+    );
+    let demo = nesy_sim::demo::read(out.join("demo.mcap")).unwrap();
+    assert_eq!(demo.metadata.scenario_id.as_deref(), Some(id));
+    let (code, shown, stderr) = common::run(&["scenarios", "show", id, "--side", "target"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(shown.contains("side_drawer_body"), "{shown}");
+    let (code, _, stderr) = common::run(&["scenarios", "show", "family_nope_00_s0"]);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("family_<name>_<NN>_s<seed>"), "{stderr}");
+}
+
 #[test]
 fn a_reader_that_stops_early_ends_the_command_quietly() {
     let mut child = Command::new(env!("CARGO_BIN_EXE_nesy"))

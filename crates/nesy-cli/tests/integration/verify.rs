@@ -197,3 +197,66 @@ fn bad_input_exits_2_with_location() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("missing.pddl"));
 }
+
+/// `nesy scenarios pddl --domain-out` for a scene with two cabinets: the domain names each
+/// cabinet's schemas and the `Blocks` precondition, nesy-core's planner solves the problem in
+/// it, and `nesy verify` accepts the plan.
+#[test]
+fn a_scene_with_two_cabinets_gets_a_domain_a_planner_and_val_accept() {
+    let dir = crate::common::scratch();
+    let (domain, problem, plan) = (
+        dir.path().join("domain.pddl"),
+        dir.path().join("problem.pddl"),
+        dir.path().join("plan.txt"),
+    );
+    let out = nesy(&[
+        "scenarios",
+        "pddl",
+        "family_drawers_00_s0",
+        "--out",
+        problem.to_str().unwrap(),
+        "--domain-out",
+        domain.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let domain_text = std::fs::read_to_string(&domain).unwrap();
+    assert!(
+        domain_text.contains("(:action open-side-bottom-drawer"),
+        "{domain_text}"
+    );
+    assert!(domain_text.contains("(Blocks ?a ?b - thing)"), "{domain_text}");
+    let parsed = nesy_core::pddl::parse_domain(&domain_text).expect("the domain parses");
+    let parsed_problem = nesy_core::pddl::parse_problem(&std::fs::read_to_string(&problem).unwrap(), &parsed)
+        .expect("the problem parses");
+    let universe = parsed.universe(&parsed_problem).unwrap();
+    let found = nesy_core::planner::plan(
+        &parsed.actions,
+        &universe,
+        &parsed_problem.init,
+        &parsed_problem.goal,
+        &nesy_core::planner::PlannerConfig::default(),
+    )
+    .expect("a plan");
+    // One `(action args)` per line, as VAL reads plans.
+    let text: String = found
+        .steps
+        .iter()
+        .map(|s| match s.display_name() {
+            name if name.starts_with('(') => format!("{name}\n"),
+            name => format!("({name})\n"),
+        })
+        .collect();
+    std::fs::write(&plan, &text).unwrap();
+    let checked = verify(&domain, &problem, &plan, false);
+    assert_eq!(
+        checked.status.code(),
+        Some(0),
+        "{text}\n{}",
+        String::from_utf8_lossy(&checked.stdout)
+    );
+}

@@ -16,7 +16,7 @@ use nesy_core::Operator;
 use nesy_core::State;
 use nesy_core::Symbol;
 use nesy_core::builtin_predicates;
-use nesy_core::pddl::{Domain, Problem, parse_domain};
+use nesy_core::pddl::{Domain, PredicateDecl, Problem, parse_domain};
 use nesy_core::text::ParseError;
 use nesy_core::{AtomPattern, Effect, Formula};
 use nesy_core::{TypeError, Universe};
@@ -170,6 +170,37 @@ impl WorldDomain {
             }
         }
         out
+    }
+
+    /// The domain a scene's problem is planned in, as a PDDL domain any planner can take: the
+    /// file's types, constants and predicates (with `Blocks` declared when a schema uses it)
+    /// and the scene's schemas of both end effectors ([`WorldDomain::schemas_for`]). For a
+    /// scene with one asset under the bare names its actions are the file's.
+    pub fn scene_domain<'a>(&self, objects: impl IntoIterator<Item = &'a str>) -> Domain {
+        let universe = self.universe(objects);
+        let mut domain = self.domain.clone();
+        domain.actions = [Embodiment::Finger, Embodiment::Vacuum]
+            .into_iter()
+            .flat_map(|e| self.schemas_for(e, &universe))
+            .collect();
+        let blocks = Symbol::new(perception::observer::BLOCKS);
+        let uses_blocks = domain
+            .actions
+            .iter()
+            .any(|a| a.patterns().iter().any(|p| p.pred == blocks));
+        if uses_blocks && !domain.predicates.iter().any(|p| p.name == blocks) {
+            let thing = Symbol::new("thing");
+            domain.predicates.push(PredicateDecl {
+                name: blocks,
+                params: ["a", "b"]
+                    .map(|v| nesy_core::TypedVar {
+                        name: Symbol::new(v),
+                        ty: thing,
+                    })
+                    .to_vec(),
+            });
+        }
+        domain
     }
 
     /// A typed universe of the scene's objects (see [`object_type`]); the robot's own

@@ -232,7 +232,7 @@ pub enum ScenarioError {
     },
     /// No scenario has this id.
     #[error(
-        "unknown scenario {id:?}: expected <factor>_<complexity>_<NN>_s<seed>, e.g. obst_low_00_s0 (see `nesy scenarios list --ids`)"
+        "unknown scenario {id:?}: expected <factor>_<complexity>_<NN>_s<seed> (e.g. obst_low_00_s0), gap_obst_plus<k>_<NN>_s<seed> or family_<name>_<NN>_s<seed> (see `nesy scenarios list --ids`)"
     )]
     UnknownScenario {
         /// The id asked for.
@@ -822,6 +822,22 @@ pub fn scenarios(files: &[ConfigFile]) -> Vec<Scenario> {
             })
         })
         .collect()
+}
+
+/// The generated suite a scenario id belongs to: the complexity-gap suite for `gap_…`, a
+/// family's file for `family_<name>_…`, else the 440.
+pub fn generated_suite_of(id: &str) -> Vec<ConfigFile> {
+    if id.starts_with("gap_") {
+        return generate_gap_suite();
+    }
+    if let Some(rest) = id.strip_prefix("family_")
+        && let Some(family) = Family::ALL
+            .into_iter()
+            .find(|f| rest.strip_prefix(f.as_str()).is_some_and(|r| r.starts_with('_')))
+    {
+        return vec![generate_family_file(family)];
+    }
+    generate_suite()
 }
 
 /// Finds a scenario by id.
