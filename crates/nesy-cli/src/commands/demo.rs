@@ -33,57 +33,61 @@ pub(crate) enum DemonstratorArg {
     Vacuum,
 }
 
+/// Arguments of `nesy demo import`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct ImportArgs {
+    /// A video (`.mp4`, `.m4v` or `.mov` with H.264), a folder of frames (`*.jpg`/`*.png`,
+    /// or one subfolder per view), or a folder with the authors' `data.json` and `frames/`.
+    source: PathBuf,
+    /// The demo folder to write (new, or empty).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Keyframes: `auto` (where the scene, having changed, comes to rest; the default for
+    /// a video), `every:SECONDS`, `at:T1,T2,...` (seconds), or `all` (every frame; the
+    /// default for a folder, and the only choice for the authors' format).
+    #[arg(long, value_name = "MODE", value_parser = parse_mode)]
+    keyframes: Option<KeyframeMode>,
+    /// `auto`: the least luma difference (0-255, over the 4-pixel block of a 128-pixel
+    /// thumbnail where it is largest) that counts as motion; a noisy camera raises it by
+    /// itself to three times its quiet level.
+    #[arg(long, value_name = "LUMA", default_value_t = MIN_MOTION)]
+    min_motion: f32,
+    /// `auto`: seconds the pictures must stay still for the scene to be at rest.
+    #[arg(long, value_name = "SECONDS", default_value_t = MIN_REST_S)]
+    min_rest: f64,
+    /// Frames per second of a frames folder (needed by auto, every: and at:; a video
+    /// carries its own times).
+    #[arg(long, value_name = "FPS")]
+    fps: Option<f64>,
+    /// The view name of a video, or of a folder holding its frames directly.
+    #[arg(long, value_name = "NAME", default_value = DEFAULT_VIEW)]
+    view: String,
+    /// The task's instruction (required for a video or a frames folder).
+    #[arg(long, value_name = "TEXT")]
+    instruction: Option<String>,
+    /// The objects in the scene, comma-separated (required for a video or a frames folder).
+    #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
+    objects: Option<Vec<String>>,
+    /// Who demonstrated (default: human for a video or frames, finger for the authors'
+    /// format).
+    #[arg(long, value_enum)]
+    demonstrator: Option<DemonstratorArg>,
+    /// The ground truth of a simulated demonstration video (`demo.video.json` from
+    /// `nesy record --video`): keyframes get the recording's states at their frames (and
+    /// the recorded calls of the true keyframes they match), the task and robot come from
+    /// it, and the chosen keyframes are scored against the true ones.
+    #[arg(long, value_name = "FILE")]
+    truth: Option<PathBuf>,
+    /// Print the import report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
 /// The `nesy demo` actions.
 #[derive(Debug, clap::Subcommand)]
 pub(crate) enum DemoAction {
     /// Write a demo folder from a video, a frames folder or the authors' demo format.
-    Import {
-        /// A video (`.mp4`, `.m4v` or `.mov` with H.264), a folder of frames (`*.jpg`/`*.png`,
-        /// or one subfolder per view), or a folder with the authors' `data.json` and `frames/`.
-        source: PathBuf,
-        /// The demo folder to write (new, or empty).
-        #[arg(long, value_name = "DIR")]
-        out: PathBuf,
-        /// Keyframes: `auto` (where the scene, having changed, comes to rest; the default for
-        /// a video), `every:SECONDS`, `at:T1,T2,...` (seconds), or `all` (every frame; the
-        /// default for a folder, and the only choice for the authors' format).
-        #[arg(long, value_name = "MODE", value_parser = parse_mode)]
-        keyframes: Option<KeyframeMode>,
-        /// `auto`: the least luma difference (0-255, over the 4-pixel block of a 128-pixel
-        /// thumbnail where it is largest) that counts as motion; a noisy camera raises it by
-        /// itself to three times its quiet level.
-        #[arg(long, value_name = "LUMA", default_value_t = MIN_MOTION)]
-        min_motion: f32,
-        /// `auto`: seconds the pictures must stay still for the scene to be at rest.
-        #[arg(long, value_name = "SECONDS", default_value_t = MIN_REST_S)]
-        min_rest: f64,
-        /// Frames per second of a frames folder (needed by auto, every: and at:; a video
-        /// carries its own times).
-        #[arg(long, value_name = "FPS")]
-        fps: Option<f64>,
-        /// The view name of a video, or of a folder holding its frames directly.
-        #[arg(long, value_name = "NAME", default_value = DEFAULT_VIEW)]
-        view: String,
-        /// The task's instruction (required for a video or a frames folder).
-        #[arg(long, value_name = "TEXT")]
-        instruction: Option<String>,
-        /// The objects in the scene, comma-separated (required for a video or a frames folder).
-        #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
-        objects: Option<Vec<String>>,
-        /// Who demonstrated (default: human for a video or frames, finger for the authors'
-        /// format).
-        #[arg(long, value_enum)]
-        demonstrator: Option<DemonstratorArg>,
-        /// The ground truth of a simulated demonstration video (`demo.video.json` from
-        /// `nesy record --video`): keyframes get the recording's states at their frames (and
-        /// the recorded calls of the true keyframes they match), the task and robot come from
-        /// it, and the chosen keyframes are scored against the true ones.
-        #[arg(long, value_name = "FILE")]
-        truth: Option<PathBuf>,
-        /// Print the import report as JSON.
-        #[arg(long)]
-        json: bool,
-    },
+    Import(ImportArgs),
     /// Write a contact sheet of a recording's keyframes (a demo, or the `execution.mcap` of
     /// `nesy adapt --execute --render-every N`), each captioned with the call that led to it:
     /// a run's key steps at a glance.
@@ -109,16 +113,20 @@ fn parse_mode(text: &str) -> Result<KeyframeMode, String> {
 
 /// Runs `nesy demo`.
 pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
-    if let DemoAction::Frames {
-        recording,
-        out,
-        view,
-        after,
-    } = args.action
-    {
-        return frames(&recording, &out, &view, after.as_deref());
+    match args.action {
+        DemoAction::Import(import_args) => import(import_args),
+        DemoAction::Frames {
+            recording,
+            out,
+            view,
+            after,
+        } => frames(&recording, &out, &view, after.as_deref()),
     }
-    let DemoAction::Import {
+}
+
+/// `nesy demo import`: a demo folder from a video, a frames folder or the authors' format.
+fn import(args: ImportArgs) -> anyhow::Result<ExitCode> {
+    let ImportArgs {
         source,
         out,
         keyframes,
@@ -131,10 +139,7 @@ pub(crate) fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         demonstrator,
         truth,
         json,
-    } = args.action
-    else {
-        unreachable!("frames is handled above");
-    };
+    } = args;
     let keyframes = keyframes.unwrap_or(if nesy_import::is_video(&source) {
         KeyframeMode::Auto
     } else {

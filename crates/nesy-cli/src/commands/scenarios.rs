@@ -203,12 +203,10 @@ pub(crate) fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
         } => {
             let files = suite_of(suite.as_deref(), &id)?;
             let scenario = scenario::find(&files, &id)?;
-            let text = pddl_problem(&scenario, side.into())?;
+            let (text, names) = pddl_problem(&scenario, side.into())?;
             if let Some(path) = domain_out {
-                let scene = scenario.generate(side.into())?.scene;
-                let names = scene.part_names();
                 let world = nesy_sim::domain::WorldDomain::builtin()?;
-                let domain = world.scene_domain(names.iter().map(String::as_str).chain(["floor"]));
+                let domain = world.scene_domain(names.iter().map(String::as_str));
                 std::fs::write(&path, domain.to_string())
                     .with_context(|| format!("writing {}", path.display()))?;
                 eprintln!("{}", path.display());
@@ -564,8 +562,9 @@ fn run_one(s: &Scenario, side: Side) -> SceneResult {
 }
 
 /// One side of a scenario as a PDDL problem: the scene built and observed, its objects typed
-/// for the true domain, its goal with the end effector released.
-fn pddl_problem(scenario: &Scenario, side: Side) -> anyhow::Result<String> {
+/// for the true domain, its goal with the end effector released; and the scene's object
+/// names, which `--domain-out`'s domain is built from too.
+fn pddl_problem(scenario: &Scenario, side: Side) -> anyhow::Result<(String, Vec<String>)> {
     use nesy_core::Formula;
     let generated = scenario.generate(side)?;
     let scene = generated.scene;
@@ -583,5 +582,5 @@ fn pddl_problem(scenario: &Scenario, side: Side) -> anyhow::Result<String> {
         if side == Side::Source { "source" } else { "target" }
     );
     let problem = world.problem(&name, names.iter().map(String::as_str), init, goal);
-    Ok(problem.to_string())
+    Ok((problem.to_string(), names))
 }

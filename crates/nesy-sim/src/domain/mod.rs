@@ -271,13 +271,7 @@ fn add_blocking_preconditions(op: &mut Operator, links: &[&str]) {
     let Some(opened) = opened else {
         return;
     };
-    let prefix_of = |link: &str| {
-        MOVING_LINKS
-            .iter()
-            .find_map(|bare| link.strip_suffix(bare))
-            .unwrap_or_default()
-            .to_owned()
-    };
+    let prefix_of = |link: &str| split_asset_part(link).map(|(prefix, _)| prefix.to_owned());
     let own = prefix_of(&opened);
     let mut pre: Vec<Formula> = op.pre.to_vec();
     for other in links.iter().filter(|o| prefix_of(o) != own) {

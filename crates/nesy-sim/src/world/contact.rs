@@ -119,31 +119,20 @@ impl Sim {
     /// The first blocker that articulation `ai`'s solid moving colliders would overlap at
     /// joint position `q`.
     fn blocked_at(&self, ai: usize, q: f64, blockers: &[Blocker<'_>]) -> Option<usize> {
-        let a = &self.articulations[ai];
-        let body_pose = a.frame * objects::joint_motion(a.joint, q);
-        for &part in &a.parts {
-            for &c in &self.parts[part].colliders {
-                let collider = &self.world.colliders[c];
-                if collider.is_sensor() {
+        for moving in self.articulation_colliders_at(ai, q) {
+            for blocker in blockers {
+                if !moving.aabb.intersects(&blocker.aabb) {
                     continue;
                 }
-                let local = collider.position_wrt_parent().copied().unwrap_or(Pose::IDENTITY);
-                let pose = body_pose * local;
-                let aabb = collider.shape().compute_aabb(&pose);
-                for blocker in blockers {
-                    if !aabb.intersects(&blocker.aabb) {
-                        continue;
-                    }
-                    let touching = rapier3d::parry::query::intersection_test(
-                        &pose,
-                        collider.shape(),
-                        &blocker.pose,
-                        blocker.shape,
-                    )
-                    .is_ok_and(|hit| hit.intersecting);
-                    if touching {
-                        return Some(blocker.part);
-                    }
+                let touching = rapier3d::parry::query::intersection_test(
+                    &moving.pose,
+                    moving.shape,
+                    &blocker.pose,
+                    blocker.shape,
+                )
+                .is_ok_and(|hit| hit.intersecting);
+                if touching {
+                    return Some(blocker.part);
                 }
             }
         }
@@ -194,28 +183,25 @@ impl Sim {
     }
 
     /// The solid colliders of articulation `ai`'s moving parts posed at joint position `q`.
-    fn articulation_colliders_at(&self, ai: usize, q: f64) -> Vec<Blocker<'_>> {
+    fn articulation_colliders_at(&self, ai: usize, q: f64) -> impl Iterator<Item = Blocker<'_>> {
         let a = &self.articulations[ai];
         let body_pose = a.frame * objects::joint_motion(a.joint, q);
-        a.parts
-            .iter()
-            .flat_map(|&part| {
-                self.parts[part].colliders.iter().filter_map(move |&c| {
-                    let collider = &self.world.colliders[c];
-                    if collider.is_sensor() {
-                        return None;
-                    }
-                    let local = collider.position_wrt_parent().copied().unwrap_or(Pose::IDENTITY);
-                    let pose = body_pose * local;
-                    Some(Blocker {
-                        part,
-                        shape: collider.shape(),
-                        pose,
-                        aabb: collider.shape().compute_aabb(&pose),
-                    })
+        a.parts.iter().flat_map(move |&part| {
+            self.parts[part].colliders.iter().filter_map(move |&c| {
+                let collider = &self.world.colliders[c];
+                if collider.is_sensor() {
+                    return None;
+                }
+                let local = collider.position_wrt_parent().copied().unwrap_or(Pose::IDENTITY);
+                let pose = body_pose * local;
+                Some(Blocker {
+                    part,
+                    shape: collider.shape(),
+                    pose,
+                    aabb: collider.shape().compute_aabb(&pose),
                 })
             })
-            .collect()
+        })
     }
 
     /// Pairs of moving links (part indices) of different assets where the first, fully
@@ -227,11 +213,16 @@ impl Sim {
         let mut pairs = Vec::new();
         for (ai, a) in self.articulations.iter().enumerate() {
             let owner = self.parts[a.link].object;
-            let open = self.articulation_colliders_at(ai, a.limits.1);
-            for (bi, b) in self.articulations.iter().enumerate() {
-                if bi == ai || self.parts[b.link].object == owner {
-                    continue;
-                }
+            let others: Vec<usize> = (0..self.articulations.len())
+                .filter(|&bi| self.parts[self.articulations[bi].link].object != owner)
+                .collect();
+            // A scene with one asset (every benchmark scene) has nothing to check.
+            if others.is_empty() {
+                continue;
+            }
+            let open: Vec<Blocker<'_>> = self.articulation_colliders_at(ai, a.limits.1).collect();
+            for bi in others {
+                let b = &self.articulations[bi];
                 let (closed, full) = b.limits;
                 let meets = (1..=BLOCKING_SAMPLES).any(|k| {
                     let q = closed + (full - closed) * k as f64 / BLOCKING_SAMPLES as f64;

@@ -106,51 +106,32 @@ pub fn run<R: RobotApi + ?Sized>(robot: &mut R, scene: &SceneSpec) -> Result<(),
         .collect();
     let mut goals = scene.goals.iter().peekable();
     while let Some(goal) = goals.next() {
-        // Loads for the bottom drawers of several cabinets in a row are made together when
-        // the cabinets stand side by side (see `prismatic::run_side_by_side`).
-        if let SubtaskGoal::PutInPrismatic { objects, drawer } = goal {
-            let mut loads: Vec<(&[String], &str)> = vec![(objects, drawer)];
-            while let Some(SubtaskGoal::PutInPrismatic { objects, drawer }) = goals.peek() {
-                loads.push((objects, drawer));
-                goals.next();
+        let mut hand = Hand::new(robot, goal.kind(), &loose);
+        match goal {
+            SubtaskGoal::PickPlace { objects, container } => pick_place::run(&mut hand, objects, container)?,
+            SubtaskGoal::Sweep { placements } => {
+                let pairs: Vec<(&str, &str)> = placements
+                    .iter()
+                    .map(|p| (p.object.as_str(), p.container.as_str()))
+                    .collect();
+                sweep::run(&mut hand, &pairs)?
             }
-            let mut hand = Hand::new(robot, goal.kind(), &loose);
-            let drawers: Vec<&str> = loads.iter().map(|(_, d)| *d).collect();
-            if loads.len() > 1 && prismatic::side_by_side(&mut hand, &drawers)? {
-                prismatic::run_side_by_side(&mut hand, &loads)?;
-            } else {
-                for (objects, drawer) in loads {
-                    prismatic::run(&mut hand, objects, drawer)?;
+            SubtaskGoal::PutInHinge {
+                objects,
+                container,
+                lid,
+            } => hinge::run(&mut hand, objects, container, lid)?,
+            // Loads for the bottom drawers of several cabinets in a row are made together
+            // (see `prismatic::run`).
+            SubtaskGoal::PutInPrismatic { objects, drawer } => {
+                let mut loads: Vec<(&[String], &str)> = vec![(objects, drawer)];
+                while let Some(SubtaskGoal::PutInPrismatic { objects, drawer }) = goals.peek() {
+                    loads.push((objects, drawer));
+                    goals.next();
                 }
+                prismatic::run(&mut hand, &loads)?
             }
-            continue;
         }
-        run_subtask(robot, goal, &loose)?;
     }
     Ok(())
-}
-
-/// Runs the expert of one subtask; `loose` names the scene's loose objects.
-fn run_subtask<R: RobotApi + ?Sized>(
-    robot: &mut R,
-    goal: &SubtaskGoal,
-    loose: &[String],
-) -> Result<(), ExpertError> {
-    let mut hand = Hand::new(robot, goal.kind(), loose);
-    match goal {
-        SubtaskGoal::PickPlace { objects, container } => pick_place::run(&mut hand, objects, container),
-        SubtaskGoal::Sweep { placements } => {
-            let pairs: Vec<(&str, &str)> = placements
-                .iter()
-                .map(|p| (p.object.as_str(), p.container.as_str()))
-                .collect();
-            sweep::run(&mut hand, &pairs)
-        }
-        SubtaskGoal::PutInHinge {
-            objects,
-            container,
-            lid,
-        } => hinge::run(&mut hand, objects, container, lid),
-        SubtaskGoal::PutInPrismatic { objects, drawer } => prismatic::run(&mut hand, objects, drawer),
-    }
 }

@@ -322,55 +322,53 @@ fn close_bottom<R: RobotApi + ?Sized>(
     hand.let_go_handle()
 }
 
-/// Cylinders into the bottom drawer: an open top drawer (which covers the bottom handle) is
-/// closed, a closed bottom drawer opened, the cylinders dropped in, the drawer closed.
+/// Objects into the bottom drawers of one or more cabinets, `(objects, drawer)` per cabinet:
+/// for each, an open top drawer (which covers the bottom handle) is closed, a closed bottom
+/// drawer opened, the objects dropped in, the drawer closed. Cabinets standing side by side
+/// (every bottom drawer sliding out the same way, so none opens into another's way) are loaded
+/// the way a person sorts things into them: every drawer opened first, then each one filled,
+/// then every one closed.
 pub(super) fn run<R: RobotApi + ?Sized>(
-    hand: &mut Hand<'_, R>,
-    cylinders: &[String],
-    drawer: &str,
-) -> Result<(), ExpertError> {
-    let cabinet = Cabinet::of(hand, drawer)?;
-    open_bottom(hand, &cabinet, drawer)?;
-    fill(hand, &cabinet, cylinders, drawer)?;
-    close_bottom(hand, &cabinet, drawer)
-}
-
-/// Whether the bottom drawers `drawers` (of different cabinets) all slide out the same way,
-/// so that the cabinets stand side by side and none opens into another's way.
-pub(super) fn side_by_side<R: RobotApi + ?Sized>(
-    hand: &mut Hand<'_, R>,
-    drawers: &[&str],
-) -> Result<bool, ExpertError> {
-    let mut ways = Vec::new();
-    for drawer in drawers {
-        let cabinet = Cabinet::of(hand, drawer)?;
-        ways.push((cabinet.axis, cabinet.outward > 0.0, cabinet.prefix));
-    }
-    let distinct_cabinets = ways
-        .iter()
-        .enumerate()
-        .all(|(i, w)| ways[..i].iter().all(|o| o.2 != w.2));
-    Ok(distinct_cabinets && ways.windows(2).all(|w| w[0].0 == w[1].0 && w[0].1 == w[1].1))
-}
-
-/// Loads into the bottom drawers of cabinets standing side by side the way a person sorts
-/// things into them: every drawer opened first, then each one filled, then every one closed.
-pub(super) fn run_side_by_side<R: RobotApi + ?Sized>(
     hand: &mut Hand<'_, R>,
     loads: &[(&[String], &str)],
 ) -> Result<(), ExpertError> {
-    let mut cabinets = Vec::new();
+    let mut cabinets = Vec::with_capacity(loads.len());
     for (_, drawer) in loads {
         cabinets.push(Cabinet::of(hand, drawer)?);
     }
-    for ((_, drawer), cabinet) in loads.iter().zip(&cabinets) {
-        open_bottom(hand, cabinet, drawer)?;
-    }
-    for ((objects, drawer), cabinet) in loads.iter().zip(&cabinets) {
-        fill(hand, cabinet, objects, drawer)?;
-    }
-    for ((_, drawer), cabinet) in loads.iter().zip(&cabinets) {
-        close_bottom(hand, cabinet, drawer)?;
+    let loads: Vec<(&Cabinet, &[String], &str)> = cabinets
+        .iter()
+        .zip(loads)
+        .map(|(cabinet, (objects, drawer))| (cabinet, *objects, *drawer))
+        .collect();
+    if loads.len() > 1 && side_by_side(&cabinets) {
+        for (cabinet, _, drawer) in &loads {
+            open_bottom(hand, cabinet, drawer)?;
+        }
+        for (cabinet, objects, drawer) in &loads {
+            fill(hand, cabinet, objects, drawer)?;
+        }
+        for (cabinet, _, drawer) in &loads {
+            close_bottom(hand, cabinet, drawer)?;
+        }
+    } else {
+        for (cabinet, objects, drawer) in &loads {
+            open_bottom(hand, cabinet, drawer)?;
+            fill(hand, cabinet, objects, drawer)?;
+            close_bottom(hand, cabinet, drawer)?;
+        }
     }
     Ok(())
+}
+
+/// Whether the cabinets are distinct and all their bottom drawers slide out the same way.
+fn side_by_side(cabinets: &[Cabinet]) -> bool {
+    let distinct = cabinets
+        .iter()
+        .enumerate()
+        .all(|(i, c)| cabinets[..i].iter().all(|o| o.prefix != c.prefix));
+    distinct
+        && cabinets
+            .windows(2)
+            .all(|w| w[0].axis == w[1].axis && (w[0].outward > 0.0) == (w[1].outward > 0.0))
 }
