@@ -8,7 +8,8 @@
 ;; predicates' CamelCase spelling from the vocabulary after parsing.
 (define (domain nesy-world)
   (:requirements :strips :typing :negative-preconditions :universal-preconditions :conditional-effects)
-  (:types item surface box part - thing)
+  (:types item surface box part pieces - thing
+    tool - item)
   (:constants
     floor board - surface
     hinge_body hinge_lid hinge_handle drawer_body top_drawer bottom_drawer
@@ -18,7 +19,8 @@
     (Open ?x - thing) (Closed ?x - thing)
     (FingerGripper) (VacuumSuction)
     (GripperSurrounding ?x - thing) (GripperHolding ?x - thing) (GripperOpen) (GripperClosed)
-    (VacuumAligned ?x - thing) (VacuumAttached ?x - thing) (VacuumActive) (VacuumInactive))
+    (VacuumAligned ?x - thing) (VacuumAttached ?x - thing) (VacuumActive) (VacuumInactive)
+    (Finegrained ?x - thing) (Gathered ?x - thing) (OnMagnet ?x ?h - thing))
 
   ;; ---------------------------------------------------------------- finger gripper
   ; move_gripper_to(?x, depth=h/2): the open tool goes around (finger) or onto (vacuum) a loose object nothing rests on
@@ -382,6 +384,59 @@
       (not (GripperClosed))
       (not (GripperHolding top_drawer_handle))
       (GripperSurrounding top_drawer)
+    ))
+
+  ;; ---------------------------------------------------------------- magnetic hook (finger gripper)
+  ; gather_with_hook(?x): sweep the held hook's magnet low over the pieces of ?x; they cling to it and are lifted with it
+  (:action gather-with-hook
+    :parameters (?h - tool ?x - pieces)
+    :precondition (and
+      (FingerGripper)
+      (GripperHolding ?h)
+      (Finegrained ?x)
+    )
+    :effect (and
+      (forall (?s - thing) (when (or (InsideOf ?x ?s) (OnTopOf ?x ?s)) (OverOf ?h ?s)))
+      (forall (?y - thing) (not (OnTopOf ?h ?y)))
+      (forall (?y - thing) (not (InsideOf ?h ?y)))
+      (forall (?y - thing) (not (OverOf ?h ?y)))
+      (forall (?y - thing) (not (OnTopOf ?x ?y)))
+      (forall (?y - thing) (not (InsideOf ?x ?y)))
+      (Gathered ?x)
+      (OnMagnet ?x ?h)
+    ))
+  ; move_to_position: hold the hook over the open bottom drawer, the pieces on its magnet hanging under it
+  (:action carry-hook-over-bottom-drawer
+    :parameters (?h - tool)
+    :precondition (and
+      (FingerGripper)
+      (GripperHolding ?h)
+      (Open bottom_drawer)
+    )
+    :effect (and
+      (forall (?y - thing) (not (OnTopOf ?h ?y)))
+      (forall (?y - thing) (not (InsideOf ?h ?y)))
+      (forall (?y - thing) (not (OverOf ?h ?y)))
+      (OverOf ?h bottom_drawer)
+      (forall (?x - thing) (when (OnMagnet ?x ?h) (and
+        (forall (?y - thing) (not (OnTopOf ?x ?y)))
+        (forall (?y - thing) (not (InsideOf ?x ?y))))))
+    ))
+  ; open_gripper: drop the hook into the bottom drawer below it; the pieces on its magnet go in with it
+  (:action drop-hook-into-bottom-drawer
+    :parameters (?h - tool)
+    :precondition (and
+      (FingerGripper)
+      (GripperHolding ?h)
+      (OverOf ?h bottom_drawer)
+    )
+    :effect (and
+      (GripperOpen)
+      (not (GripperClosed))
+      (not (GripperHolding ?h))
+      (InsideOf ?h bottom_drawer)
+      (not (OverOf ?h bottom_drawer))
+      (forall (?x - thing) (when (OnMagnet ?x ?h) (InsideOf ?x bottom_drawer)))
     ))
 
   ;; ---------------------------------------------------------------- vacuum suction tool

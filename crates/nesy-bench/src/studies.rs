@@ -59,6 +59,8 @@ pub enum Study {
     ComplexityGap,
     /// Table 2's task in simulation: the real-world drawers family.
     Drawers,
+    /// Figures 1 and 5's task in simulation: the real-world hook-and-screws family.
+    Hook,
 }
 
 /// One row of a study: its label in the table, the variant it runs, and what reading of
@@ -75,11 +77,12 @@ pub struct StudyRow {
 
 impl Study {
     /// Every study.
-    pub const ALL: [Study; 4] = [
+    pub const ALL: [Study; 5] = [
         Study::Ablation,
         Study::Robustness,
         Study::ComplexityGap,
         Study::Drawers,
+        Study::Hook,
     ];
 
     /// The scenarios a study runs on unless told otherwise: the paper's cell for both tables
@@ -87,7 +90,7 @@ impl Study {
     pub fn default_scenarios(self) -> &'static str {
         match self {
             Study::Ablation | Study::Robustness => "comb_medium",
-            Study::ComplexityGap | Study::Drawers => "all",
+            Study::ComplexityGap | Study::Drawers | Study::Hook => "all",
         }
     }
 
@@ -103,6 +106,7 @@ impl Study {
     pub fn family(self) -> Option<Family> {
         match self {
             Study::Drawers => Some(Family::Drawers),
+            Study::Hook => Some(Family::Hook),
             _ => None,
         }
     }
@@ -112,7 +116,7 @@ impl Study {
     pub fn default_repeats(self) -> u32 {
         match self {
             Study::Ablation | Study::Robustness => 3,
-            Study::ComplexityGap | Study::Drawers => 1,
+            Study::ComplexityGap | Study::Drawers | Study::Hook => 1,
         }
     }
 
@@ -123,6 +127,7 @@ impl Study {
             Study::Robustness => "robustness",
             Study::ComplexityGap => "complexity-gap",
             Study::Drawers => "drawers",
+            Study::Hook => "hook",
         }
     }
 
@@ -146,6 +151,7 @@ impl Study {
             Study::Robustness => "Robustness to scene-graph perturbation (Table 8 shape)",
             Study::ComplexityGap => "Complexity gap (Figure 4(b) shape)",
             Study::Drawers => "Drawers that block each other (Table 2's task, simulated)",
+            Study::Hook => "A magnetic hook gathers scattered screws (Figures 1 and 5's task, simulated)",
         }
     }
 
@@ -160,6 +166,7 @@ impl Study {
             ),
             Study::ComplexityGap => "no noise; the offline responder answers every call from ground truth and nesy's true domain, and its patches are nesy-core's plans, so the subtasks the demonstration never shows are planned, not adapted from it. The NeSyCR rows are the responder's upper bound with the goal given by the target task or derived from the demonstration; the scenarios are the auxiliary complexity-gap suite (Obstruction, one demonstrated subtask, targets with 0 to 3 more), not part of the 440.".to_owned(),
             Study::Drawers => "no noise; the offline responder answers every call from ground truth and nesy's true domain (the upper bound), and the controls are model-free. The scenarios are the drawers family (two cabinets side by side in the demonstration, at right angles with the cubes stacked in the target; simulated, finger robot), not part of the 440 and not the paper's real-robot trials.".to_owned(),
+            Study::Hook => "no noise; the offline responder answers every call from ground truth and nesy's true domain (the upper bound), and the controls are model-free. The scenarios are the hook family (the hook, the screws on its magnet and the cubes on the table in the demonstration; in the target the hook lies in the open drawer under a cube and the screws are scattered, so the hook must be uncovered, taken out and swept over them; simulated magnet, finger robot), not part of the 440 and not the paper's real-robot trials.".to_owned(),
         }
     }
 
@@ -169,7 +176,7 @@ impl Study {
             Study::Ablation => ablation_rows(),
             Study::Robustness => robustness_rows(),
             Study::ComplexityGap => complexity_gap_rows(),
-            Study::Drawers => family_rows(),
+            Study::Drawers | Study::Hook => family_rows(),
         }
     }
 

@@ -36,7 +36,8 @@ pub fn api_function(schema: &str, embodiment: Embodiment) -> Option<&'static str
         s if s.starts_with("attach-") => "attach_vacuum_handle",
         s if s.starts_with("carry-") || s == "open-hinge-lid" || s == "close-hinge-lid" => "move_to_position",
         "put-down" | "release-into" => release,
-        s if s.starts_with("drop-into-") => release,
+        s if s.starts_with("drop-") => release,
+        "gather-with-hook" => "gather_with_hook",
         "sweep-into" | "slide-into" | "retreat" => "move_parallel",
         s if s.ends_with("-drawer") && (s.starts_with("open-") || s.starts_with("close-")) => "move_parallel",
         s if s.starts_with("release-") => "release_handle",
@@ -141,7 +142,10 @@ fn focus_object(call: Option<&ApiCall>, prev: &State, next: &State) -> Option<Sy
 /// Every type-correct binding of `schema`'s parameters; `focus`, the object the call works on,
 /// fixes the first parameter when that is an item.
 fn bindings(schema: &Operator, universe: &Universe, focus: Option<Symbol>) -> Vec<Vec<Symbol>> {
-    let item_first = schema.params.first().is_some_and(|p| p.ty.as_str() == "item");
+    let item_first = schema
+        .params
+        .first()
+        .is_some_and(|p| matches!(p.ty.as_str(), "item" | "tool"));
     let focus = focus.filter(|_| item_first);
     let mut out = vec![Vec::new()];
     for (i, p) in schema.params.iter().enumerate() {

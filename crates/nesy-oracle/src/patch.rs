@@ -356,8 +356,10 @@ fn append_to_goal(
             }
         }
     }
-    match planning.plan(&violation.state, &goal_of(&wanted)) {
+    let goal = goal_of(&wanted);
+    let appended = match planning.plan(&violation.state, &goal) {
         Ok((plan, _)) => {
+            let steps = plan.len();
             let mut replace = vec![last.clone()];
             replace.extend(plan);
             found.patches.push(ProposedPatch {
@@ -367,10 +369,59 @@ fn append_to_goal(
                 at: procedure.len() - 1,
                 rationale: "every action applies but the goal does not hold yet; a plan over the true domain reaches the unmet goal literals after the last action.".into(),
             });
+            Some(steps)
         }
-        Err(e) => found.reasons.push(e),
-    }
+        Err(e) => {
+            found.reasons.push(e);
+            None
+        }
+    };
+    insert_for_goal(planning, ctx, &goal, appended, found);
     Ok(())
+}
+
+/// Goal literals an earlier step makes easy to reach: a plan to them put before step `j`,
+/// offered for every `j` where it is shorter than the plan after the last action (or where
+/// that one failed). The paper's hook is swept over the screws while it is in the hand,
+/// before the items that would cover it in the drawer are put away, instead of being dug
+/// out again at the end; the verifier (in [`score`]) keeps only insertions after which the
+/// rest of the procedure still applies and the goal holds.
+fn insert_for_goal(
+    planning: &Planning<'_>,
+    ctx: &PatchContext,
+    goal: &Formula,
+    appended: Option<usize>,
+    found: &mut Candidates,
+) {
+    let req = &ctx.request;
+    let procedure = &req.procedure;
+    if appended.is_some_and(|steps| steps <= 1) {
+        return;
+    }
+    let mut state = req.initial_state.clone();
+    for (j, step) in procedure.iter().enumerate() {
+        if let Ok((plan, _)) = planning.plan(&state, goal)
+            && !plan.is_empty()
+            && appended.is_none_or(|steps| plan.len() < steps)
+        {
+            let mut replace = plan;
+            replace.push(step.clone());
+            found.patches.push(ProposedPatch {
+                strategy: Strategy::Insert,
+                search: vec![step.clone()],
+                replace,
+                at: j,
+                rationale: format!(
+                    "every action applies but the goal does not hold yet; before {} the unmet goal literals are a shorter plan away than after the last action, and the rest of the procedure keeps them.",
+                    step.name
+                ),
+            });
+        }
+        match apply(&state, step) {
+            Ok(next) => state = next,
+            Err(_) => break,
+        }
+    }
 }
 
 /// When step `i` fails on the other end effector's predicates: the rest of the procedure

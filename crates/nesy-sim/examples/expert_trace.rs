@@ -81,10 +81,8 @@ fn single_config(args: &[String]) -> Result<TaskConfig, Box<dyn std::error::Erro
     if args.len() < 5 {
         return Err(USAGE.into());
     }
-    let kind = SubtaskKind::ALL
-        .into_iter()
-        .find(|k| k.as_str() == args[0])
-        .ok_or_else(|| format!("unknown subtask {:?}; {USAGE}", args[0]))?;
+    let kind =
+        SubtaskKind::from_name(&args[0]).ok_or_else(|| format!("unknown subtask {:?}; {USAGE}", args[0]))?;
     let embodiment = match args[4].as_str() {
         "finger" => Embodiment::Finger,
         "vacuum" => Embodiment::Vacuum,

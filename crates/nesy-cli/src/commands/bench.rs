@@ -90,9 +90,11 @@ pub(crate) struct RunArgs {
     pub methods: Option<String>,
     /// A study: `ablation` (Table 3's shape) or `robustness` (Table 8's shape), each a set
     /// of NeSyCR variants under one stated error model, on Combination/medium with 3
-    /// repeats; or `complexity-gap` (Figure 4(b)'s shape), NeSyCR and the controls on the
-    /// auxiliary complexity-gap suite with 1 repeat; unless `--scenarios`, `--repeats` and
-    /// `--suite` say otherwise. Needs `--vlm oracle`.
+    /// repeats; `complexity-gap` (Figure 4(b)'s shape), NeSyCR and the controls on the
+    /// auxiliary complexity-gap suite with 1 repeat; or `drawers` (Table 2's task) or `hook`
+    /// (Figures 1 and 5's task), NeSyCR and the controls on that real-world task's family
+    /// with 1 repeat; unless `--scenarios`, `--repeats` and `--suite` say otherwise. Needs
+    /// `--vlm oracle`.
     #[arg(long, value_name = "NAME", conflicts_with = "methods")]
     pub study: Option<String>,
     /// Scenarios: `all`, or ids and id prefixes, comma-separated (`comb_medium`). Default

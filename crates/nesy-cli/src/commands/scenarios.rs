@@ -29,8 +29,8 @@ pub(crate) enum ScenariosAction {
         /// Write the complexity-gap suite (Figure 4(b); not part of the 440) instead.
         #[arg(long, conflicts_with = "family")]
         gap: bool,
-        /// Write a real-world task's family instead: `drawers` (Table 2's task; not part of
-        /// the 440).
+        /// Write a real-world task's family instead: `drawers` (Table 2's task) or `hook`
+        /// (Figures 1 and 5's task); neither is part of the 440.
         #[arg(long, value_parser = parse_family)]
         family: Option<Family>,
     },

@@ -82,7 +82,8 @@ pub(super) fn schema_by_effects(op: &Operator, objects: &[String]) -> Option<(St
     // The first rule that recognises the operator decides, so their order is part of the
     // judgement.
     if let Some(verdict) = ev
-        .articulation_change()
+        .gathering()
+        .or_else(|| ev.articulation_change())
         .or_else(|| ev.handle_action())
         .or_else(|| ev.release_of_item())
         .or_else(|| ev.grasp_or_approach())
@@ -110,9 +111,9 @@ fn named(name: &str, part: Option<&str>, args: Vec<String>) -> Verdict {
     Some((instance_name(name, prefix), args))
 }
 
-/// True if the object is a loose one the robot picks and places.
+/// True if the object is a loose one the robot picks and places (a hook too).
 fn is_item(o: &str) -> bool {
-    kind_of(o) == Some(Kind::Item)
+    kind_of(o).is_some_and(|k| Kind::Item.accepts(k))
 }
 
 /// An operator's top-level literals over the scene's objects, which every rule reads.
@@ -164,6 +165,27 @@ impl Evidence<'_> {
         self.pre
             .iter()
             .any(|(p, a)| is_holding(p) && a.len() == 1 && a[0] == x)
+    }
+
+    /// Gathering: a fine-grained object's pieces brought onto a held hook's magnet
+    /// (`OnMagnet`), or gathered while a hook is held.
+    fn gathering(&self) -> Option<Verdict> {
+        let pieces = |o: &str| kind_of(o) == Some(Kind::Pieces);
+        let hook = |o: &str| kind_of(o) == Some(Kind::Tool);
+        if let Some((x, h)) = self
+            .add2(crate::perception::observer::ON_MAGNET)
+            .into_iter()
+            .find(|(x, h)| pieces(x) && hook(h))
+        {
+            return Some(named("gather-with-hook", None, vec![h, x]));
+        }
+        let x = self.add1(&|p| p == "Gathered").filter(|x| pieces(x))?;
+        let held = self
+            .pre
+            .iter()
+            .find(|(p, a)| is_holding(p) && a.len() == 1 && hook(&a[0]))
+            .map(|(_, a)| a[0].clone())?;
+        Some(named("gather-with-hook", None, vec![held, x]))
     }
 
     /// Articulations: a lid or a drawer opened or closed (a swing waypoint may only state
@@ -247,6 +269,9 @@ impl Evidence<'_> {
         let bare = split_asset_part(&rest).map(|(_, bare)| bare);
         Some(match (bare, kind_of(&rest)) {
             (Some(parts::HINGE_BODY), _) => named("drop-into-hinge-body", Some(&rest), vec![x]),
+            (Some(parts::BOTTOM_DRAWER), _) if kind_of(&x) == Some(Kind::Tool) => {
+                named("drop-hook-into-bottom-drawer", Some(&rest), vec![x])
+            }
             (Some(parts::BOTTOM_DRAWER), _) => named("drop-into-bottom-drawer", Some(&rest), vec![x]),
             (_, Some(Kind::Surface)) => named("put-down", None, vec![x, rest]),
             (_, Some(Kind::Box)) => named("release-into", None, vec![x, rest]),
@@ -270,6 +295,9 @@ impl Evidence<'_> {
         if let Some((x, place)) = self.add2("OverOf").into_iter().find(|(x, _)| is_item(x)) {
             return Some(match split_asset_part(&place).map(|(_, bare)| bare) {
                 Some(parts::HINGE_BODY) => named("carry-over-hinge-body", Some(&place), vec![x]),
+                Some(parts::BOTTOM_DRAWER) if kind_of(&x) == Some(Kind::Tool) => {
+                    named("carry-hook-over-bottom-drawer", Some(&place), vec![x])
+                }
                 Some(parts::BOTTOM_DRAWER) => named("carry-over-bottom-drawer", Some(&place), vec![x]),
                 _ => None,
             });

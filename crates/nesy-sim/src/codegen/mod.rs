@@ -151,7 +151,10 @@ fn match_args(rest: &str, params: &[Kind], objects: &[String]) -> Option<Vec<Str
         return rest.is_empty().then(Vec::new);
     };
     // Longest names first, so `RedCube` never shadows `RedCubeTwo`.
-    let mut candidates: Vec<&String> = objects.iter().filter(|o| kind_of(o) == Some(*first)).collect();
+    let mut candidates: Vec<&String> = objects
+        .iter()
+        .filter(|o| kind_of(o).is_some_and(|k| first.accepts(k)))
+        .collect();
     candidates.sort_by_key(|o| std::cmp::Reverse(camel(o).len()));
     for o in candidates {
         if let Some(tail) = rest.strip_prefix(camel(o).as_str())
@@ -464,6 +467,7 @@ impl Emitter<'_> {
             CarryInto => self.carry_into(arg(0), arg(1)),
             CarryOverHinge => self.carry_over_hinge(&asset, arg(0)),
             CarryOverDrawer => self.carry_over_drawer(&asset, arg(0)),
+            Gather => self.line(&format!("gather_with_hook({:?})", arg(1))),
             Push => self.push(i, arg(0), arg(1)),
             Retreat => {
                 let up = format!("move_parallel(\"up\", {DRAWER_RETREAT}");
@@ -593,9 +597,14 @@ impl Emitter<'_> {
 
     fn carry_over_drawer(&mut self, asset: &SchemaInstance, x: &str) {
         let drawer = asset.asset_part(parts::BOTTOM_DRAWER);
-        let k = self.next_drop(&drawer);
-        // A spot is an offset across the cabinet and one along the way its drawers open.
-        let [across, along] = DRAWER_SPOTS[k % DRAWER_SPOTS.len()];
+        // A spot is an offset across the cabinet and one along the way its drawers open. A
+        // 10 cm hook fits the drawer only along its middle; the others take the spots.
+        let [across, along] = if kind_of(x) == Some(Kind::Tool) {
+            [0.0, 0.0]
+        } else {
+            let k = self.next_drop(&drawer);
+            DRAWER_SPOTS[k % DRAWER_SPOTS.len()]
+        };
         self.drawer_axis(asset);
         self.line(&format!("drawer = get_obj_pos({drawer:?})"));
         self.line(&reachable_move(

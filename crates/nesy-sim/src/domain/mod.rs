@@ -87,11 +87,13 @@ impl WorldDomain {
             .map_err(Clone::clone)
     }
 
-    /// Parses a domain text and restores the vocabulary's predicate spelling (PDDL names
-    /// are read in lower case).
+    /// Parses a domain text and restores the predicates' spelling (PDDL names are read in
+    /// lower case): the vocabulary's, and for predicates beyond it (`OnMagnet`) the one the
+    /// text's `(:predicates ...)` block writes.
     pub fn parse(text: &str) -> Result<WorldDomain, DomainError> {
         let mut domain = parse_domain(text)?;
-        let names: Vec<Symbol> = builtin_predicates().iter().map(|p| p.name).collect();
+        let mut names: Vec<Symbol> = builtin_predicates().iter().map(|p| p.name).collect();
+        names.extend(declared_spellings(text));
         let recase = |s: Symbol| {
             names
                 .iter()
@@ -253,6 +255,38 @@ impl WorldDomain {
     }
 }
 
+/// The predicate names a domain text declares, as it spells them: the word after each `(`
+/// inside its `(:predicates ...)` block.
+fn declared_spellings(text: &str) -> Vec<Symbol> {
+    let Some(start) = text.find("(:predicates") else {
+        return Vec::new();
+    };
+    let block = &text[start + "(:predicates".len()..];
+    let mut depth = 1usize;
+    let mut names = Vec::new();
+    let mut rest = block;
+    while let Some(at) = rest.find(['(', ')']) {
+        let (open, after) = (rest.as_bytes()[at] == b'(', &rest[at + 1..]);
+        if open {
+            depth += 1;
+            let word: String = after
+                .chars()
+                .take_while(|c| !c.is_whitespace() && *c != '(' && *c != ')')
+                .collect();
+            if !word.is_empty() {
+                names.push(Symbol::new(&word));
+            }
+        } else {
+            depth -= 1;
+            if depth == 0 {
+                break;
+            }
+        }
+        rest = after;
+    }
+    names
+}
+
 /// The moving links of the articulated assets (bare names).
 const MOVING_LINKS: [&str; 3] = [parts::HINGE_LID, parts::TOP_DRAWER, parts::BOTTOM_DRAWER];
 
@@ -293,14 +327,17 @@ fn is_robot_entry(name: &str) -> bool {
 
 /// The domain type of a scene object, by the benchmark's naming: `floor` and `board` are
 /// surfaces, `toy_box` and the chess boxes open-topped boxes, the hinge box and drawer
-/// cabinet parts `part`s, and everything else (cubes, cylinders, fruits, chess pieces) a
-/// loose `item`.
+/// cabinet parts `part`s, a magnetic hook (`…hook`) a `tool` (an item the hand takes like
+/// any other), screws (`…screws`, too small to take one by one) `pieces`, and everything
+/// else (cubes, cylinders, fruits, chess pieces) a loose `item`.
 pub fn object_type(name: &str) -> &'static str {
     match name {
         "floor" | "board" => "surface",
         "toy_box" => "box",
         n if n.ends_with("chess_box") => "box",
         n if is_asset_part(n) => "part",
+        n if n.ends_with("hook") => "tool",
+        n if n.ends_with("screws") => "pieces",
         _ => "item",
     }
 }

@@ -41,6 +41,8 @@ pub enum Motion {
     OpenDrawer,
     /// `move_parallel` pushing a drawer closed.
     CloseDrawer,
+    /// `gather_with_hook`: the held hook's magnet swept over a fine-grained object's pieces.
+    Gather,
 }
 
 /// Argument kinds of a schema (the domain's types).
@@ -52,6 +54,19 @@ pub enum SchemaKind {
     Surface,
     /// An open-topped box (`box`).
     Box,
+    /// A magnetic hook (`tool`, a kind of item).
+    Tool,
+    /// A fine-grained object, too small to take one piece at a time (`pieces`).
+    Pieces,
+}
+
+impl SchemaKind {
+    /// Whether an object of kind `object` can fill a parameter of this kind: its own kind,
+    /// or a tool where an item is asked for (the hand takes and carries a hook like any
+    /// item).
+    pub fn accepts(self, object: SchemaKind) -> bool {
+        self == object || (self == SchemaKind::Item && object == SchemaKind::Tool)
+    }
 }
 
 /// One schema of the true domain: name, what it does, its parameters, and the part it
@@ -84,7 +99,7 @@ const fn s(
 }
 
 use Motion::*;
-use SchemaKind::{Box as B, Item as I, Surface as S};
+use SchemaKind::{Box as B, Item as I, Pieces as P, Surface as S, Tool as T};
 
 /// Every schema of `nesy-world.pddl` (finger, then vacuum); `tests/integration/codegen_domain.rs`
 /// checks the table against the file.
@@ -146,6 +161,9 @@ const SCHEMAS: &[Schema] = &[
     s("open-top-drawer", OpenDrawer, &[], Some(parts::TOP_DRAWER)),
     s("close-top-drawer", CloseDrawer, &[], Some(parts::TOP_DRAWER)),
     s("release-top-drawer-handle", ReleaseHandle, &[], None),
+    s("gather-with-hook", Gather, &[T, P], None),
+    s("carry-hook-over-bottom-drawer", CarryOverDrawer, &[T], None),
+    s("drop-hook-into-bottom-drawer", Release, &[T], None),
     s("move-to-align", MoveToObject, &[I], None),
     s("attach", Take, &[I], None),
     s("suction-carry-onto", CarryOnto, &[I, S], None),
@@ -238,15 +256,20 @@ pub fn schema(name: &str) -> &'static Schema {
         .expect("resolved actions name table schemas")
 }
 
-/// The schema argument kind an object can fill, from its name: the world's fixed names are
-/// surfaces, boxes or parts no schema takes as an argument (an articulated asset's parts
-/// under any prefix too); every other name is a loose item.
+/// The schema argument kind an object can fill, from its name (the domain's type,
+/// [`crate::domain::object_type`]): surfaces, boxes, tools and pieces by the world's names,
+/// no kind for the robot's own entry and an articulated asset's parts (which no schema takes
+/// as an argument), every other name a loose item.
 pub fn kind_of(object: &str) -> Option<SchemaKind> {
-    match object {
-        parts::FLOOR | parts::BOARD => Some(SchemaKind::Surface),
-        parts::TOY_BOX | parts::LEFT_CHESS_BOX | parts::RIGHT_CHESS_BOX => Some(SchemaKind::Box),
-        parts::GRIPPER | parts::VACUUM_GRIPPER => None,
-        o if is_asset_part(o) => None,
+    if object == parts::GRIPPER || object == parts::VACUUM_GRIPPER {
+        return None;
+    }
+    match crate::domain::object_type(object) {
+        "surface" => Some(SchemaKind::Surface),
+        "box" => Some(SchemaKind::Box),
+        "tool" => Some(SchemaKind::Tool),
+        "pieces" => Some(SchemaKind::Pieces),
+        "part" => None,
         _ => Some(SchemaKind::Item),
     }
 }

@@ -20,6 +20,10 @@ pub enum SubtaskKind {
     /// Cubes sorted into the bottom drawers of two cabinets, both drawers closed: the paper's
     /// real-world drawers task (Table 2). Its goals are one `put_in_prismatic` per cabinet.
     SortIntoDrawers,
+    /// A magnetic hook, screws and cubes into the bottom drawer, drawer closed: the paper's
+    /// real-world hook-and-screws task (Figures 1 and 5). The screws are fine-grained: they
+    /// go in on the hook's magnet.
+    StowTools,
 }
 
 impl SubtaskKind {
@@ -32,6 +36,17 @@ impl SubtaskKind {
         SubtaskKind::PutInPrismatic,
     ];
 
+    /// The real-world tasks' subtasks (the families of `tasks::scenario::Family`).
+    pub const REAL_WORLD: [SubtaskKind; 2] = [SubtaskKind::SortIntoDrawers, SubtaskKind::StowTools];
+
+    /// The subtask called `name`, among the benchmark's and the real-world tasks'.
+    pub fn from_name(name: &str) -> Option<SubtaskKind> {
+        SubtaskKind::ALL
+            .into_iter()
+            .chain(SubtaskKind::REAL_WORLD)
+            .find(|k| k.as_str() == name)
+    }
+
     /// The snake_case name (`pick_place`, ...).
     pub fn as_str(self) -> &'static str {
         match self {
@@ -40,6 +55,7 @@ impl SubtaskKind {
             SubtaskKind::PutInHinge => "put_in_hinge",
             SubtaskKind::PutInPrismatic => "put_in_prismatic",
             SubtaskKind::SortIntoDrawers => "sort_into_drawers",
+            SubtaskKind::StowTools => "stow_tools",
         }
     }
 
@@ -53,6 +69,9 @@ impl SubtaskKind {
             SubtaskKind::SortIntoDrawers => {
                 "Sort the cubes into the bottom drawers of the two cabinets and close both drawers."
             }
+            SubtaskKind::StowTools => {
+                "Put the magnetic hook, the screws and the cubes in the bottom drawer and close it."
+            }
         }
     }
 
@@ -60,7 +79,10 @@ impl SubtaskKind {
     pub fn is_articulated(self) -> bool {
         matches!(
             self,
-            SubtaskKind::PutInHinge | SubtaskKind::PutInPrismatic | SubtaskKind::SortIntoDrawers
+            SubtaskKind::PutInHinge
+                | SubtaskKind::PutInPrismatic
+                | SubtaskKind::SortIntoDrawers
+                | SubtaskKind::StowTools
         )
     }
 

@@ -22,6 +22,7 @@ mod pick_place;
 mod prismatic;
 pub mod scenario;
 mod sweep;
+mod tools;
 
 use std::collections::BTreeMap;
 
@@ -152,6 +153,7 @@ pub(crate) fn layout(config: &SubtaskConfig, offset: [f64; 2]) -> SubtaskLayout 
         SubtaskKind::PutInHinge => hinge::layout(config, offset),
         SubtaskKind::PutInPrismatic => prismatic::layout(config, offset),
         SubtaskKind::SortIntoDrawers => drawers::layout(config, offset),
+        SubtaskKind::StowTools => tools::layout(config, offset),
     }
 }
 

@@ -63,16 +63,22 @@ pub enum Family {
     /// by side and deployed with them at right angles (one bottom drawer cannot open while
     /// the other stands open) and the cubes stacked (`sort_into_drawers`).
     Drawers,
+    /// Figures 1 and 5: a magnetic hook, screws and cubes put in a drawer, demonstrated with
+    /// everything on the table and the screws on the hook's magnet, deployed with the hook
+    /// already in the open drawer under a cube and the screws scattered over the table
+    /// (`stow_tools`).
+    Hook,
 }
 
 impl Family {
     /// Every family.
-    pub const ALL: [Family; 1] = [Family::Drawers];
+    pub const ALL: [Family; 2] = [Family::Drawers, Family::Hook];
 
     /// The name in file names, ids and on the command line.
     pub fn as_str(self) -> &'static str {
         match self {
             Family::Drawers => "drawers",
+            Family::Hook => "hook",
         }
     }
 
@@ -85,14 +91,17 @@ impl Family {
     pub fn subtask(self) -> SubtaskKind {
         match self {
             Family::Drawers => SubtaskKind::SortIntoDrawers,
+            Family::Hook => SubtaskKind::StowTools,
         }
     }
 
     /// The vocabulary its tasks are stated in: the benchmark's fifteen predicates and the
-    /// relations its scenes need (`Blocks` for the drawers), from `assets/vocabulary/`.
+    /// relations its scenes need (`Blocks` for the drawers; `Finegrained`, `Gathered` and
+    /// `OnMagnet` for the hook), from `assets/vocabulary/`.
     pub fn vocabulary(self) -> Result<nesy_core::Vocabulary, nesy_core::VocabularyFileError> {
         let text = match self {
             Family::Drawers => include_str!("../../../../assets/vocabulary/blocking-drawers.toml"),
+            Family::Hook => include_str!("../../../../assets/vocabulary/hook-and-screws.toml"),
         };
         nesy_core::parse_vocabulary_file(text)
     }

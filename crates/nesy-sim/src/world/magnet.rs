@@ -22,7 +22,7 @@ pub const MAGNET_PULL: f64 = 3.0 * 9.81;
 
 impl Sim {
     /// Every magnetic hook's part and the world position of its magnet's centre.
-    pub(super) fn magnets(&self) -> Vec<(usize, [f64; 3])> {
+    pub fn magnets(&self) -> Vec<(usize, [f64; 3])> {
         self.parts
             .iter()
             .enumerate()

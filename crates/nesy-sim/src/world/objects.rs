@@ -542,6 +542,13 @@ const HANDLE_STANDOFF: f32 = 0.025;
 /// middle shelf; two drawers (open boxes 0.142 × 0.142, 0.085 tall with a front panel)
 /// sliding out toward −y by up to 0.1232; a visual-only bar handle 2.5 cm in front of each
 /// face. Part names carry `prefix`.
+/// How far (m) a drawer's floor plate reaches below the drawer's base height, under its
+/// 4 mm top: the plate is 8 mm thick. Light pieces squeezed under a heavy load (screws under
+/// the hook's steel magnet) are pushed a few millimetres into a kinematic drawer's floor;
+/// through a 4 mm plate that push crossed its middle and the contact then drove them down
+/// through it. The bottom drawer's plate still clears the table by 1.5 mm.
+pub const DRAWER_FLOOR_DEPTH: f32 = 0.004;
+
 fn drawer_cabinet(prefix: &str, colour: [f32; 3]) -> Vec<PartBuild> {
     let [body_name, bottom, top, bottom_handle, top_handle] =
         parts::prefixed(prefix, &parts::DRAWER_CABINET_PARTS);
@@ -567,7 +574,13 @@ fn drawer_cabinet(prefix: &str, colour: [f32; 3]) -> Vec<PartBuild> {
             motion: PartMotion::Articulated,
             offset: Pose::IDENTITY,
             shapes: vec![
-                cuboid([w, d, wt], [0.0, yc, z0 + wt / 2.0], tint),
+                // The floor's top is `wt` above `z0`; its plate reaches
+                // `DRAWER_FLOOR_DEPTH` below `z0`, as a real drawer's bottom board does.
+                cuboid(
+                    [w, d, wt + DRAWER_FLOOR_DEPTH],
+                    [0.0, yc, z0 + (wt - DRAWER_FLOOR_DEPTH) / 2.0],
+                    tint,
+                ),
                 cuboid([w, 0.006, h], [0.0, front + 0.003, z0 + h / 2.0], tint),
                 cuboid([w, wt, h * 0.7], [0.0, front + d - wt / 2.0, z0 + h * 0.35], tint),
                 cuboid([wt, d, h * 0.7], [-(w - wt) / 2.0, yc, z0 + h * 0.35], tint),

@@ -40,6 +40,8 @@ fn every_schema_compiles_on_both_end_effectors() {
         "top_drawer",
         "bottom_drawer_handle",
         "top_drawer_handle",
+        "magnetic_hook",
+        "black_screws",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -52,6 +54,8 @@ fn every_schema_compiles_on_both_end_effectors() {
                 "item" => "red_cube",
                 "surface" => "floor",
                 "box" => "toy_box",
+                "tool" => "magnetic_hook",
+                "pieces" => "black_screws",
                 other => panic!("unexpected parameter type {other}"),
             })
             .collect();

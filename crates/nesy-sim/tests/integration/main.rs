@@ -14,6 +14,7 @@ mod determinism;
 mod drawers_family;
 mod experts;
 mod furniture;
+mod hook_family;
 mod kinematics;
 mod refusals;
 mod scenarios;

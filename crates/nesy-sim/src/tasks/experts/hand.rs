@@ -4,6 +4,7 @@
 
 use super::ExpertError;
 use crate::api::{ApiError, DEFAULT_LIFT_CLEARANCE, Direction, Embodiment, RobotApi};
+use crate::perception::observer::CLING_REACH;
 use crate::scene::{SubtaskKind, TABLE_TOP, parts};
 use crate::tasks::layout::{DROP_CLEARANCE, LID_SWING_MAX_X};
 
@@ -23,6 +24,17 @@ pub(super) struct Hand<'a, R: RobotApi + ?Sized> {
     subtask: SubtaskKind,
     pub(super) vacuum: bool,
     loose: &'a [String],
+    /// The scene's tools (magnetic hooks) and fine-grained objects (screws).
+    tools: Tools<'a>,
+}
+
+/// The scene's magnetic hooks and the fine-grained objects only a hook's magnet can move.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Tools<'a> {
+    /// Magnetic hooks.
+    pub(super) hooks: &'a [String],
+    /// Fine-grained objects (screws).
+    pub(super) fine: &'a [String],
 }
 
 /// An axis-aligned box as the API returns it: `[min, max]`.
@@ -53,13 +65,30 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
             subtask,
             vacuum,
             loose,
+            tools: Tools::default(),
         }
+    }
+
+    /// The same hand, knowing the scene's hooks and fine-grained objects.
+    pub(super) fn with_tools(mut self, tools: Tools<'a>) -> Self {
+        self.tools = tools;
+        self
+    }
+
+    /// True for a magnetic hook.
+    pub(super) fn is_hook(&self, name: &str) -> bool {
+        self.tools.hooks.iter().any(|h| h == name)
+    }
+
+    /// True for a fine-grained object, which only a hook's magnet moves.
+    pub(super) fn is_fine_grained(&self, name: &str) -> bool {
+        self.tools.fine.iter().any(|f| f == name)
     }
 
     /// True for the scene's loose objects (cubes, cylinders, fruits, chess pieces); the
     /// furniture, the table and the robot are never moved aside.
     pub(super) fn is_loose(&self, name: &str) -> bool {
-        self.loose.iter().any(|l| l == name)
+        self.loose.iter().any(|l| l == name) && !self.is_fine_grained(name)
     }
 
     pub(super) fn fail(&self, step: String, error: ApiError) -> ExpertError {
@@ -74,6 +103,13 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
         self.robot
             .get_obj_bbox(name)
             .map_err(|e| self.fail(format!("get_obj_bbox({name})"), e))
+    }
+
+    /// Whether every piece of the fine-grained object `pieces` lies against the hook: their
+    /// box within [`CLING_REACH`] of the hook's on every side, as a pile on its magnet does.
+    pub(super) fn clings_to(&mut self, pieces: &str, hook: &str) -> Result<bool, ExpertError> {
+        let (p, h) = (self.bbox(pieces)?, self.bbox(hook)?);
+        Ok((0..3).all(|k| p[0][k] >= h[0][k] - CLING_REACH && p[1][k] <= h[1][k] + CLING_REACH))
     }
 
     /// How far below the tool point a held object's bottom hangs: suction holds it by the

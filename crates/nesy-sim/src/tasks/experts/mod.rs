@@ -17,10 +17,10 @@ mod pick_place;
 mod prismatic;
 mod sweep;
 
-use hand::Hand;
+use hand::{Hand, Tools};
 
 use crate::api::{ApiError, RobotApi};
-use crate::scene::{SceneError, SceneSpec, SubtaskGoal, SubtaskKind};
+use crate::scene::{ObjectKind, SceneError, SceneSpec, SubtaskGoal, SubtaskKind};
 use crate::tasks::goal::{EpisodeOutcome, GoalError, GoalMonitor};
 use crate::world::Sim;
 
@@ -104,9 +104,22 @@ pub fn run<R: RobotApi + ?Sized>(robot: &mut R, scene: &SceneSpec) -> Result<(),
         .filter(|o| o.kind.is_loose())
         .map(|o| o.name.clone())
         .collect();
+    let named = |keep: fn(ObjectKind) -> bool| -> Vec<String> {
+        scene
+            .objects
+            .iter()
+            .filter(|o| keep(o.kind))
+            .map(|o| o.name.clone())
+            .collect()
+    };
+    let (hooks, fine) = (named(ObjectKind::is_tool), named(ObjectKind::is_fine_grained));
+    let tools = Tools {
+        hooks: &hooks,
+        fine: &fine,
+    };
     let mut goals = scene.goals.iter().peekable();
     while let Some(goal) = goals.next() {
-        let mut hand = Hand::new(robot, goal.kind(), &loose);
+        let mut hand = Hand::new(robot, goal.kind(), &loose).with_tools(tools);
         match goal {
             SubtaskGoal::PickPlace { objects, container } => pick_place::run(&mut hand, objects, container)?,
             SubtaskGoal::Sweep { placements } => {

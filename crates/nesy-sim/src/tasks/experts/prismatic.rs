@@ -252,20 +252,46 @@ fn open_bottom<R: RobotApi + ?Sized>(
 }
 
 /// Drops the objects into the open drawer, one spot each; an object something rests on is
-/// uncovered first.
+/// uncovered first. A magnetic hook is first swept over the fine-grained objects to go in
+/// with it, unless they already cling to its magnet (they ride along), and goes in the
+/// drawer's middle; the fine-grained objects are not picked themselves.
 fn fill<R: RobotApi + ?Sized>(
     hand: &mut Hand<'_, R>,
     cabinet: &Cabinet,
     objects: &[String],
     drawer: &str,
 ) -> Result<(), ExpertError> {
-    for (k, object) in objects.iter().enumerate() {
+    // The spots are handed out in turn to the objects dropped at one; the hook goes in the
+    // middle and the screws ride on it, so neither takes a spot.
+    let mut dropped = 0usize;
+    for object in objects {
+        if hand.is_fine_grained(object) {
+            continue;
+        }
         uncover(hand, object)?;
         let h = hand.pick(object)?;
+        let hook = hand.is_hook(object);
+        if hook {
+            let fine: Vec<&String> = objects.iter().filter(|o| hand.is_fine_grained(o)).collect();
+            for pieces in fine {
+                // A pile already on the magnet rides along without a sweep.
+                if hand.clings_to(pieces, object)? {
+                    continue;
+                }
+                hand.robot
+                    .gather_with_hook(pieces)
+                    .map_err(|e| hand.fail(format!("gather_with_hook({pieces})"), e))?;
+            }
+        }
         let b = hand.bbox(drawer)?;
         let (c, s) = (centre(&b), size(&b));
         // A spot is an offset across the cabinet and one along the way its drawers open.
-        let [across, along] = DRAWER_SPOTS[k % DRAWER_SPOTS.len()];
+        let [across, along] = if hook {
+            [0.0, 0.0]
+        } else {
+            dropped += 1;
+            DRAWER_SPOTS[(dropped - 1) % DRAWER_SPOTS.len()]
+        };
         let (x, y) = if cabinet.axis == 1 {
             (c[0] + across, c[1] + along * cabinet.outward)
         } else {
