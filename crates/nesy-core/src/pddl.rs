@@ -164,6 +164,36 @@ fn section_name(doc: &str, s: &SExpr<'_>) -> Result<String, ParseError> {
     }
 }
 
+/// The predicate names a domain declares, spelt as its `(:predicates ...)` section writes
+/// them ([`parse_domain`] reads every name in lower case).
+///
+/// ```
+/// use nesy_core::pddl::declared_predicate_spellings;
+///
+/// let doc = "(define (domain d) (:predicates (OnMagnet ?x ?h) (Gathered ?x)))";
+/// let names: Vec<String> = declared_predicate_spellings(doc)
+///     .unwrap()
+///     .iter()
+///     .map(|s| s.as_str().to_owned())
+///     .collect();
+/// assert_eq!(names, ["OnMagnet", "Gathered"]);
+/// ```
+pub fn declared_predicate_spellings(doc: &str) -> Result<Vec<Symbol>, ParseError> {
+    let (_, sections) = define(doc, "domain")?;
+    let mut names = Vec::new();
+    for s in &sections {
+        if section_name(doc, s)? == ":predicates" {
+            let body = &s.list().unwrap_or(&[])[1..];
+            names.extend(
+                body.iter()
+                    .filter_map(|p| p.list()?.first()?.token())
+                    .map(Symbol::new),
+            );
+        }
+    }
+    Ok(names)
+}
+
 /// Parses a PDDL domain.
 pub fn parse_domain(doc: &str) -> Result<Domain, ParseError> {
     let (name, sections) = define(doc, "domain")?;

@@ -140,12 +140,13 @@ fn focus_object(call: Option<&ApiCall>, prev: &State, next: &State) -> Option<Sy
 }
 
 /// Every type-correct binding of `schema`'s parameters; `focus`, the object the call works on,
-/// fixes the first parameter when that is an item.
+/// fixes the first parameter when that is an item (or a kind of item, such as a tool).
 fn bindings(schema: &Operator, universe: &Universe, focus: Option<Symbol>) -> Vec<Vec<Symbol>> {
+    let item = Symbol::new("item");
     let item_first = schema
         .params
         .first()
-        .is_some_and(|p| matches!(p.ty.as_str(), "item" | "tool"));
+        .is_some_and(|p| universe.types.is_subtype(p.ty, item));
     let focus = focus.filter(|_| item_first);
     let mut out = vec![Vec::new()];
     for (i, p) in schema.params.iter().enumerate() {

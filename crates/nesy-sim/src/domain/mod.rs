@@ -16,7 +16,7 @@ use nesy_core::Operator;
 use nesy_core::State;
 use nesy_core::Symbol;
 use nesy_core::builtin_predicates;
-use nesy_core::pddl::{Domain, PredicateDecl, Problem, parse_domain};
+use nesy_core::pddl::{Domain, PredicateDecl, Problem, declared_predicate_spellings, parse_domain};
 use nesy_core::text::ParseError;
 use nesy_core::{AtomPattern, Effect, Formula};
 use nesy_core::{TypeError, Universe};
@@ -93,7 +93,7 @@ impl WorldDomain {
     pub fn parse(text: &str) -> Result<WorldDomain, DomainError> {
         let mut domain = parse_domain(text)?;
         let mut names: Vec<Symbol> = builtin_predicates().iter().map(|p| p.name).collect();
-        names.extend(declared_spellings(text));
+        names.extend(declared_predicate_spellings(text)?);
         let recase = |s: Symbol| {
             names
                 .iter()
@@ -253,38 +253,6 @@ impl WorldDomain {
             goal,
         }
     }
-}
-
-/// The predicate names a domain text declares, as it spells them: the word after each `(`
-/// inside its `(:predicates ...)` block.
-fn declared_spellings(text: &str) -> Vec<Symbol> {
-    let Some(start) = text.find("(:predicates") else {
-        return Vec::new();
-    };
-    let block = &text[start + "(:predicates".len()..];
-    let mut depth = 1usize;
-    let mut names = Vec::new();
-    let mut rest = block;
-    while let Some(at) = rest.find(['(', ')']) {
-        let (open, after) = (rest.as_bytes()[at] == b'(', &rest[at + 1..]);
-        if open {
-            depth += 1;
-            let word: String = after
-                .chars()
-                .take_while(|c| !c.is_whitespace() && *c != '(' && *c != ')')
-                .collect();
-            if !word.is_empty() {
-                names.push(Symbol::new(&word));
-            }
-        } else {
-            depth -= 1;
-            if depth == 0 {
-                break;
-            }
-        }
-        rest = after;
-    }
-    names
 }
 
 /// The moving links of the articulated assets (bare names).

@@ -289,8 +289,9 @@ fn fill<R: RobotApi + ?Sized>(
         let [across, along] = if hook {
             [0.0, 0.0]
         } else {
+            let spot = DRAWER_SPOTS[dropped % DRAWER_SPOTS.len()];
             dropped += 1;
-            DRAWER_SPOTS[(dropped - 1) % DRAWER_SPOTS.len()]
+            spot
         };
         let (x, y) = if cabinet.axis == 1 {
             (c[0] + across, c[1] + along * cabinet.outward)
