@@ -101,6 +101,11 @@ pub(crate) enum ScenariosAction {
         /// displaced objects).
         #[arg(long, value_name = "REPORT")]
         rerun_failures: Option<PathBuf>,
+        /// Run the experts with the robot's protective stop on: a motion that presses the arm
+        /// or what it carries into furniture ends there (counts the scenes whose expert it
+        /// stops; the benchmark runs without it).
+        #[arg(long)]
+        protective_stop: bool,
     },
 }
 
@@ -228,6 +233,7 @@ pub(crate) fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
             report,
             scenes,
             rerun_failures,
+            protective_stop,
         } => {
             let filter = SceneFilter {
                 only,
@@ -235,7 +241,8 @@ pub(crate) fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
                 scenes: scenes.as_deref().map(parse_scenes).transpose()?,
                 rerun: rerun_failures.as_deref().map(failed_scenes).transpose()?,
             };
-            sweep(suite, filter, threads, report)
+            let options = nesy_sim::demo::ExpertOptions { protective_stop };
+            sweep(suite, filter, threads, report, options)
         }
     }
 }
@@ -322,6 +329,7 @@ fn sweep(
     filter: SceneFilter,
     threads: usize,
     report: Option<PathBuf>,
+    options: nesy_sim::demo::ExpertOptions,
 ) -> anyhow::Result<ExitCode> {
     let files = load_suite(suite.as_deref())?;
     let all = scenario::scenarios(&files);
@@ -353,7 +361,7 @@ fn sweep(
     let results = nesy_bench::pool::run_all(
         &jobs,
         threads,
-        |_, (s, side)| run_one(s, *side),
+        |_, (s, side)| run_one(s, *side, options),
         |i, result: &SceneResult| {
             eprintln!("{}", sweep_line(i, total, result));
             if let Some(file) = &mut report_file {
@@ -521,13 +529,13 @@ fn print_sweep_summary(results: &[SceneResult], wall: f64, threads: usize) -> an
     })
 }
 
-fn run_one(s: &Scenario, side: Side) -> SceneResult {
+fn run_one(s: &Scenario, side: Side, options: nesy_sim::demo::ExpertOptions) -> SceneResult {
     let started = Instant::now();
     let task = s.generate(side);
     let (embodiment, outcome) = match &task {
         Ok(t) => (
             t.scene.embodiment.as_str(),
-            nesy_sim::demo::run_expert(&t.scene).map_err(|e| e.to_string()),
+            nesy_sim::demo::run_expert_with(&t.scene, options).map_err(|e| e.to_string()),
         ),
         Err(e) => ("?", Err(e.to_string())),
     };

@@ -256,11 +256,17 @@ impl Sim {
         pointing: Direction,
     ) -> Vec<Vec<Vec<f64>>> {
         // An object already touching the arm where the transit starts (a piece just pushed,
-        // say) cannot be avoided by the transit; the others can.
+        // say) cannot be avoided by the transit; the others can. Furniture the arm touches at
+        // the transit's end (the cabinet whose handle it goes to) cannot be kept clear either.
+        let goal_q = direct.last();
         let obstacles: Vec<Obstacle<'_>> = self
             .transit_obstacles()
             .into_iter()
             .filter(|o| self.configuration_is_clear(q_from, std::slice::from_ref(o)))
+            .filter(|o| {
+                self.parts[o.part].role == PartRole::Loose
+                    || goal_q.is_none_or(|q| self.configuration_is_clear(q, std::slice::from_ref(o)))
+            })
             .collect();
         if obstacles.is_empty() || self.path_is_clear(&direct, &obstacles) {
             return vec![direct];
@@ -490,9 +496,33 @@ impl Sim {
             .collect()
     }
 
-    /// The loose objects that are not held: what a transit must not touch.
+    /// The loose objects that are not held and, with the protective stop on, the furniture
+    /// (fixed parts, articulated bodies, lids and drawers, by their solid colliders): what a
+    /// transit must not touch.
     fn transit_obstacles(&self) -> Vec<Obstacle<'_>> {
-        self.unheld_obstacles(|role| role == PartRole::Loose)
+        let furniture = self.protective_stop;
+        let mut obstacles = self.unheld_obstacles(|role| {
+            role == PartRole::Loose
+                || (furniture && matches!(role, PartRole::Fixed | PartRole::ArticulatedBody | PartRole::Link))
+        });
+        for o in &mut obstacles {
+            if self.parts[o.part].role != PartRole::Loose {
+                let solid: Vec<_> = self.parts[o.part]
+                    .colliders
+                    .iter()
+                    .filter(|&&c| !self.world.colliders[c].is_sensor())
+                    .map(|&c| {
+                        (
+                            self.world.colliders[c].shape(),
+                            *self.world.colliders[c].position(),
+                        )
+                    })
+                    .collect();
+                o.shapes = solid;
+            }
+        }
+        obstacles.retain(|o| !o.shapes.is_empty());
+        obstacles
     }
 
     fn collider_shapes(&self, colliders: &[ColliderHandle]) -> Vec<(&dyn rapier3d::prelude::Shape, Pose)> {
@@ -567,6 +597,11 @@ impl Sim {
         min_segment: f64,
     ) -> Result<(), ContactStop> {
         self.contact_stop = None;
+        let at_start = if self.protective_stop {
+            self.furniture_overlaps_at_start()
+        } else {
+            Vec::new()
+        };
         for path in segments {
             let (cumulative, total) = path_lengths(path);
             let tool_len = {
@@ -588,14 +623,20 @@ impl Sim {
                 let s = ease(k as f64 / steps as f64);
                 let q = sample_path(path, &cumulative, total, s);
                 self.control_step(&q);
-                // A protective stop: the arm halts where the driven link met furniture.
+                // A protective stop: the arm halts where a driven lid or drawer, a link of
+                // the arm or the carried object met furniture.
+                if self.protective_stop && self.contact_stop.is_none() {
+                    self.contact_stop = self.protective_stop(&at_start);
+                }
                 if let Some(stop) = self.contact_stop.take() {
                     self.step_idle(settle);
+                    self.note_left_asset();
                     return Err(stop);
                 }
             }
         }
         self.step_idle(settle);
+        self.note_left_asset();
         Ok(())
     }
 }

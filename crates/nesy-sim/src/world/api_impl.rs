@@ -414,6 +414,7 @@ impl Sim {
             });
         }
         let is_handle = p.role == PartRole::Handle;
+        let asset = p.object;
         let depth = match self.scene.embodiment {
             Embodiment::Vacuum if is_handle => -0.01,
             Embodiment::Vacuum => 0.0,
@@ -458,13 +459,16 @@ impl Sim {
                 self.gripper_target = self.preshape_travel(part, &rotation);
             }
         }
-        self.do_move_to_position(
+        self.handle_approach = is_handle.then_some(asset);
+        let moved = self.do_move_to_position(
             "move_gripper_to",
             target,
             pointing,
             crate::api::DEFAULT_LIFT_CLEARANCE,
             yaw,
-        )
+        );
+        self.handle_approach = None;
+        moved
     }
 
     /// Of the finger grasp spins `angle + k·step`, the one nearest the current tool whose
@@ -514,18 +518,49 @@ impl Sim {
                 .fold(0.0, f64::max);
             f64::max(fingers, palm)
         };
-        let scored: Vec<(f64, f64)> = spins.iter().map(|&spin| (spin, crowding(spin))).collect();
+        // With the protective stop on (a robot that knows its furniture): how far the hand,
+        // its open fingers or the wrist would press into furniture on the way down to the
+        // grasp (a piece beside the cabinet: the 20 cm palm turned toward it
+        // goes through the drawer front), 0 when clear. It outranks crowding: a neighbour is
+        // nudged, furniture stops the arm. Even a touch counts: the fingers narrow to the
+        // object while the arm moves, so on the way down they stand wider than at the grasp.
+        let centre = object.centre();
+        let into_furniture = |spin: f64| {
+            if !self.protective_stop {
+                return 0.0;
+            }
+            let rotation = Sim::pointing(pointing, spin);
+            let travel = self.preshape_travel(part, &rotation);
+            let mut seed = self.q.clone();
+            let mut deepest = 0.0_f64;
+            for lift in DESCENT_CHECK_HEIGHTS.iter().rev() {
+                let goal = ToolGoal {
+                    position: Vector3::new(centre[0], centre[1], tool_z + lift),
+                    rotation,
+                };
+                if let Some(q) = self.ik(&goal, &seed, &IkOptions::default()) {
+                    deepest = deepest.max(self.arm_furniture_depth_at(&q, travel));
+                    seed = q;
+                }
+            }
+            deepest
+        };
+        let scored: Vec<(f64, f64, f64)> = spins
+            .iter()
+            .map(|&spin| (spin, into_furniture(spin), crowding(spin)))
+            .collect();
         if std::env::var_os("NESY_DEBUG_TRANSIT").is_some() {
             eprintln!(
-                "grasp spins of {} (spin, crowding): {scored:?}",
+                "grasp spins of {} (spin, into furniture, crowding): {scored:?}",
                 self.parts[part].name
             );
         }
-        // The least crowded; among equals, the nearest (min_by keeps the first).
+        // Clear of furniture, then the least crowded; among equals, the nearest (min_by keeps
+        // the first).
         scored
             .iter()
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .map_or(nearest, |&(spin, _)| spin)
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.2.total_cmp(&b.2)))
+            .map_or(nearest, |&(spin, _, _)| spin)
     }
 
     /// The highest top of the loose objects (other than `part` and a held one) under the
@@ -731,10 +766,17 @@ impl Sim {
     }
 
     fn do_release_handle(&mut self) {
+        self.leaving_asset = self
+            .handle_grasp
+            .map(|grasp| self.articulation_asset(grasp.articulation));
         self.handle_grasp = None;
         self.open_fingers();
     }
 }
+
+/// Heights (m) above a grasp at which a spin's hand is checked against furniture: the
+/// vertical approach from [`crate::api::DEFAULT_LIFT_CLEARANCE`] above down to the grasp.
+const DESCENT_CHECK_HEIGHTS: [f64; 4] = [0.0, 0.04, 0.08, crate::api::DEFAULT_LIFT_CLEARANCE];
 
 const FINGER_ONLY: Embodiment = Embodiment::Finger;
 const VACUUM_ONLY: Embodiment = Embodiment::Vacuum;

@@ -405,6 +405,9 @@ impl Sim {
             hooks: Vec::new(),
             action_pause_steps: 0,
             contact_stop: None,
+            handle_approach: None,
+            leaving_asset: None,
+            protective_stop: false,
             blocking: Vec::new(),
         };
         sim.check_interpenetration()?;

@@ -6,10 +6,17 @@
 //! the two meet, as a real one does, and the arm that pulls it stops there too (the
 //! motion ends with [`ApiError::Collision`], the way a real arm's protective stop ends it).
 //!
-//! The arm is kinematic too, so its links and the object it carries pass through furniture
-//! the same way. [`FurnitureContactProbe`] measures how deep they go: for every link or
-//! carried object and every piece of furniture, the deepest overlap of an episode and the
-//! call that made it.
+//! The arm is kinematic too, so nothing in the physics stops its links or the object it
+//! carries at furniture. The protective stop does when it is on ([`Sim::set_protective_stop`];
+//! the check is [`Sim::protective_stop`]), the way a real arm's collision reflex does: a motion that presses a link or the carried object more than
+//! [`FURNITURE_TOUCH_DEPTH`] into a fixed part, an articulated body or a lid or drawer ends
+//! there with [`ApiError::Collision`] naming both. One exemption stands for the authors'
+//! handles: they are visual only and grasped by proximity, 2.5 cm in front of a drawer face
+//! and over a lid, closer than a Panda hand fits, so while the hand reaches for a handle,
+//! holds it, or leaves it, its overlap with that handle's own asset is not a stop (it is
+//! measured all the same). [`FurnitureContactProbe`] measures every overlap: for every link
+//! or carried object and every piece of furniture, the deepest overlap of an episode and
+//! the call that made it.
 //!
 //! Loose objects are not obstacles here: they are dynamic bodies, and the arm and the links
 //! push them through the physics as they move.
@@ -34,6 +41,11 @@ pub(crate) const CONTACT_RESOLUTION: f64 = 1e-4;
 /// a touch or a brush (fingers grazing a box's wall on their way in) rather than a push into
 /// the part that a real arm's protective stop would end.
 pub const FURNITURE_TOUCH_DEPTH: f64 = 0.005;
+
+/// How much deeper (m) than at the start of a motion a link already pressed into furniture
+/// may go before the protective stop ends the motion: a hand leaving a part it rests
+/// against slides along it without pushing further in.
+const FURNITURE_STOP_SLACK: f64 = 0.001;
 
 /// What was moving when a motion was stopped by contact.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -244,6 +256,112 @@ impl Sim {
             .iter()
             .map(|&(a, b)| (self.parts[a].name.clone(), self.parts[b].name.clone()))
             .collect()
+    }
+
+    /// The scene object (index) that articulation `ai` belongs to.
+    pub(crate) fn articulation_asset(&self, ai: usize) -> usize {
+        self.parts[self.articulations[ai].link].object
+    }
+
+    /// The scene objects (indices) the protective stop lets the arm overlap: the asset whose
+    /// handle the hand is reaching for or holding, and the one whose handle it let go of
+    /// and has not yet left.
+    fn handled_assets(&self) -> [Option<usize>; 2] {
+        let operated = self.handle_approach.or_else(|| {
+            self.handle_grasp
+                .map(|grasp| self.articulation_asset(grasp.articulation))
+        });
+        [operated, self.leaving_asset]
+    }
+
+    /// Forgets the asset the hand let go of once no link of the arm overlaps it any more.
+    pub(crate) fn note_left_asset(&mut self) {
+        let Some(asset) = self.leaving_asset else { return };
+        let still_in = self
+            .arm_furniture_depths()
+            .iter()
+            .any(|((_, part), _)| self.parts[*part].object == asset);
+        if !still_in {
+            self.leaving_asset = None;
+        }
+    }
+
+    /// The overlaps with furniture, deeper than a touch, that a motion starting now may keep
+    /// without being stopped (a hand that let go of a handle leaves the lid it rests on).
+    pub(crate) fn furniture_overlaps_at_start(&self) -> Vec<((Mover, usize), f64)> {
+        let mut depths = self.arm_furniture_depths();
+        depths.retain(|(_, depth)| *depth > FURNITURE_TOUCH_DEPTH);
+        depths
+    }
+
+    /// The protective stop: the deepest overlap of a robot link or the carried object with a
+    /// piece of furniture that is deeper than [`FURNITURE_TOUCH_DEPTH`] and deeper (by
+    /// [`FURNITURE_STOP_SLACK`]) than the same pair was at the motion's start (`at_start`, from
+    /// [`Sim::furniture_overlaps_at_start`]). The asset whose handle the hand is reaching
+    /// for or holding is exempt (see the module's documentation).
+    pub(crate) fn protective_stop(&self, at_start: &[((Mover, usize), f64)]) -> Option<ContactStop> {
+        let handled = self.handled_assets();
+        self.arm_furniture_depths()
+            .into_iter()
+            .filter(|((_, part), _)| !handled.contains(&Some(self.parts[*part].object)))
+            .filter(|(key, depth)| {
+                let before = at_start
+                    .iter()
+                    .find(|(k, _)| k == key)
+                    .map_or(0.0, |(_, d)| *d + FURNITURE_STOP_SLACK);
+                *depth > FURNITURE_TOUCH_DEPTH.max(before)
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|((moving, obstacle), _)| ContactStop { moving, obstacle })
+    }
+
+    /// The deepest overlap (m) of the robot's links with any piece of furniture were the arm
+    /// at joints `q` with finger travel `g` (0 when it touches none): what a grasp would
+    /// press into before it is tried.
+    pub(crate) fn arm_furniture_depth_at(&self, q: &[f64], g: f64) -> f64 {
+        self.robot_furniture_depth_at(q, g, |_| true)
+    }
+
+    /// [`Sim::arm_furniture_depth_at`] for the fingers alone.
+    pub(crate) fn fingers_furniture_depth_at(&self, q: &[f64], g: f64) -> f64 {
+        self.robot_furniture_depth_at(q, g, |c| self.robot.gripper_colliders.contains(&c))
+    }
+
+    /// The deepest overlap (m) with furniture of the robot colliders that `keep` accepts,
+    /// were the arm at `(q, g)`.
+    fn robot_furniture_depth_at(
+        &self,
+        q: &[f64],
+        g: f64,
+        keep: impl Fn(rapier3d::prelude::ColliderHandle) -> bool,
+    ) -> f64 {
+        let blockers = self.furniture_colliders(|_| true);
+        if blockers.is_empty() {
+            return 0.0;
+        }
+        let poses = self.robot.model.link_poses(q, g);
+        let mut deepest = 0.0_f64;
+        for &(li, body) in &self.robot.bodies {
+            let link = crate::world::geometry::iso_to_pose(&(self.base * poses[li]));
+            for &c in self.world.bodies[body].colliders() {
+                let collider = &self.world.colliders[c];
+                if collider.is_sensor() || !keep(c) {
+                    continue;
+                }
+                let local = collider.position_wrt_parent().copied().unwrap_or(Pose::IDENTITY);
+                let pose = link * local;
+                let shape = collider.shape();
+                let aabb = shape.compute_aabb(&pose);
+                for blocker in blockers.iter().filter(|b| aabb.intersects(&b.aabb)) {
+                    let contact =
+                        rapier3d::parry::query::contact(&pose, shape, &blocker.pose, blocker.shape, 0.0);
+                    if let Ok(Some(contact)) = contact {
+                        deepest = deepest.max(-f64::from(contact.dist));
+                    }
+                }
+            }
+        }
+        deepest
     }
 
     /// How deep each of the robot's links and the carried object presses into each piece of

@@ -333,7 +333,8 @@ fn the_furniture_probe_measures_a_descent_into_a_cabinet_and_names_the_part() {
         "5 cm above the cabinet the hand touches nothing"
     );
 
-    // The kinematic arm is not stopped; the probe says how far it went in, and where.
+    // Without the protective stop the kinematic arm goes on; the probe says how far it went
+    // in, and where.
     sim.move_to_position([x, y, hi[2] - 0.03], Direction::Down, 0.0, 0.0)
         .unwrap();
     let probe = sim.hook::<FurnitureContactProbe>().unwrap();
@@ -348,4 +349,69 @@ fn the_furniture_probe_measures_a_descent_into_a_cabinet_and_names_the_part() {
         into_top.call, "move_to_position #2",
         "the second move, after get_obj_bbox and the first"
     );
+}
+
+#[test]
+fn with_the_protective_stop_a_descent_through_a_fixed_part_fails_naming_the_part() {
+    let mut sim = Sim::new(&perpendicular_cabinets(0.0)).unwrap();
+    sim.set_protective_stop(true);
+    let [lo, hi] = sim.get_obj_bbox("side_drawer_body").unwrap();
+    let (x, y) = ((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0);
+    sim.move_to_position([x, y, hi[2] + 0.05], Direction::Down, 0.12, 0.0)
+        .expect("5 cm above the cabinet the way is clear");
+
+    let err = sim
+        .move_to_position([x, y, hi[2] - 0.03], Direction::Down, 0.0, 0.0)
+        .expect_err("the cabinet's top is in the way");
+    let ApiError::Collision {
+        call,
+        moving,
+        obstacle,
+    } = &err
+    else {
+        panic!("expected a collision, got {err:?}");
+    };
+    assert_eq!(call, "move_to_position");
+    assert_eq!(obstacle, "side_drawer_body", "{err}");
+    assert!(moving.starts_with("the robot's panda_"), "{err}");
+    assert!(
+        err.to_string().contains("ran into side_drawer_body"),
+        "the message names the part: {err}"
+    );
+    // The arm halted at the top, a touch deep at most, well short of the 3 cm it was sent.
+    let tool_z = sim.tool_pose().translation.vector.z;
+    assert!(
+        tool_z > hi[2] - 0.015,
+        "tool stopped at z {tool_z:.4}, top at {:.4}",
+        hi[2]
+    );
+
+    // Back up the way it came: a motion out of the contact is not stopped.
+    sim.move_to_position([x, y, hi[2] + 0.05], Direction::Down, 0.0, 0.0)
+        .expect("leaving the contact");
+}
+
+#[test]
+fn the_protective_stop_is_off_unless_asked_for() {
+    let mut sim = Sim::new(&perpendicular_cabinets(0.0)).unwrap();
+    let [lo, hi] = sim.get_obj_bbox("side_drawer_body").unwrap();
+    let (x, y) = ((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0);
+    sim.move_to_position([x, y, hi[2] + 0.05], Direction::Down, 0.12, 0.0)
+        .unwrap();
+    sim.move_to_position([x, y, hi[2] - 0.03], Direction::Down, 0.0, 0.0)
+        .expect("nothing stops the kinematic arm");
+}
+
+#[test]
+fn with_the_protective_stop_a_drawer_is_still_pulled_by_its_handle() {
+    // The authors' handles stand 2.5 cm off the face, closer than a Panda hand fits: the hand
+    // overlaps its own cabinet while it reaches for, holds and leaves the handle.
+    let mut sim = Sim::new(&perpendicular_cabinets(0.0)).unwrap();
+    sim.set_protective_stop(true);
+    pull_front_top_drawer(&mut sim).expect("the pull is not stopped by its own cabinet");
+    let open = sim.articulation_q("front_top_drawer").unwrap();
+    assert!(open > DRAWER_OPEN - 0.01, "travel {open:.4}");
+    sim.release_handle().unwrap();
+    sim.move_parallel(Direction::Up, 0.1, Direction::Down)
+        .expect("the hand leaves the handle upward");
 }

@@ -12,6 +12,9 @@ use crate::tasks::layout::{DROP_CLEARANCE, LID_SWING_MAX_X};
 const HAND_HALF_LENGTH: f64 = 0.105;
 /// Half the finger hand's width across the fingers' travel, seen from above (m).
 const HAND_HALF_WIDTH: f64 = 0.035;
+/// Height (m) of the finger hand's palm underside above the grasp point (between the
+/// pads).
+const PALM_ABOVE_GRASP: f64 = 0.034;
 /// Grasps tried on one object before the expert carries on regardless.
 const PICK_ATTEMPTS: usize = 3;
 /// Nearest x (m) to the robot's base at which the experts set objects down out of the way.
@@ -26,6 +29,8 @@ pub(super) struct Hand<'a, R: RobotApi + ?Sized> {
     loose: &'a [String],
     /// The scene's tools (magnetic hooks) and fine-grained objects (screws).
     tools: Tools<'a>,
+    /// The robot's protective stop is on: approaches keep off furniture.
+    pub(super) furniture_aware: bool,
 }
 
 /// The scene's magnetic hooks and the fine-grained objects only a hook's magnet can move.
@@ -66,6 +71,7 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
             vacuum,
             loose,
             tools: Tools::default(),
+            furniture_aware: false,
         }
     }
 
@@ -268,17 +274,30 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
     /// Picks a round object (a fruit) with the finger hand turned so that its long side
     /// (≈ 21 cm along the fingers' travel) misses the neighbours: round fruits nudged by the
     /// hand roll away (Rapier has no rolling resistance). The usual wrist angle when it is
-    /// clear or both are blocked, else the wrist turned by 90°. Returns the height.
+    /// clear or both are blocked, or (furniture-aware) when the turned palm would come down
+    /// on furniture taller than its underside (the hinge box beside the fruit), else the
+    /// wrist turned by 90°. Returns the height.
     pub(super) fn pick_round(&mut self, name: &str) -> Result<f64, ExpertError> {
         if self.vacuum {
             return self.pick(name);
         }
         let me = self.bbox(name)?;
         let c = centre(&me);
+        let palm_underside = me[1][2] - size(&me)[2] / 2.0 + PALM_ABOVE_GRASP;
         let mut others = Vec::new();
+        let mut furniture = Vec::new();
         for other in self.robot.get_obj_names() {
-            if other != name && self.is_loose(&other) {
-                others.push(self.bbox(&other)?);
+            if other == name || self.is_fine_grained(&other) || other.ends_with("_handle") {
+                continue;
+            }
+            if [parts::FLOOR, parts::GRIPPER, parts::VACUUM_GRIPPER].contains(&other.as_str()) {
+                continue;
+            }
+            let b = self.bbox(&other)?;
+            if self.is_loose(&other) {
+                others.push(b);
+            } else if b[1][2] > palm_underside {
+                furniture.push(b);
             }
         }
         let footprint = |long_x: bool| -> Bbox {
@@ -301,7 +320,10 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
                 .fold(0.0, f64::max)
         };
         let usual = intrusion(&footprint(false));
-        if usual <= 0.0 || intrusion(&footprint(true)) >= usual {
+        let turned = footprint(true);
+        let turned_onto_furniture =
+            self.furniture_aware && furniture.iter().any(|f| overlaps_xy(f, &turned, 0.0));
+        if usual <= 0.0 || turned_onto_furniture || intrusion(&turned) >= usual {
             return self.pick(name);
         }
         let h = size(&me)[2];

@@ -98,6 +98,17 @@ pub fn run_scene(scene: &SceneSpec) -> Result<ExpertEpisode, EpisodeError> {
 /// Runs the expert of every goal of `scene`, in order, on `robot` (a world built from that
 /// scene).
 pub fn run<R: RobotApi + ?Sized>(robot: &mut R, scene: &SceneSpec) -> Result<(), ExpertError> {
+    run_with(robot, scene, false)
+}
+
+/// [`run`] for a robot whose protective stop is on (`furniture_aware`): the expert also keeps
+/// its turned fruit grasps and sideways handle approaches off furniture, and takes a handle
+/// from above when a sideways approach is stopped.
+pub fn run_with<R: RobotApi + ?Sized>(
+    robot: &mut R,
+    scene: &SceneSpec,
+    furniture_aware: bool,
+) -> Result<(), ExpertError> {
     let loose: Vec<String> = scene
         .objects
         .iter()
@@ -120,6 +131,7 @@ pub fn run<R: RobotApi + ?Sized>(robot: &mut R, scene: &SceneSpec) -> Result<(),
     let mut goals = scene.goals.iter().peekable();
     while let Some(goal) = goals.next() {
         let mut hand = Hand::new(robot, goal.kind(), &loose).with_tools(tools);
+        hand.furniture_aware = furniture_aware;
         match goal {
             SubtaskGoal::PickPlace { objects, container } => pick_place::run(&mut hand, objects, container)?,
             SubtaskGoal::Sweep { placements } => {

@@ -3,7 +3,7 @@
 
 use super::ExpertError;
 use super::hand::{Bbox, Hand, centre, overlaps, overlaps_xy, size};
-use crate::api::{DEFAULT_LIFT_CLEARANCE, Direction, RobotApi};
+use crate::api::{ApiError, DEFAULT_LIFT_CLEARANCE, Direction, RobotApi};
 use crate::domain::split_asset_part;
 use crate::scene::parts;
 use crate::tasks::layout::{DRAWER_DROP_CLEARANCE, DRAWER_PULL_FRACTION, DRAWER_RETREAT, DRAWER_SPOTS};
@@ -14,6 +14,16 @@ const WRIST_CLEARANCE: f64 = 0.07;
 /// How far (m) the wrist and forearm trail behind the tool point when the hand grasps a
 /// handle pointing sideways.
 const FOREARM_REACH: f64 = 0.3;
+/// How far (m) below the tool point the wrist hangs when the hand points sideways: joint 6's
+/// housing (a 5 cm capsule 8.8 cm off the last joint's axis) swings below the forearm, and
+/// came down on the closed lid of a hinge box standing behind the cabinet.
+const FOREARM_BELOW: f64 = 0.1;
+/// How far (m) below the tool point the corridor reaches for a robot without the
+/// protective stop: the hand's own half height.
+const HAND_BELOW: f64 = 0.03;
+/// How far (m) to either side of the wrist's corridor the elbow swings the forearm on the
+/// way to a sideways grasp (it came down on a toy box 20–30 cm beside the bottom handle).
+const FOREARM_SWING: f64 = 0.3;
 
 /// Moves to the table the loose objects the arm would knock on its way to grasp `handle`
 /// pointing along `pointing`. From above, the wrist passes within [`WRIST_CLEARANCE`] of the
@@ -61,6 +71,11 @@ fn approach_corridor<R: RobotApi + ?Sized>(
 ) -> Result<Bbox, ExpertError> {
     let h = hand.bbox(handle)?;
     let c = centre(&h);
+    let below = if hand.furniture_aware {
+        FOREARM_BELOW
+    } else {
+        HAND_BELOW
+    };
     Ok(match pointing {
         Direction::Down => [
             [c[0] - WRIST_CLEARANCE, c[1] - WRIST_CLEARANCE, h[1][2] + 0.02],
@@ -69,7 +84,7 @@ fn approach_corridor<R: RobotApi + ?Sized>(
         _ => {
             let back = -pointing.unit()[1] * FOREARM_REACH;
             [
-                [c[0] - WRIST_CLEARANCE, c[1].min(c[1] + back), c[2] - 0.03],
+                [c[0] - WRIST_CLEARANCE, c[1].min(c[1] + back), c[2] - below],
                 [c[0] + WRIST_CLEARANCE, c[1].max(c[1] + back), c[2] + 0.3],
             ]
         }
@@ -84,7 +99,12 @@ fn furniture_in_the_way<R: RobotApi + ?Sized>(
     handle: &str,
     pointing: Direction,
 ) -> Result<bool, ExpertError> {
-    let corridor = approach_corridor(hand, handle, pointing)?;
+    let mut corridor = approach_corridor(hand, handle, pointing)?;
+    if hand.furniture_aware && pointing != Direction::Down {
+        // The elbow swings the forearm out of the tool's line on the way to a sideways grasp.
+        corridor[0][0] -= FOREARM_SWING;
+        corridor[1][0] += FOREARM_SWING;
+    }
     for name in hand.robot.get_obj_names() {
         let bare = bare_name(&name);
         let drawer = bare == parts::TOP_DRAWER || bare == parts::BOTTOM_DRAWER;
@@ -216,6 +236,29 @@ impl Cabinet {
     }
 }
 
+/// Clears the way to `handle` and grasps it pointing along `pointing`; when a sideways
+/// approach is stopped by furniture on the way (the forearm coming down on a box beside the
+/// cabinet), grasps it from above instead. Returns the pointing it was grasped with.
+fn grab_handle<R: RobotApi + ?Sized>(
+    hand: &mut Hand<'_, R>,
+    handle: &str,
+    pointing: Direction,
+) -> Result<Direction, ExpertError> {
+    clear_handle_approach(hand, handle, pointing)?;
+    match hand.grab_handle_pointing(handle, pointing) {
+        Err(e)
+            if hand.furniture_aware
+                && pointing != Direction::Down
+                && matches!(e.error, ApiError::Collision { .. }) =>
+        {
+            clear_handle_approach(hand, handle, Direction::Down)?;
+            hand.grab_handle_pointing(handle, Direction::Down)?;
+            Ok(Direction::Down)
+        }
+        grasped => grasped.map(|()| pointing),
+    }
+}
+
 /// Makes the cabinet's bottom drawer ready to fill: an open top drawer (which covers the
 /// bottom handle) is closed, a closed bottom drawer opened.
 fn open_bottom<R: RobotApi + ?Sized>(
@@ -234,16 +277,14 @@ fn open_bottom<R: RobotApi + ?Sized>(
             Some(sideways) if !furniture_in_the_way(hand, &top_handle, sideways)? => sideways,
             _ => Direction::Down,
         };
-        clear_handle_approach(hand, &top_handle, pointing)?;
-        hand.grab_handle_pointing(&top_handle, pointing)?;
+        let pointing = grab_handle(hand, &top_handle, pointing)?;
         hand.slide_pointing(close_dir, travel, pointing)?;
         hand.let_go_handle()?;
     }
     let pointing = cabinet.bottom_pointing(hand)?;
     if !cabinet.drawer_open(hand, drawer)? {
         let handle = cabinet.part(parts::BOTTOM_DRAWER_HANDLE);
-        clear_handle_approach(hand, &handle, pointing)?;
-        hand.grab_handle_pointing(&handle, pointing)?;
+        let pointing = grab_handle(hand, &handle, pointing)?;
         hand.slide_pointing(open_dir, travel, pointing)?;
         hand.let_go_handle()?;
         hand.slide_pointing(Direction::Up, DRAWER_RETREAT, pointing)?;
@@ -343,8 +384,7 @@ fn close_bottom<R: RobotApi + ?Sized>(
     let travel = cabinet.travel(hand, drawer)?;
     let pointing = cabinet.bottom_pointing(hand)?;
     let handle = cabinet.part(parts::BOTTOM_DRAWER_HANDLE);
-    clear_handle_approach(hand, &handle, pointing)?;
-    hand.grab_handle_pointing(&handle, pointing)?;
+    let pointing = grab_handle(hand, &handle, pointing)?;
     hand.slide_pointing(close_dir, travel, pointing)?;
     hand.let_go_handle()
 }
