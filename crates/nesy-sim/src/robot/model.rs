@@ -22,6 +22,10 @@ pub const HOME_ARM: [f64; 7] = [
     std::f64::consts::FRAC_PI_4,
 ];
 
+/// Height (m) of the finger hand's palm underside above its tool point (the grasp point
+/// between the pads).
+pub const PALM_ABOVE_TOOL: f64 = 0.034;
+
 /// Initial and maximum finger travel (each finger) of the finger gripper.
 pub const FINGER_OPEN: f64 = 0.04;
 

@@ -505,20 +505,16 @@ impl Sim {
             role == PartRole::Loose
                 || (furniture && matches!(role, PartRole::Fixed | PartRole::ArticulatedBody | PartRole::Link))
         });
+        // Furniture by its solid colliders only (a handle's sensor is not in the way).
         for o in &mut obstacles {
             if self.parts[o.part].role != PartRole::Loose {
-                let solid: Vec<_> = self.parts[o.part]
-                    .colliders
-                    .iter()
-                    .filter(|&&c| !self.world.colliders[c].is_sensor())
-                    .map(|&c| {
-                        (
-                            self.world.colliders[c].shape(),
-                            *self.world.colliders[c].position(),
-                        )
-                    })
-                    .collect();
-                o.shapes = solid;
+                o.shapes.clear();
+                for &c in &self.parts[o.part].colliders {
+                    let collider = &self.world.colliders[c];
+                    if !collider.is_sensor() {
+                        o.shapes.push((collider.shape(), *collider.position()));
+                    }
+                }
             }
         }
         obstacles.retain(|o| !o.shapes.is_empty());
@@ -560,18 +556,28 @@ impl Sim {
         shapes_are_clear(&self.moving_shapes(q), obstacles)
     }
 
-    /// The shapes and world poses of the arm, the gripper and the carried object at `q`.
-    fn moving_shapes(&self, q: &[f64]) -> Vec<(&dyn rapier3d::prelude::Shape, Pose)> {
-        let poses = self.robot.model.link_poses(q, self.gripper);
-        let mut moving: Vec<(&dyn rapier3d::prelude::Shape, Pose)> = Vec::new();
+    /// Calls `visit` with each robot collider, its shape and its world pose, the links posed
+    /// at `poses` ([`crate::robot::kinematics::RobotModel::link_poses`]).
+    pub(crate) fn visit_robot_shapes<'s>(
+        &'s self,
+        poses: &[Iso],
+        mut visit: impl FnMut(ColliderHandle, &'s dyn rapier3d::prelude::Shape, Pose),
+    ) {
         for &(li, body) in &self.robot.bodies {
             let link = iso_to_pose(&(self.base * poses[li]));
             for &c in self.world.bodies[body].colliders() {
                 let collider = &self.world.colliders[c];
                 let local = collider.position_wrt_parent().copied().unwrap_or(Pose::IDENTITY);
-                moving.push((collider.shape(), link * local));
+                visit(c, collider.shape(), link * local);
             }
         }
+    }
+
+    /// The shapes and world poses of the arm, the gripper and the carried object at `q`.
+    fn moving_shapes(&self, q: &[f64]) -> Vec<(&dyn rapier3d::prelude::Shape, Pose)> {
+        let poses = self.robot.model.link_poses(q, self.gripper);
+        let mut moving: Vec<(&dyn rapier3d::prelude::Shape, Pose)> = Vec::new();
+        self.visit_robot_shapes(&poses, |_, shape, pose| moving.push((shape, pose)));
         if let Some(held) = self.held {
             let carrier = iso_to_pose(&(self.base * poses[self.robot.carrier_link]));
             let body = &self.world.bodies[self.parts[held.part].body];

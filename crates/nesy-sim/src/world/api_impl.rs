@@ -12,6 +12,7 @@ use crate::api::{
 };
 use crate::robot::kinematics::IkOptions;
 use crate::robot::model::FINGER_OPEN;
+use crate::robot::model::PALM_ABOVE_TOOL;
 use crate::robot::motion::{MOTION_SETTLE_STEPS, PARALLEL_MIN_DURATION, ToolGoal};
 use crate::scene::parts;
 use crate::scene::{ObjectKind, TABLE_TOP};
@@ -29,8 +30,6 @@ const FINGER_SWEEP: [f64; 3] = [-0.01, 0.0, 0.012];
 const PRESHAPE_CLEARANCE: f64 = 0.012;
 /// Half the width (m) of a finger pad across the closing axis.
 const FINGER_HALF_WIDTH: f64 = 0.01;
-/// Height (m) of the palm's underside above the tool point.
-const PALM_ABOVE_TOOL: f64 = 0.034;
 /// Half the palm's length (m) along the closing axis, and half its width across it.
 const PALM_HALF_LENGTH: f64 = 0.1;
 const PALM_HALF_WIDTH: f64 = 0.025;
@@ -525,10 +524,11 @@ impl Sim {
         // nudged, furniture stops the arm. Even a touch counts: the fingers narrow to the
         // object while the arm moves, so on the way down they stand wider than at the grasp.
         let centre = object.centre();
+        let furniture = self.protective_stop.then(|| self.furniture_snapshot());
         let into_furniture = |spin: f64| {
-            if !self.protective_stop {
+            let Some(furniture) = &furniture else {
                 return 0.0;
-            }
+            };
             let rotation = Sim::pointing(pointing, spin);
             let travel = self.preshape_travel(part, &rotation);
             let mut seed = self.q.clone();
@@ -539,7 +539,7 @@ impl Sim {
                     rotation,
                 };
                 if let Some(q) = self.ik(&goal, &seed, &IkOptions::default()) {
-                    deepest = deepest.max(self.arm_furniture_depth_at(&q, travel));
+                    deepest = deepest.max(furniture.arm_depth_at(&q, travel));
                     seed = q;
                 }
             }

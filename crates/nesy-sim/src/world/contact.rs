@@ -22,7 +22,7 @@
 //! push them through the physics as they move.
 
 use rapier3d::parry::bounding_volume::BoundingVolume;
-use rapier3d::prelude::{Pose, Shape};
+use rapier3d::prelude::{ColliderHandle, Pose, Shape};
 use serde::Serialize;
 
 use crate::api::ApiError;
@@ -46,6 +46,51 @@ pub const FURNITURE_TOUCH_DEPTH: f64 = 0.005;
 /// may go before the protective stop ends the motion: a hand leaving a part it rests
 /// against slides along it without pushing further in.
 const FURNITURE_STOP_SLACK: f64 = 0.001;
+
+/// The furniture of a scene at one moment ([`Sim::furniture_snapshot`]): how deep the robot
+/// would press into it at given joints.
+pub(crate) struct FurnitureSnapshot<'a> {
+    sim: &'a Sim,
+    blockers: Vec<Blocker<'a>>,
+}
+
+impl FurnitureSnapshot<'_> {
+    /// The deepest overlap (m) of the robot's links with any piece of furniture were the arm
+    /// at joints `q` with finger travel `g` (0 when it touches none): what a grasp would
+    /// press into before it is tried.
+    pub(crate) fn arm_depth_at(&self, q: &[f64], g: f64) -> f64 {
+        self.robot_depth_at(q, g, |_| true)
+    }
+
+    /// [`FurnitureSnapshot::arm_depth_at`] for the fingers alone.
+    pub(crate) fn fingers_depth_at(&self, q: &[f64], g: f64) -> f64 {
+        self.robot_depth_at(q, g, |c| self.sim.robot.gripper_colliders.contains(&c))
+    }
+
+    /// The deepest overlap (m) with furniture of the robot colliders that `keep` accepts,
+    /// were the arm at `(q, g)`.
+    fn robot_depth_at(&self, q: &[f64], g: f64, keep: impl Fn(ColliderHandle) -> bool) -> f64 {
+        if self.blockers.is_empty() {
+            return 0.0;
+        }
+        let poses = self.sim.robot.model.link_poses(q, g);
+        let mut deepest = 0.0_f64;
+        self.sim.visit_robot_shapes(&poses, |c, shape, pose| {
+            if !keep(c) {
+                return;
+            }
+            let aabb = shape.compute_aabb(&pose);
+            for blocker in self.blockers.iter().filter(|b| aabb.intersects(&b.aabb)) {
+                let contact =
+                    rapier3d::parry::query::contact(&pose, shape, &blocker.pose, blocker.shape, 0.0);
+                if let Ok(Some(contact)) = contact {
+                    deepest = deepest.max(-f64::from(contact.dist));
+                }
+            }
+        });
+        deepest
+    }
+}
 
 /// What was moving when a motion was stopped by contact.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -315,53 +360,13 @@ impl Sim {
             .map(|((moving, obstacle), _)| ContactStop { moving, obstacle })
     }
 
-    /// The deepest overlap (m) of the robot's links with any piece of furniture were the arm
-    /// at joints `q` with finger travel `g` (0 when it touches none): what a grasp would
-    /// press into before it is tried.
-    pub(crate) fn arm_furniture_depth_at(&self, q: &[f64], g: f64) -> f64 {
-        self.robot_furniture_depth_at(q, g, |_| true)
-    }
-
-    /// [`Sim::arm_furniture_depth_at`] for the fingers alone.
-    pub(crate) fn fingers_furniture_depth_at(&self, q: &[f64], g: f64) -> f64 {
-        self.robot_furniture_depth_at(q, g, |c| self.robot.gripper_colliders.contains(&c))
-    }
-
-    /// The deepest overlap (m) with furniture of the robot colliders that `keep` accepts,
-    /// were the arm at `(q, g)`.
-    fn robot_furniture_depth_at(
-        &self,
-        q: &[f64],
-        g: f64,
-        keep: impl Fn(rapier3d::prelude::ColliderHandle) -> bool,
-    ) -> f64 {
-        let blockers = self.furniture_colliders(|_| true);
-        if blockers.is_empty() {
-            return 0.0;
+    /// Every piece of furniture's solid colliders as they stand now, to weigh arm poses
+    /// against (built once for the several poses a decision compares).
+    pub(crate) fn furniture_snapshot(&self) -> FurnitureSnapshot<'_> {
+        FurnitureSnapshot {
+            sim: self,
+            blockers: self.furniture_colliders(|_| true),
         }
-        let poses = self.robot.model.link_poses(q, g);
-        let mut deepest = 0.0_f64;
-        for &(li, body) in &self.robot.bodies {
-            let link = crate::world::geometry::iso_to_pose(&(self.base * poses[li]));
-            for &c in self.world.bodies[body].colliders() {
-                let collider = &self.world.colliders[c];
-                if collider.is_sensor() || !keep(c) {
-                    continue;
-                }
-                let local = collider.position_wrt_parent().copied().unwrap_or(Pose::IDENTITY);
-                let pose = link * local;
-                let shape = collider.shape();
-                let aabb = shape.compute_aabb(&pose);
-                for blocker in blockers.iter().filter(|b| aabb.intersects(&b.aabb)) {
-                    let contact =
-                        rapier3d::parry::query::contact(&pose, shape, &blocker.pose, blocker.shape, 0.0);
-                    if let Ok(Some(contact)) = contact {
-                        deepest = deepest.max(-f64::from(contact.dist));
-                    }
-                }
-            }
-        }
-        deepest
     }
 
     /// How deep each of the robot's links and the carried object presses into each piece of

@@ -537,8 +537,9 @@ impl Sim {
         // do (a cube let go of by the toy box's wall): the fingers are kinematic and nothing
         // else would stop them.
         if self.protective_stop && g_next > g_prev && self.robot.model.gripper_limits.is_some() {
-            let before = self.fingers_furniture_depth_at(q_prev, g_prev);
-            let after = self.fingers_furniture_depth_at(q_next, g_next);
+            let furniture = self.furniture_snapshot();
+            let before = furniture.fingers_depth_at(q_prev, g_prev);
+            let after = furniture.fingers_depth_at(q_next, g_next);
             if after > before.max(contact::FURNITURE_TOUCH_DEPTH) {
                 g_next = g_prev;
             }

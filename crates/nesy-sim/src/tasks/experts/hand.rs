@@ -5,6 +5,7 @@
 use super::ExpertError;
 use crate::api::{ApiError, DEFAULT_LIFT_CLEARANCE, Direction, Embodiment, RobotApi};
 use crate::perception::observer::CLING_REACH;
+use crate::robot::model::PALM_ABOVE_TOOL;
 use crate::scene::{SubtaskKind, TABLE_TOP, parts};
 use crate::tasks::layout::{DROP_CLEARANCE, LID_SWING_MAX_X};
 
@@ -12,9 +13,6 @@ use crate::tasks::layout::{DROP_CLEARANCE, LID_SWING_MAX_X};
 const HAND_HALF_LENGTH: f64 = 0.105;
 /// Half the finger hand's width across the fingers' travel, seen from above (m).
 const HAND_HALF_WIDTH: f64 = 0.035;
-/// Height (m) of the finger hand's palm underside above the grasp point (between the
-/// pads).
-const PALM_ABOVE_GRASP: f64 = 0.034;
 /// Grasps tried on one object before the expert carries on regardless.
 const PICK_ATTEMPTS: usize = 3;
 /// Nearest x (m) to the robot's base at which the experts set objects down out of the way.
@@ -283,7 +281,7 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
         }
         let me = self.bbox(name)?;
         let c = centre(&me);
-        let palm_underside = me[1][2] - size(&me)[2] / 2.0 + PALM_ABOVE_GRASP;
+        let palm_underside = me[1][2] - size(&me)[2] / 2.0 + PALM_ABOVE_TOOL;
         let mut others = Vec::new();
         let mut furniture = Vec::new();
         for other in self.robot.get_obj_names() {
