@@ -94,6 +94,8 @@ def main():
         "--methods", ",".join(variants),
         "--scenarios", ",".join(scenarios),
         "--observation", settings.get("observation", "images"),
+        # A manifest without the setting is a run made before the protective stop existed.
+        "--protective-stop", "on" if settings.get("protective_stop", False) else "off",
         "--repeats", str(manifest.get("repeats", 1)),
         "--seed", str(manifest.get("run_seed", 0)),
         "--vlm", f"replay:{(run / 'cassettes').resolve()}",

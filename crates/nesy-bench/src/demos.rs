@@ -84,15 +84,25 @@ pub struct CachedDemo {
 pub struct DemoCache {
     dir: PathBuf,
     image_size: u32,
+    protective_stop: bool,
 }
 
 impl DemoCache {
-    /// A cache in `dir`, recording views of `image_size` pixels.
+    /// A cache in `dir`, recording views of `image_size` pixels with the robot's protective
+    /// stop off.
     pub fn new(dir: impl Into<PathBuf>, image_size: u32) -> DemoCache {
         DemoCache {
             dir: dir.into(),
             image_size,
+            protective_stop: false,
         }
+    }
+
+    /// The same cache with the robot's protective stop set as given, in the demonstrations
+    /// it records and the target scenes it writes (part of the cache key).
+    pub fn with_protective_stop(mut self, on: bool) -> DemoCache {
+        self.protective_stop = on;
+        self
     }
 
     /// The cache folder.
@@ -110,6 +120,9 @@ impl DemoCache {
         }
         h.update(nesy_sim::FINGERPRINT.as_bytes());
         h.update(self.image_size.to_le_bytes());
+        if self.protective_stop {
+            h.update(b"protective stop");
+        }
         hex(&h.finalize())
     }
 
@@ -137,8 +150,10 @@ impl DemoCache {
             return Ok(hit);
         }
         let started = Instant::now();
-        let source = scenario.generate(Side::Source)?.scene;
-        let target = scenario.generate(Side::Target)?.scene;
+        let mut source = scenario.generate(Side::Source)?.scene;
+        let mut target = scenario.generate(Side::Target)?.scene;
+        source.protective_stop = self.protective_stop;
+        target.protective_stop = self.protective_stop;
         let options = RecordOptions {
             image_size: self.image_size,
             render_threads: render_threads.max(1),

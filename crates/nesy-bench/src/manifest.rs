@@ -116,6 +116,12 @@ pub struct RunSettings {
     /// pictures, so runs made before the setting existed keep their configuration hashes.
     #[serde(default, skip_serializing_if = "Observation::is_images")]
     pub observation: Observation,
+    /// Whether the robot's protective stop is on in every scene the run builds (its
+    /// demonstrations and its executions; `nesy_sim::scene::SceneSpec::protective_stop`).
+    /// Off by default, and then left out of the manifest, so runs made before the stop
+    /// existed (which ran without it) keep their configuration hashes.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub protective_stop: bool,
 }
 
 /// What every method is shown of the demonstration's keyframes and the target scene.

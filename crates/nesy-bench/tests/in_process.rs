@@ -43,6 +43,7 @@ fn config(run_dir: &Path, demos: &Path) -> RunConfig {
             policy_wall_ms: 120_000,
             max_calls_per_unit: None,
             observation: Observation::Images,
+            protective_stop: false,
         },
         shard: "0/1".parse().unwrap(),
         jobs: 2,

@@ -220,7 +220,7 @@ impl OracleTransport {
 
 /// The template compiler's program for a code-generation request.
 fn compile(ctx: &CodeGenerationContext) -> Result<String, TransportError> {
-    compile_policy(&ctx.procedure, &ctx.objects, ctx.embodiment)
+    compile_policy(&ctx.procedure, &ctx.objects, ctx.embodiment, ctx.protective_stop)
         .map(|compiled| compiled.code)
         .map_err(|e| fail(e.to_string()))
 }

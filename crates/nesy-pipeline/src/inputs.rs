@@ -233,6 +233,12 @@ impl TargetInput {
         self.scene.as_ref().is_some_and(SceneSpec::holds_tool)
     }
 
+    /// True when the target scene turns the robot's protective stop on; a camera target
+    /// without a scene says nothing, so off.
+    pub fn protective_stop(&self) -> bool {
+        self.scene.as_ref().is_some_and(|scene| scene.protective_stop)
+    }
+
     /// Reads `path`: a scene file, or a camera target folder (`manifest.json` with one
     /// keyframe, optionally `scene.json`); without a path, the target scene recorded in the
     /// demo. A scene is built, observed and rendered. Embodiment atoms go into the state

@@ -519,6 +519,7 @@ async fn synthesize_adapted(
         source: inputs.setting.source_embodiment,
         target: inputs.setting.target_embodiment,
         tools: inputs.target.holds_tool(),
+        protective_stop: inputs.target.protective_stop(),
     };
     let synth_started = Instant::now();
     let result = synth::synthesize(reasoner, inputs.options.codegen, &request).await;

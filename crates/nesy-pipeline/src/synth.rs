@@ -43,6 +43,9 @@ pub struct SynthesisRequest {
     pub target: Embodiment,
     /// The target scene holds a tool: offer the tool-use calls.
     pub tools: bool,
+    /// The target robot's protective stop is on: the template compiler keeps the hand off
+    /// tall furniture where it chooses a wrist turn.
+    pub protective_stop: bool,
 }
 
 /// A synthesized program and how it was obtained.
@@ -111,6 +114,7 @@ pub async fn synthesize(
                     embodiment: request.target,
                     extended: request.source != request.target,
                     tools: request.tools,
+                    protective_stop: request.protective_stop,
                 })
                 .await;
             let source = match result {
@@ -147,11 +151,15 @@ pub async fn synthesize(
 }
 
 fn template(request: &SynthesisRequest) -> Result<SynthesizedPolicy, SynthError> {
-    let compiled = compile_policy(&request.procedure, &request.objects, request.target).map_err(|e| {
-        SynthError::NoProgram {
-            message: e.to_string(),
-            replies: Vec::new(),
-        }
+    let compiled = compile_policy(
+        &request.procedure,
+        &request.objects,
+        request.target,
+        request.protective_stop,
+    )
+    .map_err(|e| SynthError::NoProgram {
+        message: e.to_string(),
+        replies: Vec::new(),
     })?;
     Ok(SynthesizedPolicy {
         code: compiled.code,

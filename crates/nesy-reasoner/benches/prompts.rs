@@ -95,6 +95,7 @@ fn prompts(c: &mut Criterion) {
         embodiment: nesy_core::Embodiment::Vacuum,
         extended: true,
         tools: false,
+        protective_stop: false,
     };
     let mut group = c.benchmark_group("prompts");
     group.bench_function("induction_request_6_rendered_images", |b| {

@@ -72,6 +72,10 @@ pub struct CodeGenerationContext {
     pub embodiment: Embodiment,
     /// Whether the extended prompt (both end effectors' functions) was used.
     pub extended: bool,
+    /// Whether the target robot's protective stop is on (what a template compilation of the
+    /// procedure takes into account).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub protective_stop: bool,
 }
 
 /// The typed context of one VLM call, by task.

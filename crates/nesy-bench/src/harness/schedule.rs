@@ -42,7 +42,8 @@ pub async fn run(
     progress.start(mine.len(), pending.len());
     let live = live_transport(&config.responder)?;
     let shared = Arc::new(Shared {
-        cache: DemoCache::new(&config.demo_cache, config.settings.image_size),
+        cache: DemoCache::new(&config.demo_cache, config.settings.image_size)
+            .with_protective_stop(config.settings.protective_stop),
         cpu: Arc::new(Semaphore::new(config.cpu_jobs.max(1))),
         model: Arc::new(Semaphore::new(config.model_jobs.max(1))),
         live,

@@ -265,6 +265,7 @@ pub(super) async fn make_code(
                 source: inputs.setting.source_embodiment,
                 target: inputs.setting.target_embodiment,
                 tools: target.holds_tool(),
+                protective_stop: target.protective_stop(),
             };
             let reasoner =
                 VlmReasoner::new(client.clone()).map_err(|e| (UnitStatus::MethodError, e.to_string()))?;
@@ -289,6 +290,7 @@ pub(super) async fn make_code(
                 extended: matches!(inputs.setting.factor, Factor::Grip | Factor::Vacu | Factor::Comb)
                     || inputs.setting.source_embodiment != inputs.setting.target_embodiment,
                 tools: target.holds_tool(),
+                protective_stop: target.protective_stop(),
             };
             let source = reasoner.generate_code(&request).await.map_err(|e| {
                 let status = match FailureKind::of_reasoner(e.reasoner_kind()) {

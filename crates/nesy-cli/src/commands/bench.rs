@@ -19,6 +19,8 @@ use nesy_bench::{Selection, Shard, UnitRecord, UnitStatus};
 use nesy_policy::WorkerCommand;
 use nesy_vlm::ConfigOverrides;
 
+use super::OnOff;
+
 /// Arguments of `nesy bench`.
 #[derive(Debug, clap::Args)]
 pub(crate) struct BenchArgs {
@@ -159,6 +161,12 @@ pub(crate) struct RunArgs {
     /// models; NeSyCR reads the ground-truth states).
     #[arg(long, value_enum, default_value_t = Observation::Images)]
     pub observation: Observation,
+    /// The robot's protective stop in every scene of the run: `off` (the kinematic arm,
+    /// which passes through furniture) or `on` (a motion that presses the arm or what it
+    /// carries into furniture ends there, and the experts' demonstrations keep off it); the
+    /// manifest records it.
+    #[arg(long, value_enum, default_value_t = OnOff::Off)]
+    pub protective_stop: OnOff,
     /// Record the offline responder's calls to per-unit cassettes too (live calls always are).
     #[arg(long)]
     pub record_cassettes: bool,
@@ -220,6 +228,10 @@ pub(crate) struct DemosArgs {
     /// Read the scenario suite from this folder instead of generating it.
     #[arg(long, value_name = "DIR")]
     pub suite: Option<PathBuf>,
+    /// The robot's protective stop in the demonstrations: `off` or `on`, as the run that
+    /// will use them sets it (`nesy bench run --protective-stop`).
+    #[arg(long, value_enum, default_value_t = OnOff::Off)]
+    pub protective_stop: OnOff,
 }
 
 /// Arguments of `nesy bench slurm`.
@@ -424,6 +436,7 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
             policy_wall_ms: (args.policy_timeout * 1000.0) as u64,
             max_calls_per_unit: args.max_calls_per_unit,
             observation: args.observation,
+            protective_stop: args.protective_stop.is_on(),
         },
         shard: args.shard.parse()?,
         jobs: args.jobs.unwrap_or_else(cores).max(1),
@@ -622,7 +635,8 @@ fn run_bench(args: RunArgs) -> anyhow::Result<ExitCode> {
 fn demos(args: DemosArgs) -> anyhow::Result<ExitCode> {
     let files = harness::load_suite(args.suite.as_deref())?;
     let scenarios = Selection::parse(&args.scenarios).apply(nesy_sim::tasks::scenario::scenarios(&files))?;
-    let cache = DemoCache::new(&args.demos, nesy_sim::perception::render::VIEW_SIZE);
+    let cache = DemoCache::new(&args.demos, nesy_sim::perception::render::VIEW_SIZE)
+        .with_protective_stop(args.protective_stop.is_on());
     let started = Instant::now();
     let total = scenarios.len();
     let results = nesy_bench::pool::run_all(
@@ -686,7 +700,8 @@ fn demos(args: DemosArgs) -> anyhow::Result<ExitCode> {
 fn plan(args: RunArgs) -> anyhow::Result<ExitCode> {
     let config = config(&args)?;
     let prepared: Prepared = harness::prepare(&config)?;
-    let cache = DemoCache::new(&config.demo_cache, config.settings.image_size);
+    let cache = DemoCache::new(&config.demo_cache, config.settings.image_size)
+        .with_protective_stop(config.settings.protective_stop);
     let plan = nesy_bench::call_budget::estimate(&prepared, &cache);
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&plan)?)?;

@@ -25,3 +25,19 @@ pub(crate) fn seconds_to_ms(flag: &str, seconds: f64) -> anyhow::Result<u64> {
     }
     Ok((seconds * 1000.0).ceil() as u64)
 }
+
+/// A setting that is either on or off on the command line (`--flag on|off`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum OnOff {
+    /// On.
+    On,
+    /// Off.
+    Off,
+}
+
+impl OnOff {
+    /// True for `on`.
+    pub(crate) fn is_on(self) -> bool {
+        self == OnOff::On
+    }
+}

@@ -8,6 +8,8 @@ use std::time::Instant;
 use anyhow::Context;
 use nesy_sim::tasks::scenario::{self, ConfigFile, CountTable, Family, Scenario, Side};
 
+use super::OnOff;
+
 /// Arguments of `nesy scenarios`.
 #[derive(Debug, clap::Args)]
 pub(crate) struct ScenariosArgs {
@@ -101,11 +103,11 @@ pub(crate) enum ScenariosAction {
         /// displaced objects).
         #[arg(long, value_name = "REPORT")]
         rerun_failures: Option<PathBuf>,
-        /// Run the experts with the robot's protective stop on: a motion that presses the arm
-        /// or what it carries into furniture ends there (counts the scenes whose expert it
-        /// stops; the benchmark runs without it).
-        #[arg(long)]
-        protective_stop: bool,
+        /// The robot's protective stop: `off` (the kinematic arm, as the benchmark runs by
+        /// default) or `on` (a motion that presses the arm or what it carries into furniture
+        /// ends there, and the experts keep off it).
+        #[arg(long, value_enum, default_value_t = OnOff::Off)]
+        protective_stop: OnOff,
     },
 }
 
@@ -241,8 +243,7 @@ pub(crate) fn run(args: ScenariosArgs) -> anyhow::Result<ExitCode> {
                 scenes: scenes.as_deref().map(parse_scenes).transpose()?,
                 rerun: rerun_failures.as_deref().map(failed_scenes).transpose()?,
             };
-            let options = nesy_sim::demo::ExpertOptions { protective_stop };
-            sweep(suite, filter, threads, report, options)
+            sweep(suite, filter, threads, report, protective_stop.is_on())
         }
     }
 }
@@ -329,7 +330,7 @@ fn sweep(
     filter: SceneFilter,
     threads: usize,
     report: Option<PathBuf>,
-    options: nesy_sim::demo::ExpertOptions,
+    protective_stop: bool,
 ) -> anyhow::Result<ExitCode> {
     let files = load_suite(suite.as_deref())?;
     let all = scenario::scenarios(&files);
@@ -361,7 +362,7 @@ fn sweep(
     let results = nesy_bench::pool::run_all(
         &jobs,
         threads,
-        |_, (s, side)| run_one(s, *side, options),
+        |_, (s, side)| run_one(s, *side, protective_stop),
         |i, result: &SceneResult| {
             eprintln!("{}", sweep_line(i, total, result));
             if let Some(file) = &mut report_file {
@@ -529,13 +530,16 @@ fn print_sweep_summary(results: &[SceneResult], wall: f64, threads: usize) -> an
     })
 }
 
-fn run_one(s: &Scenario, side: Side, options: nesy_sim::demo::ExpertOptions) -> SceneResult {
+fn run_one(s: &Scenario, side: Side, protective_stop: bool) -> SceneResult {
     let started = Instant::now();
-    let task = s.generate(side);
+    let task = s.generate(side).map(|mut t| {
+        t.scene.protective_stop = protective_stop;
+        t
+    });
     let (embodiment, outcome) = match &task {
         Ok(t) => (
             t.scene.embodiment.as_str(),
-            nesy_sim::demo::run_expert_with(&t.scene, options).map_err(|e| e.to_string()),
+            nesy_sim::demo::run_expert(&t.scene).map_err(|e| e.to_string()),
         ),
         Err(e) => ("?", Err(e.to_string())),
     };

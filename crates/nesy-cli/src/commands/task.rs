@@ -126,7 +126,7 @@ fn new(args: NewArgs) -> anyhow::Result<ExitCode> {
     //    solve from its own state would make a task no method can succeed on.
     let (procedure, objects) = plan(&source, &args.source, "source")?;
     let (target_plan, _) = plan(&target, &args.target, "target")?;
-    let compiled = compile_policy(&procedure, &objects, source.embodiment)
+    let compiled = compile_policy(&procedure, &objects, source.embodiment, source.protective_stop)
         .with_context(|| format!("compiling the plan for {}", args.source.display()))?;
 
     // 2. Run the program in the sandbox on the source scene.

@@ -131,6 +131,7 @@ async fn adapt_and_execute(case: &Case, noise: OracleNoise, budget: usize) -> Ru
                 embodiment: case.target,
                 extended: cross,
                 tools: false,
+                protective_stop: false,
             })
             .await
             .unwrap();

@@ -106,7 +106,7 @@ fn compiled_plan_succeeds(
             ),
         }
     }
-    let policy = nesy_sim::codegen::compile_policy(&procedure, &names, embodiment).unwrap();
+    let policy = nesy_sim::codegen::compile_policy(&procedure, &names, embodiment, false).unwrap();
     let mut episode = Sim::new(&scene).unwrap();
     GoalMonitor::attach(&mut episode).unwrap();
     let result = run_in_process(&policy.code, Box::new(episode), &Limits::default(), None).unwrap();

@@ -700,3 +700,64 @@ print("in gripper:", obj_in_gripper("magnetic_hook"))
     let state = format!("{:?}", result.final_state);
     assert!(state.contains("(Gathered black_screws)"), "{state}");
 }
+
+/// A template-compiled fruit pick beside the hinge box, on a robot whose protective stop is
+/// on: the turn away from the nearest fruit would lay the hand's length across the hinge
+/// box's wall, where the stop ends the descent; compiled for the stop, the program turns
+/// the wrist further, until the hand is clear, and takes the fruit.
+#[test]
+fn a_fruit_pick_compiled_for_the_protective_stop_keeps_the_hand_off_the_hinge_box() {
+    let scene = r#"{
+      "schema_version": 1, "embodiment": "finger", "protective_stop": true,
+      "objects": [
+        {"name": "hinge_body", "kind": "hinge_box", "pose": {"position": [0.65, 0.18, 0.5]}},
+        {"name": "apple", "kind": "apple", "pose": {"position": [0.51, 0.2, 0.5]}},
+        {"name": "orange", "kind": "orange", "pose": {"position": [0.51, 0.12, 0.5]}}
+      ],
+      "goals": []
+    }"#;
+    let scene = nesy_sim::scene::SceneSpec::from_json_str(scene, "apple by the hinge box").unwrap();
+    let objects: Vec<String> = [
+        "floor",
+        "hinge_body",
+        "hinge_lid",
+        "hinge_handle",
+        "apple",
+        "orange",
+    ]
+    .map(String::from)
+    .to_vec();
+    let procedure: Vec<nesy_core::Operator> = [
+        "MoveToSurroundApple",
+        "GraspApple",
+        "CarryOverHingeBodyApple",
+        "DropIntoHingeBodyApple",
+    ]
+    .into_iter()
+    .map(|name| nesy_core::Operator::new(name, vec![], vec![]))
+    .collect();
+    let pick = |protective_stop: bool| {
+        let code =
+            nesy_sim::codegen::compile_policy(&procedure, &objects, Embodiment::Finger, protective_stop)
+                .unwrap()
+                .code;
+        // The program up to the grasp, then a report of what the hand holds.
+        let end = code.find("# 3. ").expect("a third action");
+        let source = format!("{}print(\"holding:\", obj_in_gripper(\"apple\"))\n", &code[..end]);
+        let sim = nesy_sim::world::Sim::new(&scene).unwrap();
+        run_in_process(&source, Box::new(sim), &Limits::default(), None).expect("interpreter starts")
+    };
+
+    let unaware = pick(false);
+    let err = python_error(&unaware);
+    assert_eq!(err.exception, "robot.CollisionError", "{err:#?}");
+    assert!(err.message.contains("ran into hinge_"), "{err:#?}");
+
+    let aware = pick(true);
+    assert_eq!(aware.outcome, Outcome::Ok, "{:#?}", aware.outcome);
+    assert!(
+        aware.stdout.text.contains("holding: True"),
+        "{}",
+        aware.stdout.text
+    );
+}

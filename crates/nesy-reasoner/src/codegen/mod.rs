@@ -42,6 +42,12 @@ pub struct CodeGenerationRequest {
     /// hook. Off, the prompt is the one a scene without tools gets.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub tools: bool,
+    /// The target robot's protective stop is on (`nesy_sim::scene::SceneSpec::protective_stop`):
+    /// a template compilation of the procedure (the offline responder's answer) then keeps
+    /// the hand's length off tall furniture when it turns the wrist for a fruit. The prompt
+    /// does not change.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub protective_stop: bool,
 }
 
 /// A generated program, ready for the sandbox, with how it was obtained.
@@ -210,6 +216,7 @@ pub fn build_request(
             .collect(),
         embodiment: request.embodiment,
         extended,
+        protective_stop: request.protective_stop,
     });
     let chat = ChatRequest::new()
         .purpose(context.purpose())

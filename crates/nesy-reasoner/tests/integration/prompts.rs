@@ -401,6 +401,7 @@ fn codegen_request(embodiment: Embodiment, extended: bool) -> ChatRequest {
         embodiment,
         extended,
         tools: false,
+        protective_stop: false,
     };
     let prompts = Prompts::builtin().unwrap();
     let (chat, used) = nesy_reasoner::codegen::build_request(

@@ -189,6 +189,7 @@ async fn the_loop_recovers_from_a_rejected_operator_and_a_non_matching_patch() {
         embodiment: Embodiment::Finger,
         extended: false,
         tools: false,
+        protective_stop: false,
     };
     let policy = reasoner.generate_code(&request).await.unwrap();
     assert!(
@@ -487,6 +488,7 @@ async fn plausible_but_wrong_programs_are_re_asked_before_anything_runs() {
             embodiment: Embodiment::Finger,
             extended: false,
             tools: false,
+            protective_stop: false,
         };
         let policy = reasoner
             .generate_code(&request)

@@ -29,8 +29,9 @@ use crate::domain::{
     Motion, Schema, SchemaInstance, SchemaKind as Kind, asset_of, asset_prefixes, instance_name, kind_of,
     schema_instance, schemas,
 };
+use crate::robot::model::{HAND_HALF_LENGTH, HAND_HALF_WIDTH, PALM_ABOVE_TOOL};
 use crate::scene::{TABLE_TOP, parts};
-use crate::world::FLOOR_AABB;
+use crate::world::{FLOOR_AABB, FURNITURE_TOUCH_DEPTH};
 use Motion::*;
 
 // Where objects go and how the lid swings: the scripted experts' constants, shared so the
@@ -91,6 +92,57 @@ def clear_angle(name):
             angle = math.atan2(dy, dx)
     return angle
 "#;
+
+/// [`CLEAR_ANGLE_HELPER`] for a robot whose protective stop is on. The hand is 21 cm long
+/// along the fingers' travel: when the turn away from the nearest neighbour would put it
+/// into something standing higher than its palm by more than a touch (the hinge box, its
+/// open lid or a cabinet beside the fruit), where the stop would end the descent, the helper takes the nearest
+/// turn, in eighths of a half turn, that keeps it clear. (The helper without the stop is kept as it was, so that the
+/// programs of runs made without the stop, and the policy line numbers their errors name,
+/// stay the same.)
+fn furniture_aware_clear_angle_helper() -> String {
+    let steps = (HAND_HALF_LENGTH / HAND_STEP).round() as i32;
+    // The helper above with the tall boxes collected on the way and the final turn checked.
+    let replace_once = |text: String, from: &str, to: &str| {
+        debug_assert_eq!(text.matches(from).count(), 1, "{from}");
+        text.replacen(from, to, 1)
+    };
+    let helper = replace_once(
+        CLEAR_ANGLE_HELPER.to_owned(),
+        "    angle, nearest = 0.0, 1e9\n",
+        &format!(
+            "    palm = own[1][2] - min((own[1][2] - own[0][2]) / 2, {MAX_FINGER_DEPTH}) + {PALM_ABOVE_TOOL}\n    angle, nearest, tall = 0.0, 1e9, []\n"
+        ),
+    );
+    let helper = replace_once(
+        helper,
+        "        b = get_obj_bbox(other)\n",
+        &format!(
+            "        b = get_obj_bbox(other)\n        if b[1][2] > palm + {FURNITURE_TOUCH_DEPTH}:\n            tall.append(b)\n"
+        ),
+    );
+    let helper = replace_once(
+        helper,
+        "    return angle\n",
+        "    for k in (0, 1, -1, 2, -2, 3, -3, 4):\n        if not hand_meets(centre, angle + k * math.pi / 8, tall):\n            return angle + k * math.pi / 8\n    return angle\n",
+    );
+    format!(
+        r#"{helper}
+def hand_meets(centre, turn, boxes):
+    # Points {HAND_STEP} m apart along the hand's length, each with the hand's half-width around it.
+    ux, uy = -math.sin(turn), math.cos(turn)
+    for k in range(-{steps}, {steps} + 1):
+        x, y = centre[0] + ux * {HAND_STEP} * k, centre[1] + uy * {HAND_STEP} * k
+        for b in boxes:
+            if b[0][0] - {HAND_HALF_WIDTH} < x < b[1][0] + {HAND_HALF_WIDTH} and b[0][1] - {HAND_HALF_WIDTH} < y < b[1][1] + {HAND_HALF_WIDTH}:
+                return True
+    return False
+"#
+    )
+}
+
+/// Spacing (m) of the points along the hand's length that `clear_angle` tests.
+const HAND_STEP: f64 = 0.015;
 
 /// One action recognised in a procedure.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -225,11 +277,14 @@ pub fn resolve_by_effects(op: &Operator, objects: &[String]) -> Option<ResolvedA
     })
 }
 
-/// Compiles a verified procedure into a policy program for `embodiment`.
+/// Compiles a verified procedure into a policy program for `embodiment`, on a robot whose
+/// protective stop is on or off (`protective_stop`: where the program chooses a wrist turn,
+/// it then keeps the hand off tall furniture).
 pub fn compile_policy(
     procedure: &[Operator],
     objects: &[String],
     embodiment: Embodiment,
+    protective_stop: bool,
 ) -> Result<CompiledPolicy, CodegenError> {
     let actions: Vec<ResolvedAction> = procedure
         .iter()
@@ -246,7 +301,7 @@ pub fn compile_policy(
         .into_iter()
         .flatten()
         .collect();
-    let code = emit(&actions, embodiment);
+    let code = emit(&actions, embodiment, protective_stop);
     Ok(CompiledPolicy {
         code,
         actions,
@@ -404,7 +459,7 @@ fn instance(action: &ResolvedAction) -> SchemaInstance {
     schema_instance(&action.schema).expect("resolved actions name schema instances")
 }
 
-fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
+fn emit(actions: &[ResolvedAction], embodiment: Embodiment, protective_stop: bool) -> String {
     let vacuum = embodiment == Embodiment::Vacuum;
     // The hinge task's fruits (what is carried over the hinge body) are round: the fingers
     // take them at the turn that keeps clear of their neighbours.
@@ -430,7 +485,11 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment) -> String {
     e.line("import math");
     e.out.push_str(&within_reach_helper());
     if !vacuum && !e.fruits.is_empty() {
-        e.out.push_str(CLEAR_ANGLE_HELPER);
+        if protective_stop {
+            e.out.push_str(&furniture_aware_clear_angle_helper());
+        } else {
+            e.out.push_str(CLEAR_ANGLE_HELPER);
+        }
     }
     for (i, a) in actions.iter().enumerate() {
         let _ = writeln!(e.out, "\n# {}. {}", i + 1, a.name);
@@ -737,7 +796,7 @@ mod tests {
             Vec::new(),
             Vec::new(),
         )];
-        let policy = compile_policy(&procedure, &o, Embodiment::Finger).unwrap();
+        let policy = compile_policy(&procedure, &o, Embodiment::Finger, false).unwrap();
         let close = policy.code.find("close_gripper()").unwrap();
         let carry = policy.code.find("move_to_position(").unwrap();
         assert!(close < carry, "{}", policy.code);
@@ -782,12 +841,16 @@ mod tests {
             "CarryOverHingeBodyApple",
             "DropIntoHingeBodyApple",
         ]);
-        let finger = compile_policy(&procedure, &o, Embodiment::Finger).unwrap().code;
+        let finger = compile_policy(&procedure, &o, Embodiment::Finger, false)
+            .unwrap()
+            .code;
         assert!(finger.contains("def clear_angle(name):"), "{finger}");
         assert!(finger.contains("angle=clear_angle(\"apple\")"), "{finger}");
         assert!(finger.contains("move_gripper_to(\"red_cube\""), "{finger}");
         assert!(!finger.contains("move_gripper_to(\"apple\""), "{finger}");
-        let vacuum = compile_policy(&procedure, &o, Embodiment::Vacuum).unwrap().code;
+        let vacuum = compile_policy(&procedure, &o, Embodiment::Vacuum, false)
+            .unwrap()
+            .code;
         assert!(!vacuum.contains("clear_angle"), "{vacuum}");
     }
 
@@ -810,7 +873,9 @@ mod tests {
             "GraspRedCube",
             "CarryIntoRedCubeToyBox",
         ]);
-        let code = compile_policy(&procedure, &o, Embodiment::Vacuum).unwrap().code;
+        let code = compile_policy(&procedure, &o, Embodiment::Vacuum, false)
+            .unwrap()
+            .code;
         // The piece's own x, clamped inside the box (two pieces at the centre would stack);
         // the cube still goes to the toy box's centre.
         assert!(
@@ -831,7 +896,7 @@ mod tests {
             "SweepIntoWhiteBishopLeftChessBox",
         ]);
         for embodiment in [Embodiment::Finger, Embodiment::Vacuum] {
-            let code = compile_policy(&procedure, &o, embodiment).unwrap().code;
+            let code = compile_policy(&procedure, &o, embodiment, false).unwrap().code;
             // A piece knocked beside the board (affo_medium_00_s0: x 0.238 beside a board from
             // 0.265) keeps its own x only inside the board's extent.
             assert!(
@@ -855,7 +920,9 @@ mod tests {
             "MoveToSurroundWhiteRook",
             "SweepIntoWhiteRookLeftChessBox",
         ]);
-        let code = compile_policy(&procedure, &o, Embodiment::Finger).unwrap().code;
+        let code = compile_policy(&procedure, &o, Embodiment::Finger, false)
+            .unwrap()
+            .code;
         let approach = "move_gripper_to(\"white_rook\", depth=get_obj_size(\"white_rook\")[2] / 1.3)";
         // Once inserted after the put-down, once from the procedure's own approach.
         assert_eq!(code.matches(approach).count(), 2, "{code}");
@@ -912,7 +979,7 @@ mod tests {
                 ],
             ),
         ];
-        let policy = compile_policy(&procedure, &o, Embodiment::Finger).unwrap();
+        let policy = compile_policy(&procedure, &o, Embodiment::Finger, false).unwrap();
         let schemas: Vec<&str> = policy.actions.iter().map(|a| a.schema.as_str()).collect();
         assert_eq!(
             schemas,
@@ -940,6 +1007,7 @@ mod tests {
             )],
             &o,
             Embodiment::Finger,
+            false,
         )
         .unwrap_err();
         assert!(err.to_string().contains("action 1 (Wave)"), "{err}");
@@ -957,17 +1025,22 @@ mod tests {
         .iter()
         .map(|n| Operator::new(*n, Vec::new(), Vec::new()))
         .collect();
-        let finger = compile_policy(&ops, &o, Embodiment::Finger).unwrap();
+        let finger = compile_policy(&ops, &o, Embodiment::Finger, false).unwrap();
         assert!(finger.code.contains("close_gripper()") && finger.code.contains("open_gripper()"));
         assert!(
             finger.code.contains("depth=get_obj_size(\"red_cube\")[2] / 2"),
             "{}",
             finger.code
         );
-        let vacuum = compile_policy(&ops, &o, Embodiment::Vacuum).unwrap();
+        let vacuum = compile_policy(&ops, &o, Embodiment::Vacuum, false).unwrap();
         assert!(vacuum.code.contains("activate_vacuum()") && !vacuum.code.contains("close_gripper"));
-        let err =
-            compile_policy(&[Operator::new("Dance", vec![], vec![])], &o, Embodiment::Finger).unwrap_err();
+        let err = compile_policy(
+            &[Operator::new("Dance", vec![], vec![])],
+            &o,
+            Embodiment::Finger,
+            false,
+        )
+        .unwrap_err();
         assert!(err.to_string().contains("action 1 (Dance)"), "{err}");
     }
 
@@ -1017,7 +1090,7 @@ mod tests {
             "PutDownRedCubeFloor",
         ]);
         for embodiment in [Embodiment::Finger, Embodiment::Vacuum] {
-            let code = compile_policy(&procedure, &o, embodiment).unwrap().code;
+            let code = compile_policy(&procedure, &o, embodiment, false).unwrap().code;
             let calls = code.matches("move_to_position(").count();
             assert!(calls >= 6, "{code}");
             assert_eq!(

@@ -33,8 +33,8 @@ pub use folder::{
 };
 pub use mcap_format::{read_mcap, read_mcap_bytes, write_mcap, write_mcap_file};
 pub use record::{
-    ExecutionRecording, ExpertOptions, ExpertRun, RecordError, RecordOptions, Recording, ReplayDivergence,
-    record_scene, record_scene_video, replay_execution, run_expert, run_expert_with,
+    ExecutionRecording, ExpertRun, RecordError, RecordOptions, Recording, ReplayDivergence, record_scene,
+    record_scene_video, replay_execution, run_expert,
 };
 pub use video::{
     StateSpan, TrueKeyframe, VIDEO_TRUTH_FILE, VIDEO_TRUTH_VERSION, VideoFrame, VideoOptions, VideoTruth,

@@ -580,27 +580,14 @@ impl ExpertRun {
     }
 }
 
-/// How [`run_expert_with`] sets up the robot.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct ExpertOptions {
-    /// Run with the protective stop on ([`Sim::set_protective_stop`]).
-    pub protective_stop: bool,
-}
-
 /// Runs the scripted expert on `scene` and checks the goals (no images), with the robot as
-/// the benchmark runs it.
+/// the scene sets it up (its protective stop included).
 pub fn run_expert(scene: &SceneSpec) -> Result<ExpertRun, RecordError> {
-    run_expert_with(scene, ExpertOptions::default())
-}
-
-/// [`run_expert`] with the robot set up by `options`.
-pub fn run_expert_with(scene: &SceneSpec, options: ExpertOptions) -> Result<ExpertRun, RecordError> {
     let mut sim = Sim::new(scene)?;
-    sim.set_protective_stop(options.protective_stop);
     let monitor = GoalMonitor::attach(&mut sim)?;
     sim.add_hook(Box::new(FurnitureContactProbe::default()));
     let start = sim.time();
-    let expert_error = experts::run_with(&mut sim, scene, options.protective_stop).err();
+    let expert_error = experts::run(&mut sim, scene).err();
     let outcome = monitor.finish(&mut sim);
     let furniture_contacts = sim
         .hook::<FurnitureContactProbe>()

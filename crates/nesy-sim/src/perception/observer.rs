@@ -357,7 +357,9 @@ fn push_inside_of(s: &Snapshot, atoms: &mut Vec<Atom>) -> Vec<Option<usize>> {
     for (i, a) in s.objects.iter().enumerate() {
         let mut best: Option<(f64, usize)> = None;
         for (j, c) in s.objects.iter().enumerate() {
-            if i == j || same_group(a, c) || on_magnet_pair(a, c) {
+            // A hook has no inside: what lies on its bar, beside the taller magnet block,
+            // sits within its box yet rests on it.
+            if i == j || same_group(a, c) || on_magnet_pair(a, c) || c.magnetic {
                 continue;
             }
             let (lo, hi) = padding(&c.name);

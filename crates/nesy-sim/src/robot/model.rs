@@ -26,6 +26,15 @@ pub const HOME_ARM: [f64; 7] = [
 /// between the pads).
 pub const PALM_ABOVE_TOOL: f64 = 0.034;
 
+/// Half the finger hand's length along the fingers' travel, seen from above (m): the
+/// hand's 20 cm box and a little margin. At the API's default angle the fingers travel
+/// along y.
+pub const HAND_HALF_LENGTH: f64 = 0.105;
+
+/// Half the finger hand's width across the fingers' travel, seen from above (m): the wrist
+/// flange's round cover, wider than the hand's box.
+pub const HAND_HALF_WIDTH: f64 = 0.035;
+
 /// Initial and maximum finger travel (each finger) of the finger gripper.
 pub const FINGER_OPEN: f64 = 0.04;
 

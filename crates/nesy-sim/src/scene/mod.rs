@@ -55,6 +55,13 @@ pub struct SceneSpec {
     /// What the episode asks for, one entry per subtask, in label order.
     #[serde(default)]
     pub goals: Vec<SubtaskGoal>,
+    /// Whether the robot's protective stop is on: a motion that presses the arm or what it
+    /// carries more than 5 mm into furniture ends there with a collision error, as a real
+    /// arm's collision detection stops it, and the scripted experts and the free-spot search
+    /// move as a robot that knows its furniture. Off by default (the kinematic arm, which
+    /// passes through furniture), so that every recorded run re-scores unchanged.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub protective_stop: bool,
 }
 
 /// One object of the scene.

@@ -40,8 +40,10 @@ const SIDE_TURNED: [f64; 2] = [0.16, -0.19];
 /// Largest shift (m) of a cabinet from its anchor.
 const CABINET_JITTER: f64 = 0.02;
 /// The band of the table the cubes are laid out in, relative to the offset: clear of both
-/// cabinets and of the drawers' travel in every setting.
-const CUBE_BAND: ([f64; 2], [f64; 2]) = ([-0.07, -0.29], [0.13, -0.13]);
+/// cabinets and of the drawers' travel in every setting, and far enough in front of the
+/// turned cabinet (15 cm from its centre) that the wrist reaching down for a cube keeps
+/// off it.
+const CUBE_BAND: ([f64; 2], [f64; 2]) = ([-0.07, -0.29], [0.13, -0.15]);
 /// Least distance (m) between two cubes' centres on the table.
 const CUBE_SPACING: f64 = 0.065;
 

@@ -259,6 +259,7 @@ impl TaskConfig {
             objects,
             articulations,
             goals,
+            protective_stop: false,
         };
         scene.validate()?;
         Ok(GeneratedTask {

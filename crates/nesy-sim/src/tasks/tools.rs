@@ -17,15 +17,17 @@ use crate::scene::parts::{self, DRAWER_OPEN};
 use crate::scene::{ObjectKind, SubtaskGoal, TABLE_TOP};
 use crate::tasks::SubtaskConfig;
 use crate::tasks::pick_place::COLOURS;
-use crate::world::objects::magnet_centre;
+use crate::world::objects::{hook_bar_side, magnet_centre};
 
 /// The hook's name in the scenes.
 pub(crate) const HOOK: &str = "magnetic_hook";
 /// The screws' name in the scenes.
 pub(crate) const SCREWS: &str = "black_screws";
 /// The hook's outer size (m): 10 cm long, so that it and the screws on its magnet fit in the
-/// bottom drawer (13.4 cm inside).
-pub(crate) const HOOK_SIZE: [f64; 3] = [0.10, 0.025, 0.02];
+/// bottom drawer (13.4 cm inside); its magnet block 4.5 cm tall, so that a hand taking the
+/// hook by its middle from the open drawer (the Panda hand is 20 cm across, wider than the
+/// drawer) keeps its palm above the drawer's side walls.
+pub(crate) const HOOK_SIZE: [f64; 3] = [0.10, 0.025, 0.045];
 /// Where the cabinet stands, relative to the subtask's offset (facing −y).
 const CABINET_AT: [f64; 2] = [0.0, 0.19];
 /// Largest shift (m) of the cabinet and the loose objects' anchors.
@@ -63,8 +65,15 @@ pub(crate) fn layout(config: &SubtaskConfig, [ox, oy]: [f64; 2]) -> SubtaskLayou
     // 5.5 mm above the table with a 4 mm floor, and slides out toward −y).
     let drawer_floor = TABLE_TOP + 0.0055 + 0.004;
     let drawer_centre = [cx, cy - 0.003 - DRAWER_OPEN];
+    // At deployment the hook lies along the drawer's travel: across it, the fingers (closing
+    // across the hook's narrow side) would turn the hand's length toward the cabinet, under
+    // its middle shelf.
     let (hook_at, hook_z, hook_yaw) = if deployed {
-        (drawer_centre, drawer_floor + REST_GAP, 0.0)
+        (
+            drawer_centre,
+            drawer_floor + REST_GAP,
+            std::f64::consts::FRAC_PI_2,
+        )
     } else {
         (
             [ox + HOOK_AT[0] + hook_shift[0], oy + HOOK_AT[1] + hook_shift[1]],
@@ -122,7 +131,12 @@ pub(crate) fn layout(config: &SubtaskConfig, [ox, oy]: [f64; 2]) -> SubtaskLayou
     for (k, name) in cube_names.iter().enumerate() {
         let on_hook = config.obst_level >= 2 && k == 0;
         let (x, y, z) = if on_hook {
-            (hook_at[0], hook_at[1], hook_z + HOOK_SIZE[2] + REST_GAP)
+            // On the bar, beside the taller magnet block.
+            (
+                hook_at[0],
+                hook_at[1],
+                hook_z + hook_bar_side(HOOK_SIZE) + REST_GAP,
+            )
         } else {
             let s = cube_shifts[k];
             (

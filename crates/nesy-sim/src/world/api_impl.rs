@@ -467,6 +467,12 @@ impl Sim {
             yaw,
         );
         self.handle_approach = None;
+        // The hand now rests at the handle, inside its asset's space (the authors' handles
+        // stand closer to the face than a Panda hand fits): without grasping, it may leave
+        // the way it came, as after letting go of a handle.
+        if is_handle && self.protective_stop {
+            self.leaving_asset = Some(asset);
+        }
         moved
     }
 

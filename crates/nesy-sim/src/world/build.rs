@@ -407,7 +407,7 @@ impl Sim {
             contact_stop: None,
             handle_approach: None,
             leaving_asset: None,
-            protective_stop: false,
+            protective_stop: scene.protective_stop,
             blocking: Vec::new(),
         };
         sim.check_interpenetration()?;

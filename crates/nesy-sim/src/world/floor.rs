@@ -1,6 +1,10 @@
 //! `get_empty_floor_xy`: a free table spot for putting an object down (`docs/benchmark.md` §4), with the
 //! authors' variable-shadowing bugs fixed (see the crate README).
 
+use nesy_core::Embodiment;
+
+use crate::robot::model::{HAND_HALF_LENGTH, HAND_HALF_WIDTH, PALM_ABOVE_TOOL};
+use crate::scene::TABLE_TOP;
 use crate::world::geometry::Aabb;
 use crate::world::objects::PartRole;
 use crate::world::{FLOOR_AABB, Sim};
@@ -15,6 +19,10 @@ const REGION_Y: (f64, f64) = (-0.15, 0.16);
 /// Finds a free xy for `part`: on a grid of step 0.6 × its larger footprint side over the
 /// region x ∈ [0.11 + hx, min(0.53, every hinge/drawer body's min x) − hx], y ∈ [−0.15 + hy,
 /// 0.16 − hy]; free means its padded footprint meets no other object's padded footprint.
+/// With the protective stop on, the finger hand setting the object down must fit as well:
+/// a spot is free only if the hand, at the default angle above it with the object held at
+/// mid-height on the table, keeps its length off every piece of furniture standing higher
+/// than its palm (else the stop would end the set-down at an open lid or drawer).
 /// The current spot wins if it is free; otherwise the candidate nearest the object's
 /// current position.
 pub(crate) fn empty_floor_xy(sim: &Sim, part: usize) -> Option<[f64; 2]> {
@@ -40,12 +48,32 @@ pub(crate) fn empty_floor_xy(sim: &Sim, part: usize) -> Option<[f64; 2]> {
         .filter(|&i| i != part && Some(sim.parts()[i].name.as_str()) != held)
         .map(|i| sim.part_aabb(i).padded([-PAD, -PAD, 0.0], [PAD, PAD, 0.0]))
         .collect();
+    let palm_underside = TABLE_TOP + size[2] / 2.0 + PALM_ABOVE_TOOL;
+    let furniture: Vec<Aabb> = if sim.protective_stop && sim.scene.embodiment == Embodiment::Finger {
+        (0..sim.parts().len())
+            .filter(|&i| {
+                matches!(
+                    sim.parts()[i].role,
+                    PartRole::Fixed | PartRole::ArticulatedBody | PartRole::Link
+                )
+            })
+            .map(|i| sim.part_aabb(i))
+            .filter(|b| b.max[2] > palm_underside)
+            .collect()
+    } else {
+        Vec::new()
+    };
     let free = |x: f64, y: f64| {
         let foot = Aabb {
             min: [x - hx - PAD, y - hy - PAD, 0.0],
             max: [x + hx + PAD, y + hy + PAD, 0.0],
         };
+        let hand = Aabb {
+            min: [x - HAND_HALF_WIDTH, y - HAND_HALF_LENGTH, 0.0],
+            max: [x + HAND_HALF_WIDTH, y + HAND_HALF_LENGTH, 0.0],
+        };
         obstacles.iter().all(|o| !foot.overlaps_xy(o, 0.0))
+            && furniture.iter().all(|f| !hand.overlaps_xy(f, 0.0))
     };
     let c = me.centre();
     if (x_lo..=x_hi).contains(&c[0]) && (y_lo..=y_hi).contains(&c[1]) && free(c[0], c[1]) {

@@ -427,9 +427,8 @@ impl Sim {
     /// through furniture (only [`crate::world::FurnitureContactProbe`] says how deep it went)
     /// and moves exactly as it did before the stop existed, so recorded runs replay.
     ///
-    /// It is off by default while the hook and drawers families' experts still meet furniture
-    /// with it on (`nesy scenarios sweep --protective-stop` counts the scenes; the 440
-    /// benchmark scenarios' experts all pass with it).
+    /// A world starts with the setting of its scene ([`SceneSpec::protective_stop`], off
+    /// unless the scene turns it on).
     ///
     /// ```
     /// use nesy_core::Embodiment;

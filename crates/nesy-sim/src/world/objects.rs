@@ -440,7 +440,7 @@ pub const STEEL_DENSITY: f32 = 7800.0;
 fn magnetic_hook(s: [f32; 3], colour: [f32; 3]) -> Vec<ShapeBuild> {
     let magnet_len = s[0] * MAGNET_LENGTH_FRACTION as f32;
     let bar_len = s[0] - magnet_len;
-    let bar_side = s[1].min(s[2]) * 0.7;
+    let bar_side = hook_bar_side(s.map(f64::from)) as f32;
     // The block sits where the magnet's pull is centred.
     let centre = magnet_centre(s.map(f64::from)).map(|v| v as f32);
     let mut magnet = cuboid([magnet_len, s[1], s[2]], centre, [0.12, 0.12, 0.14]);
@@ -453,6 +453,12 @@ fn magnetic_hook(s: [f32; 3], colour: [f32; 3]) -> Vec<ShapeBuild> {
         ),
         magnet,
     ]
+}
+
+/// The side (m) of a magnetic hook's square bar, for outer size `size`: lower and narrower
+/// than the magnet block, so what lies on the hook rests on the bar beside the block.
+pub fn hook_bar_side(size: [f64; 3]) -> f64 {
+    size[1].min(size[2]) * 0.7
 }
 
 /// Share of the hook's length taken by its magnet block.

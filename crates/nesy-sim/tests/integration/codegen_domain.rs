@@ -68,6 +68,7 @@ fn every_schema_compiles_on_both_end_effectors() {
                 &[Operator::new(name.clone(), vec![], vec![])],
                 &objects,
                 embodiment,
+                false,
             )
             .unwrap();
             let wrong = if embodiment == Embodiment::Vacuum {

@@ -52,7 +52,9 @@ fn every_asset_names_its_parts_after_its_body() {
 #[test]
 fn a_drawer_opened_into_another_open_drawer_stops_at_contact() {
     // Clear: the side cabinet's drawers are closed, the front drawer opens fully.
-    let mut sim = Sim::new(&perpendicular_cabinets(0.0)).unwrap();
+    let mut scene = perpendicular_cabinets(0.0);
+    scene.protective_stop = true;
+    let mut sim = Sim::new(&scene).unwrap();
     pull_front_top_drawer(&mut sim).expect("the way is clear");
     let open = sim.articulation_q("front_top_drawer").unwrap();
     assert!(open > DRAWER_OPEN - 0.01, "travel {open:.4} with the way clear");
@@ -353,8 +355,10 @@ fn the_furniture_probe_measures_a_descent_into_a_cabinet_and_names_the_part() {
 
 #[test]
 fn with_the_protective_stop_a_descent_through_a_fixed_part_fails_naming_the_part() {
-    let mut sim = Sim::new(&perpendicular_cabinets(0.0)).unwrap();
-    sim.set_protective_stop(true);
+    // Turned on by the scene.
+    let mut scene = perpendicular_cabinets(0.0);
+    scene.protective_stop = true;
+    let mut sim = Sim::new(&scene).unwrap();
     let [lo, hi] = sim.get_obj_bbox("side_drawer_body").unwrap();
     let (x, y) = ((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0);
     sim.move_to_position([x, y, hi[2] + 0.05], Direction::Down, 0.12, 0.0)
@@ -392,8 +396,20 @@ fn with_the_protective_stop_a_descent_through_a_fixed_part_fails_naming_the_part
 }
 
 #[test]
-fn the_protective_stop_is_off_unless_asked_for() {
-    let mut sim = Sim::new(&perpendicular_cabinets(0.0)).unwrap();
+fn the_protective_stop_is_off_unless_the_scene_turns_it_on() {
+    let mut scene = perpendicular_cabinets(0.0);
+    assert!(!scene.protective_stop, "off unless the scene says otherwise");
+    assert!(
+        !scene.to_json_pretty().contains("protective_stop"),
+        "written out only when on"
+    );
+    scene.protective_stop = true;
+    let text = scene.to_json_pretty();
+    assert!(text.contains("\"protective_stop\": true"), "{text}");
+    let on = SceneSpec::from_json_str(&text, "stop on").unwrap();
+    assert!(Sim::new(&on).unwrap().scene().protective_stop);
+    scene.protective_stop = false;
+    let mut sim = Sim::new(&scene).unwrap();
     let [lo, hi] = sim.get_obj_bbox("side_drawer_body").unwrap();
     let (x, y) = ((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0);
     sim.move_to_position([x, y, hi[2] + 0.05], Direction::Down, 0.12, 0.0)
@@ -407,7 +423,6 @@ fn with_the_protective_stop_a_drawer_is_still_pulled_by_its_handle() {
     // The authors' handles stand 2.5 cm off the face, closer than a Panda hand fits: the hand
     // overlaps its own cabinet while it reaches for, holds and leaves the handle.
     let mut sim = Sim::new(&perpendicular_cabinets(0.0)).unwrap();
-    sim.set_protective_stop(true);
     pull_front_top_drawer(&mut sim).expect("the pull is not stopped by its own cabinet");
     let open = sim.articulation_q("front_top_drawer").unwrap();
     assert!(open > DRAWER_OPEN - 0.01, "travel {open:.4}");

@@ -168,7 +168,7 @@ fn the_planner_shuts_the_drawer_in_the_way_before_opening_the_other() {
     let objects: Vec<String> = names.clone();
     let resolved = resolve_action("CloseSideTopDrawer", &objects).expect("resolves");
     assert_eq!(resolved.schema, "close-side-top-drawer");
-    let policy = compile_policy(&plan, &objects, Embodiment::Finger).expect("compiles");
+    let policy = compile_policy(&plan, &objects, Embodiment::Finger, false).expect("compiles");
     assert!(
         policy.code.contains("grasp_handle(\"side_top_drawer_handle\")"),
         "{}",

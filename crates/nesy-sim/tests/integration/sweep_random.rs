@@ -56,6 +56,7 @@ fn episode(embodiment: Embodiment, seed: u64) -> Result<(), String> {
         ],
         articulations: Default::default(),
         goals: vec![],
+        protective_stop: false,
     };
     let mut sim = Sim::new(&spec).map_err(|e| e.to_string())?;
     for (k, obj) in ["red_cube", "blue_cylinder"].into_iter().enumerate() {

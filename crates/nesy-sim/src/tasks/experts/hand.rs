@@ -5,14 +5,10 @@
 use super::ExpertError;
 use crate::api::{ApiError, DEFAULT_LIFT_CLEARANCE, Direction, Embodiment, RobotApi};
 use crate::perception::observer::CLING_REACH;
-use crate::robot::model::PALM_ABOVE_TOOL;
+use crate::robot::model::{HAND_HALF_LENGTH, HAND_HALF_WIDTH, PALM_ABOVE_TOOL};
 use crate::scene::{SubtaskKind, TABLE_TOP, parts};
 use crate::tasks::layout::{DROP_CLEARANCE, LID_SWING_MAX_X};
 
-/// Half the finger hand's length along the fingers' travel, seen from above (m).
-const HAND_HALF_LENGTH: f64 = 0.105;
-/// Half the finger hand's width across the fingers' travel, seen from above (m).
-const HAND_HALF_WIDTH: f64 = 0.035;
 /// Grasps tried on one object before the expert carries on regardless.
 const PICK_ATTEMPTS: usize = 3;
 /// Nearest x (m) to the robot's base at which the experts set objects down out of the way.
@@ -53,6 +49,16 @@ pub(super) fn size(b: &Bbox) -> [f64; 3] {
 
 pub(super) fn overlaps_xy(a: &Bbox, b: &Bbox, margin: f64) -> bool {
     (0..2).all(|i| a[0][i] < b[1][i] + margin && b[0][i] < a[1][i] + margin)
+}
+
+/// Whether the finger hand, its tool point above `spot` at the API's default angle (the
+/// fingers' travel along y), overlaps any of `boxes` seen from above.
+fn hand_meets(boxes: &[Bbox], [x, y]: [f64; 2]) -> bool {
+    let hand: Bbox = [
+        [x - HAND_HALF_WIDTH, y - HAND_HALF_LENGTH, 0.0],
+        [x + HAND_HALF_WIDTH, y + HAND_HALF_LENGTH, 0.0],
+    ];
+    boxes.iter().any(|b| overlaps_xy(b, &hand, 0.0))
 }
 
 /// Whether two boxes overlap in all three axes.
@@ -354,12 +360,37 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
             .robot
             .get_empty_floor_xy(name)
             .map_err(|e| self.fail(format!("get_empty_floor_xy({name})"), e))?;
-        let [x, y] = if x >= COMFORTABLE_MIN_X {
+        let palm_underside = TABLE_TOP + self.hang(h) + DROP_CLEARANCE + PALM_ABOVE_TOOL;
+        let onto_furniture = self.furniture_aware
+            && !self.vacuum
+            && hand_meets(&self.furniture_above(name, palm_underside)?, [x, y]);
+        let [x, y] = if x >= COMFORTABLE_MIN_X && !onto_furniture {
             [x, y]
         } else {
             self.free_spot(name)?.unwrap_or([x, y])
         };
         self.put(x, y, TABLE_TOP, h, DROP_CLEARANCE)
+    }
+
+    /// The boxes of the furniture (everything but loose objects, handles, the floor and the
+    /// gripper) whose top stands higher than `z`, leaving out `name`.
+    fn furniture_above(&mut self, name: &str, z: f64) -> Result<Vec<Bbox>, ExpertError> {
+        let mut furniture = Vec::new();
+        for other in self.robot.get_obj_names() {
+            let skipped = other == name
+                || self.is_loose(&other)
+                || self.is_fine_grained(&other)
+                || other.ends_with("_handle")
+                || [parts::FLOOR, parts::GRIPPER, parts::VACUUM_GRIPPER].contains(&other.as_str());
+            if skipped {
+                continue;
+            }
+            let b = self.bbox(&other)?;
+            if b[1][2] > z {
+                furniture.push(b);
+            }
+        }
+        Ok(furniture)
     }
 
     /// A table spot at x ≥ [`COMFORTABLE_MIN_X`] in the middle strip of the table whose
@@ -377,6 +408,14 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
             }
             others.push(self.bbox(&other)?);
         }
+        // A hand that knows its furniture also keeps its own length (the fingers' travel
+        // along y) off what stands higher than its palm when it lets go.
+        let furniture = if self.furniture_aware && !self.vacuum {
+            let palm_underside = TABLE_TOP + self.hang(own[2]) + DROP_CLEARANCE + PALM_ABOVE_TOOL;
+            self.furniture_above(name, palm_underside)?
+        } else {
+            Vec::new()
+        };
         let mut best: Option<([f64; 2], f64)> = None;
         for i in 0..=10 {
             for j in 0..=15 {
@@ -385,7 +424,7 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
                     [spot[0] - half[0], spot[1] - half[1], TABLE_TOP],
                     [spot[0] + half[0], spot[1] + half[1], TABLE_TOP + 0.3],
                 ];
-                if others.iter().any(|b| overlaps_xy(b, &footprint, 0.0)) {
+                if others.iter().any(|b| overlaps_xy(b, &footprint, 0.0)) || hand_meets(&furniture, spot) {
                     continue;
                 }
                 let cost = (spot[0] - 0.4).abs() + spot[1].abs();

@@ -97,13 +97,16 @@ pub fn run_scene(scene: &SceneSpec) -> Result<ExpertEpisode, EpisodeError> {
 
 /// Runs the expert of every goal of `scene`, in order, on `robot` (a world built from that
 /// scene).
+///
+/// When the scene's protective stop is on ([`SceneSpec::protective_stop`]) the expert moves
+/// as a robot that knows its furniture (see [`run_with`]).
 pub fn run<R: RobotApi + ?Sized>(robot: &mut R, scene: &SceneSpec) -> Result<(), ExpertError> {
-    run_with(robot, scene, false)
+    run_with(robot, scene, scene.protective_stop)
 }
 
-/// [`run`] for a robot whose protective stop is on (`furniture_aware`): the expert also keeps
-/// its turned fruit grasps and sideways handle approaches off furniture, and takes a handle
-/// from above when a sideways approach is stopped.
+/// [`run`], saying whether the robot's protective stop is on (`furniture_aware`): the expert
+/// then also keeps its turned fruit grasps, sideways handle approaches and set-down spots
+/// off furniture, and takes a handle from above when a sideways approach is stopped.
 pub fn run_with<R: RobotApi + ?Sized>(
     robot: &mut R,
     scene: &SceneSpec,

@@ -348,6 +348,10 @@ fn fill<R: RobotApi + ?Sized>(
     Ok(())
 }
 
+/// The least height (m) above a hook's underside at which something overlapping it rests on
+/// its bar rather than beside it.
+const HOOK_BAR_MIN: f64 = 0.005;
+
 /// Moves aside, topmost first, every loose object that rests on `object`.
 fn uncover<R: RobotApi + ?Sized>(hand: &mut Hand<'_, R>, object: &str) -> Result<(), ExpertError> {
     loop {
@@ -358,7 +362,11 @@ fn uncover<R: RobotApi + ?Sized>(hand: &mut Hand<'_, R>, object: &str) -> Result
                 continue;
             }
             let b = hand.bbox(&other)?;
-            let resting = (b[0][2] - me[1][2]).abs() < 0.01 && overlaps_xy(&b, &me, 0.0);
+            // On the object's top, or (a hook, whose bar is lower than its magnet block)
+            // lower down on it, but not beside it on what it stands on.
+            let on_top = (b[0][2] - me[1][2]).abs() < 0.01;
+            let on_bar = hand.is_hook(object) && b[0][2] > me[0][2] + HOOK_BAR_MIN && b[0][2] < me[1][2];
+            let resting = (on_top || on_bar) && overlaps_xy(&b, &me, 0.0);
             if resting {
                 above = Some(other);
                 break;
