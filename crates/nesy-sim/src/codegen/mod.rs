@@ -320,6 +320,8 @@ struct Emitter<'a> {
     actions: &'a [ResolvedAction],
     /// The objects carried over the hinge body (round fruit).
     fruits: Vec<&'a str>,
+    /// The robot's protective stop is on: motions keep the hand off furniture.
+    protective_stop: bool,
 }
 
 impl Emitter<'_> {
@@ -475,6 +477,7 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment, protective_stop: boo
         pointing: false,
         actions,
         fruits,
+        protective_stop,
     };
     let _ = writeln!(
         e.out,
@@ -666,11 +669,19 @@ impl Emitter<'_> {
         };
         self.drawer_axis(asset);
         self.line(&format!("drawer = get_obj_pos({drawer:?})"));
+        // With the protective stop on, a hook (held across its bar) goes in along the
+        // drawer's travel: dropped across it, taking it again would lay the 20 cm hand
+        // under the cabinet's middle shelf.
+        let along_travel = self.protective_stop && !self.vacuum && kind_of(x) == Some(Kind::Tool);
         self.line(&reachable_move(
             &format!(
                 "[drawer[0] + ({across} if along_y else {along} * outward), drawer[1] + ({along} * outward if along_y else {across}), drawer[2] + get_obj_size({drawer:?})[2] + get_obj_size({x:?})[2] + {DRAWER_DROP_CLEARANCE}]"
             ),
-            "",
+            if along_travel {
+                ", angle=math.pi / 2 if along_y else 0.0"
+            } else {
+                ""
+            },
         ));
     }
 
@@ -852,6 +863,31 @@ mod tests {
             .unwrap()
             .code;
         assert!(!vacuum.contains("clear_angle"), "{vacuum}");
+    }
+
+    #[test]
+    fn with_the_protective_stop_a_hook_goes_into_the_drawer_along_its_travel() {
+        let o = names(&[
+            "floor",
+            "magnetic_hook",
+            "drawer_body",
+            "bottom_drawer",
+            "bottom_drawer_handle",
+        ]);
+        let procedure = ops(&[
+            "MoveToSurroundMagneticHook",
+            "GraspMagneticHook",
+            "CarryHookOverBottomDrawerMagneticHook",
+            "DropHookIntoBottomDrawerMagneticHook",
+        ]);
+        let compiled = |stop| {
+            compile_policy(&procedure, &o, Embodiment::Finger, stop)
+                .unwrap()
+                .code
+        };
+        let turn = "angle=math.pi / 2 if along_y else 0.0";
+        assert!(compiled(true).contains(turn), "{}", compiled(true));
+        assert!(!compiled(false).contains(turn), "{}", compiled(false));
     }
 
     #[test]

@@ -119,8 +119,8 @@ impl WorldDomain {
     /// The schemas of one end effector for a scene: those whose constants are all objects
     /// of the scene, then, for each asset named with a prefix (`front_drawer_body`), the
     /// asset's schemas with its parts renamed ([`SchemaInstance`]). With two or more assets,
-    /// opening a lid or drawer also needs every other asset's moving link that would stand
-    /// in its way to be shut: `(not (and (Blocks o x) (Open o)))` for each other link `o`
+    /// opening a lid or drawer, and reaching for or taking its handle, also needs every
+    /// other asset's moving link that would stand in its way to be shut: `(not (and (Blocks o x) (Open o)))` for each other link `o`
     /// (the observer states `Blocks` where the scene's geometry has it). A scene with one
     /// asset under the bare names gets the domain file's schemas unchanged.
     pub fn schemas_for(&self, embodiment: Embodiment, universe: &Universe) -> Vec<Operator> {
@@ -258,9 +258,10 @@ impl WorldDomain {
 /// The moving links of the articulated assets (bare names).
 const MOVING_LINKS: [&str; 3] = [parts::HINGE_LID, parts::TOP_DRAWER, parts::BOTTOM_DRAWER];
 
-/// Adds to a schema that opens a lid or drawer `x` the precondition that no other asset's
-/// moving link `o` among `links` that stands in its way is open:
-/// `(not (and (Blocks o x) (Open o)))`.
+/// Adds to a schema that opens a lid or drawer `x`, or reaches for or takes `x`'s handle,
+/// the precondition that no other asset's moving link `o` among `links` that stands in its
+/// way is open: `(not (and (Blocks o x) (Open o)))`. A handle sits on the face that moves
+/// along `x`'s travel, so the hand reaching it goes where the open `o` stands.
 fn add_blocking_preconditions(op: &mut Operator, links: &[&str]) {
     let Some(instance) = schema_instance(&op.name) else {
         return;
@@ -268,6 +269,11 @@ fn add_blocking_preconditions(op: &mut Operator, links: &[&str]) {
     let opened = match instance.schema.motion {
         Motion::OpenDrawer => instance.part(),
         Motion::OpenLid => Some(instance.asset_part(parts::HINGE_LID)),
+        Motion::MoveToHandle | Motion::GraspHandle => instance
+            .schema
+            .part
+            .and_then(handle_link)
+            .map(|link| instance.asset_part(link)),
         _ => None,
     };
     let Some(opened) = opened else {
@@ -285,6 +291,16 @@ fn add_blocking_preconditions(op: &mut Operator, links: &[&str]) {
         ]))));
     }
     op.pre = pre.into();
+}
+
+/// The moving link (bare name) a handle (bare name) is mounted on.
+fn handle_link(handle: &str) -> Option<&'static str> {
+    match handle {
+        parts::HINGE_HANDLE => Some(parts::HINGE_LID),
+        parts::TOP_DRAWER_HANDLE => Some(parts::TOP_DRAWER),
+        parts::BOTTOM_DRAWER_HANDLE => Some(parts::BOTTOM_DRAWER),
+        _ => None,
+    }
 }
 
 /// The robot's own entry in a scene's object list (`gripper` or `vacuum_gripper`), which is

@@ -102,6 +102,20 @@ fn each_cabinet_has_its_own_schemas_and_opening_one_needs_the_other_shut() {
             .any(|p| p.to_string() == "(not (OnTopOf side_top_drawer side_bottom_drawer_handle))"),
         "the covered-handle rule renamed for the side cabinet"
     );
+    // Reaching for a handle goes where the other cabinet's open drawer would stand.
+    for reach in [
+        "move-to-side-bottom-drawer-handle",
+        "grasp-side-bottom-drawer-handle",
+    ] {
+        let pre: Vec<String> = find(reach).pre.iter().map(ToString::to_string).collect();
+        let kept_shut =
+            "(not (and (Blocks front_bottom_drawer side_bottom_drawer) (Open front_bottom_drawer)))"
+                .to_owned();
+        assert!(
+            pre.contains(&kept_shut),
+            "{reach}: {kept_shut} missing from {pre:?}"
+        );
+    }
     // No bare-named schema survives for parts the scene does not have.
     assert!(schemas.iter().all(|s| s.name != "open-top-drawer"));
     let instance = schema_instance("open-front-top-drawer").unwrap();
