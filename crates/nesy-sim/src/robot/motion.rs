@@ -501,10 +501,8 @@ impl Sim {
     /// transit must not touch.
     fn transit_obstacles(&self) -> Vec<Obstacle<'_>> {
         let furniture = self.protective_stop;
-        let mut obstacles = self.unheld_obstacles(|role| {
-            role == PartRole::Loose
-                || (furniture && matches!(role, PartRole::Fixed | PartRole::ArticulatedBody | PartRole::Link))
-        });
+        let mut obstacles =
+            self.unheld_obstacles(|role| role == PartRole::Loose || (furniture && role.is_furniture()));
         // Furniture by its solid colliders only (a handle's sensor is not in the way).
         for o in &mut obstacles {
             if self.parts[o.part].role != PartRole::Loose {

@@ -27,7 +27,7 @@ use serde::Serialize;
 
 use crate::api::ApiError;
 use crate::api::TraceEntry;
-use crate::world::objects::{self, PartRole};
+use crate::world::objects;
 use crate::world::{Part, Sim, SimHook};
 
 /// Positions along a joint's travel at which [`Sim::articulation_blocking`] checks it
@@ -152,13 +152,7 @@ impl Sim {
         self.parts
             .iter()
             .enumerate()
-            .filter(|(_, p)| {
-                keep(p)
-                    && matches!(
-                        p.role,
-                        PartRole::Fixed | PartRole::ArticulatedBody | PartRole::Link
-                    )
-            })
+            .filter(|(_, p)| keep(p) && p.role.is_furniture())
             .flat_map(|(i, p)| {
                 p.colliders.iter().filter_map(move |&c| {
                     let collider = &self.world.colliders[c];

@@ -51,12 +51,7 @@ pub(crate) fn empty_floor_xy(sim: &Sim, part: usize) -> Option<[f64; 2]> {
     let palm_underside = TABLE_TOP + size[2] / 2.0 + PALM_ABOVE_TOOL;
     let furniture: Vec<Aabb> = if sim.protective_stop && sim.scene.embodiment == Embodiment::Finger {
         (0..sim.parts().len())
-            .filter(|&i| {
-                matches!(
-                    sim.parts()[i].role,
-                    PartRole::Fixed | PartRole::ArticulatedBody | PartRole::Link
-                )
-            })
+            .filter(|&i| sim.parts()[i].role.is_furniture())
             .map(|i| sim.part_aabb(i))
             .filter(|b| b.max[2] > palm_underside)
             .collect()

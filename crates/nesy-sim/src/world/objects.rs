@@ -80,6 +80,14 @@ pub enum PartRole {
     Handle,
 }
 
+impl PartRole {
+    /// True for the furniture the arm must not press into: fixed objects, articulated
+    /// bodies and their moving links (not loose objects, and not the visual-only handles).
+    pub fn is_furniture(self) -> bool {
+        matches!(self, PartRole::Fixed | PartRole::ArticulatedBody | PartRole::Link)
+    }
+}
+
 /// Surface pattern for the renderer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Pattern {

@@ -360,11 +360,8 @@ impl<'a, R: RobotApi + ?Sized> Hand<'a, R> {
             .robot
             .get_empty_floor_xy(name)
             .map_err(|e| self.fail(format!("get_empty_floor_xy({name})"), e))?;
-        let palm_underside = TABLE_TOP + self.hang(h) + DROP_CLEARANCE + PALM_ABOVE_TOOL;
-        let onto_furniture = self.furniture_aware
-            && !self.vacuum
-            && hand_meets(&self.furniture_above(name, palm_underside)?, [x, y]);
-        let [x, y] = if x >= COMFORTABLE_MIN_X && !onto_furniture {
+        // With the protective stop on, the API's spot already keeps the hand off furniture.
+        let [x, y] = if x >= COMFORTABLE_MIN_X {
             [x, y]
         } else {
             self.free_spot(name)?.unwrap_or([x, y])

@@ -99,19 +99,11 @@ pub fn run_scene(scene: &SceneSpec) -> Result<ExpertEpisode, EpisodeError> {
 /// scene).
 ///
 /// When the scene's protective stop is on ([`SceneSpec::protective_stop`]) the expert moves
-/// as a robot that knows its furniture (see [`run_with`]).
+/// as a robot that knows its furniture: it also keeps its turned fruit grasps, sideways
+/// handle approaches and set-down spots off furniture, and takes a handle from above when a
+/// sideways approach is stopped.
 pub fn run<R: RobotApi + ?Sized>(robot: &mut R, scene: &SceneSpec) -> Result<(), ExpertError> {
-    run_with(robot, scene, scene.protective_stop)
-}
-
-/// [`run`], saying whether the robot's protective stop is on (`furniture_aware`): the expert
-/// then also keeps its turned fruit grasps, sideways handle approaches and set-down spots
-/// off furniture, and takes a handle from above when a sideways approach is stopped.
-pub fn run_with<R: RobotApi + ?Sized>(
-    robot: &mut R,
-    scene: &SceneSpec,
-    furniture_aware: bool,
-) -> Result<(), ExpertError> {
+    let furniture_aware = scene.protective_stop;
     let loose: Vec<String> = scene
         .objects
         .iter()
