@@ -400,10 +400,11 @@ fn insert_for_goal(
     }
     let mut state = req.initial_state.clone();
     for (j, step) in procedure.iter().enumerate() {
-        if let Ok((plan, _)) = planning.plan(&state, goal)
+        if let Ok((plan, after)) = planning.plan(&state, goal)
             && !plan.is_empty()
             && appended.is_none_or(|steps| plan.len() < steps)
         {
+            absorb_redundant_window(procedure, j, &plan, &after, found);
             let mut replace = plan;
             replace.push(step.clone());
             found.patches.push(ProposedPatch {
@@ -420,6 +421,45 @@ fn insert_for_goal(
         match apply(&state, step) {
             Ok(next) => state = next,
             Err(_) => break,
+        }
+    }
+}
+
+/// Longest run of actions after an inserted plan that [`absorb_redundant_window`] checks.
+const REDUNDANT_WINDOW: usize = 6;
+
+/// A plan inserted before step `j` that leaves the actions from `j` on with nothing
+/// physical to do: for every window `j..=k` that applies after the plan and ends in the
+/// physical state the plan reached, the plan replaces the window. The paper's hook, taken
+/// out of the drawer to gather the screws and put back with them, makes the
+/// demonstration's own placing of the hook redundant; the verifier (in [`score`]) keeps only
+/// windows whose removal leaves the rest of the procedure applicable, and prefers the
+/// shorter procedure.
+fn absorb_redundant_window(
+    procedure: &[Operator],
+    j: usize,
+    plan: &[Operator],
+    after: &State,
+    found: &mut Candidates,
+) {
+    let settled = physics_atoms(after);
+    let mut state = after.clone();
+    for k in j..procedure.len().min(j + REDUNDANT_WINDOW) {
+        match apply(&state, &procedure[k]) {
+            Ok(next) => state = next,
+            Err(_) => return,
+        }
+        if physics_atoms(&state) == settled {
+            found.patches.push(ProposedPatch {
+                strategy: Strategy::Insert,
+                search: procedure[j..=k].to_vec(),
+                replace: plan.to_vec(),
+                at: j,
+                rationale: format!(
+                    "every action applies but the goal does not hold yet; a plan put before {} reaches the unmet goal literals, after which {} to {} would change nothing physical, so the plan replaces them.",
+                    procedure[j].name, procedure[j].name, procedure[k].name
+                ),
+            });
         }
     }
 }
@@ -692,6 +732,38 @@ mod tests {
         let report = appended(&ctx, &procedure, &init, &goal);
         assert!(report.first_failure.is_none());
         assert!(report.goal.is_some_and(|g| g.satisfied), "{procedure:?}");
+    }
+
+    /// A plan that already put the apple in the box makes a following placing of the apple
+    /// redundant: the placing's window, applied after the plan, ends where the plan did, so
+    /// the plan is offered in its place. Where the window still moves the apple, it is not.
+    #[test]
+    fn a_placing_that_an_inserted_plan_already_did_is_absorbed_by_it() {
+        let init = parse_state_list(
+            "- (Open hinge_lid)\n- (GripperOpen)\n- (OnTopOf hinge_body floor)\n- (OnTopOf apple floor)",
+        )
+        .unwrap();
+        let config = PlannerConfig::default();
+        let (placing, placed) = hinge_planning(&config)
+            .plan(&init, &parse_formula("(InsideOf apple hinge_body)").unwrap())
+            .unwrap();
+        assert!(placing.len() > 1, "{placing:?}");
+        let mut found = Candidates::default();
+        absorb_redundant_window(&placing, 0, &placing, &placed, &mut found);
+        let whole = found
+            .patches
+            .iter()
+            .find(|p| p.search.len() == placing.len())
+            .expect("the whole placing is absorbed");
+        assert_eq!((whole.at, &whole.replace), (0, &placing));
+        // From the initial state the same actions move the apple: nothing to absorb.
+        let mut moving = Candidates::default();
+        absorb_redundant_window(&placing, 0, &placing, &init, &mut moving);
+        assert!(
+            moving.patches.iter().all(|p| p.search.len() < placing.len()),
+            "{:?}",
+            moving.patches
+        );
     }
 
     /// A goal patch plans to the unmet literals; one that held when asked (the lid closed)

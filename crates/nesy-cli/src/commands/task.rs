@@ -17,6 +17,7 @@ use nesy_sim::domain::{WorldDomain, control_planner_config, plan_to_goal};
 use nesy_sim::perception::observer::observe;
 use nesy_sim::perception::render::{MAX_RENDER_THREADS, VIEW_SIZE, default_threads};
 use nesy_sim::scene::{SceneSpec, parts};
+use nesy_sim::tasks::goal::EpisodeOutcome;
 use nesy_sim::world::Sim;
 use serde_json::json;
 
@@ -170,22 +171,7 @@ fn new(args: NewArgs) -> anyhow::Result<ExitCode> {
         .outcome
         .as_ref()
         .context("the source scene's goals were not checked")?;
-    // Met means every subtask full or partial (`docs/benchmark.md` §7: partial when the
-    // objects went in another order than the goal lists, as a stack can force).
-    if !outcome.success() {
-        anyhow::bail!(
-            "{}: the planned demonstration did not meet every goal ({}); a demonstration must show its goal",
-            args.source.display(),
-            outcome.summary()
-        );
-    }
-    if !outcome.displaced.is_empty() {
-        anyhow::bail!(
-            "{}: the planned demonstration displaced {} after placing it; a demonstration must end showing its goal",
-            args.source.display(),
-            outcome.displaced.join(", ")
-        );
-    }
+    check_demonstration(&args.source, outcome)?;
 
     // 4. Write the task.
     let out = &args.out;
@@ -235,4 +221,79 @@ fn new(args: NewArgs) -> anyhow::Result<ExitCode> {
         target_path.display()
     )?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// Keeps a recorded demonstration only if it shows its goal: every subtask met (full or
+/// partial; `docs/benchmark.md` §7: partial when the objects went in another order than the
+/// goal lists, as a stack can force) and nothing that was counted as placed knocked out of
+/// place afterwards, since the demonstration's final state becomes the goal of adaptation.
+fn check_demonstration(source: &Path, outcome: &EpisodeOutcome) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        outcome.success(),
+        "{}: the planned demonstration did not meet every goal ({}); a demonstration must show its goal",
+        source.display(),
+        outcome.summary()
+    );
+    anyhow::ensure!(
+        outcome.displaced.is_empty(),
+        "{}: the planned demonstration displaced {} after placing it; a demonstration must end showing its goal",
+        source.display(),
+        outcome.displaced.join(", ")
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An outcome as the goal monitor reports it: one `pick_place` subtask met by
+    /// `red_cube`, with `displaced` the objects knocked out of place after being counted.
+    fn outcome(displaced: &[&str]) -> EpisodeOutcome {
+        serde_json::from_value(json!({
+            "subtasks": [{
+                "subtask": "pick_place",
+                "result": "full_success",
+                "decided_at_step": 1200,
+                "label": ["red_cube"],
+                "achieved": [{"name": "red_cube", "step": 1200}],
+                "displaced": displaced,
+            }],
+            "decision_order": [0],
+            "goal_label": ["red_cube"],
+            "achieved_sequence": ["red_cube"],
+            "final_call": false,
+            "end_step": 2400,
+            "displaced": displaced,
+        }))
+        .expect("a well-formed outcome")
+    }
+
+    #[test]
+    fn a_demonstration_that_shows_its_goal_is_kept() {
+        check_demonstration(Path::new("source.json"), &outcome(&[])).expect("kept");
+    }
+
+    #[test]
+    fn a_demonstration_that_knocked_a_placed_object_out_is_refused_naming_it() {
+        let error = check_demonstration(Path::new("scenes/source.json"), &outcome(&["red_cube"]))
+            .expect_err("refused");
+        assert_eq!(
+            error.to_string(),
+            "scenes/source.json: the planned demonstration displaced red_cube after placing it; \
+             a demonstration must end showing its goal"
+        );
+    }
+
+    #[test]
+    fn a_demonstration_that_missed_a_goal_is_refused_with_the_verdicts() {
+        let mut missed = outcome(&[]);
+        missed.subtasks[0].result = nesy_core::metrics::SubtaskResult::Fail;
+        let error = check_demonstration(Path::new("source.json"), &missed).expect_err("refused");
+        assert_eq!(
+            error.to_string(),
+            "source.json: the planned demonstration did not meet every goal (pick_place: fail); \
+             a demonstration must show its goal"
+        );
+    }
 }

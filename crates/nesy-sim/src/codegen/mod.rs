@@ -27,7 +27,7 @@ use crate::api::Embodiment;
 use crate::api::MAX_FINGER_DEPTH;
 use crate::domain::{
     Motion, Schema, SchemaInstance, SchemaKind as Kind, asset_of, asset_prefixes, instance_name, kind_of,
-    schema_instance, schemas,
+    schema_instance, schemas, split_asset_part,
 };
 use crate::robot::model::{HAND_HALF_LENGTH, HAND_HALF_WIDTH, PALM_ABOVE_TOOL};
 use crate::scene::{TABLE_TOP, parts};
@@ -41,6 +41,16 @@ use crate::tasks::layout::{
     HINGE_DROP_CLEARANCE, HINGE_SPOTS, LID_CLOSING_ARC, LID_OPENING_ARC, LID_SWING_MAX_X, PUSH_DEPTH_DIVISOR,
     PUSH_OVERSHOOT, TOY_BOX_CELLS,
 };
+use crate::tasks::layout::{FOREARM_ABOVE, FOREARM_BELOW, FOREARM_REACH, FOREARM_SWING, WRIST_CLEARANCE};
+
+/// The boxes that may stand in the lane of an arm reaching a drawer handle sideways: the
+/// containers other than the drawers themselves (bare part names).
+const BOXES_BESIDE_CABINETS: [&str; 4] = [
+    parts::HINGE_BODY,
+    parts::TOY_BOX,
+    parts::LEFT_CHESS_BOX,
+    parts::RIGHT_CHESS_BOX,
+];
 
 /// How far inside the reachable table area ([`FLOOR_AABB`]) compiled targets are kept (m).
 const REACH_MARGIN: f64 = 0.005;
@@ -301,7 +311,7 @@ pub fn compile_policy(
         .into_iter()
         .flatten()
         .collect();
-    let code = emit(&actions, embodiment, protective_stop);
+    let code = emit(&actions, objects, embodiment, protective_stop);
     Ok(CompiledPolicy {
         code,
         actions,
@@ -322,6 +332,8 @@ struct Emitter<'a> {
     fruits: Vec<&'a str>,
     /// The robot's protective stop is on: motions keep the hand off furniture.
     protective_stop: bool,
+    /// The scene's boxes that may stand beside a cabinet (see [`BOXES_BESIDE_CABINETS`]).
+    boxes: Vec<String>,
 }
 
 impl Emitter<'_> {
@@ -371,7 +383,34 @@ impl Emitter<'_> {
                 asset.asset_part(parts::BOTTOM_DRAWER_HANDLE),
                 asset.asset_part(parts::DRAWER_BODY)
             ));
-            self.line(&format!("move_gripper_to({handle:?}, pointing_to=pointing)"));
+            if self.protective_stop {
+                // Pointing sideways, the wrist and forearm trail behind the tool and the elbow
+                // swings the forearm out to either side: with a box standing in that lane the
+                // tool comes from above (as the expert does), and when the stop still ends the
+                // sideways approach, it comes from above then.
+                if !self.boxes.is_empty() {
+                    self.line(&format!("h = get_obj_bbox({handle:?})"));
+                    self.line("c = [(h[0][i] + h[1][i]) / 2 for i in range(3)]");
+                    self.line(&format!(
+                        "back = -{FOREARM_REACH} if pointing == \"right\" else {FOREARM_REACH}"
+                    ));
+                    self.line(&format!(
+                        "lane = [[c[0] - {lane}, min(c[1], c[1] + back), c[2] - {FOREARM_BELOW}], [c[0] + {lane}, max(c[1], c[1] + back), c[2] + {FOREARM_ABOVE}]]",
+                        lane = WRIST_CLEARANCE + FOREARM_SWING
+                    ));
+                    self.line(&format!("for box in {:?}:", self.boxes));
+                    self.line("    b = get_obj_bbox(box)");
+                    self.line("    if all(b[0][i] < lane[1][i] and lane[0][i] < b[1][i] for i in range(3)):");
+                    self.line("        pointing = \"down\"");
+                }
+                self.line("try:");
+                self.line(&format!("    move_gripper_to({handle:?}, pointing_to=pointing)"));
+                self.line("except robot.CollisionError:");
+                self.line("    pointing = \"down\"");
+                self.line(&format!("    move_gripper_to({handle:?}, pointing_to=pointing)"));
+            } else {
+                self.line(&format!("move_gripper_to({handle:?}, pointing_to=pointing)"));
+            }
             self.pointing = true;
         } else if self.vacuum {
             self.pointing = false;
@@ -461,7 +500,12 @@ fn instance(action: &ResolvedAction) -> SchemaInstance {
     schema_instance(&action.schema).expect("resolved actions name schema instances")
 }
 
-fn emit(actions: &[ResolvedAction], embodiment: Embodiment, protective_stop: bool) -> String {
+fn emit(
+    actions: &[ResolvedAction],
+    objects: &[String],
+    embodiment: Embodiment,
+    protective_stop: bool,
+) -> String {
     let vacuum = embodiment == Embodiment::Vacuum;
     // The hinge task's fruits (what is carried over the hinge body) are round: the fingers
     // take them at the turn that keeps clear of their neighbours.
@@ -478,6 +522,14 @@ fn emit(actions: &[ResolvedAction], embodiment: Embodiment, protective_stop: boo
         actions,
         fruits,
         protective_stop,
+        boxes: objects
+            .iter()
+            .filter(|o| {
+                let bare = split_asset_part(o).map_or(o.as_str(), |(_, bare)| bare);
+                BOXES_BESIDE_CABINETS.contains(&bare)
+            })
+            .cloned()
+            .collect(),
     };
     let _ = writeln!(
         e.out,
@@ -669,19 +721,11 @@ impl Emitter<'_> {
         };
         self.drawer_axis(asset);
         self.line(&format!("drawer = get_obj_pos({drawer:?})"));
-        // With the protective stop on, a hook (held across its bar) goes in along the
-        // drawer's travel: dropped across it, taking it again would lay the 20 cm hand
-        // under the cabinet's middle shelf.
-        let along_travel = self.protective_stop && !self.vacuum && kind_of(x) == Some(Kind::Tool);
         self.line(&reachable_move(
             &format!(
                 "[drawer[0] + ({across} if along_y else {along} * outward), drawer[1] + ({along} * outward if along_y else {across}), drawer[2] + get_obj_size({drawer:?})[2] + get_obj_size({x:?})[2] + {DRAWER_DROP_CLEARANCE}]"
             ),
-            if along_travel {
-                ", angle=math.pi / 2 if along_y else 0.0"
-            } else {
-                ""
-            },
+            "",
         ));
     }
 
@@ -866,28 +910,36 @@ mod tests {
     }
 
     #[test]
-    fn with_the_protective_stop_a_hook_goes_into_the_drawer_along_its_travel() {
+    fn with_the_protective_stop_a_sideways_suction_approach_checks_its_lane_and_comes_from_above() {
         let o = names(&[
             "floor",
-            "magnetic_hook",
+            "hinge_body",
             "drawer_body",
             "bottom_drawer",
             "bottom_drawer_handle",
         ]);
         let procedure = ops(&[
-            "MoveToSurroundMagneticHook",
-            "GraspMagneticHook",
-            "CarryHookOverBottomDrawerMagneticHook",
-            "DropHookIntoBottomDrawerMagneticHook",
+            "AttachBottomDrawerHandle",
+            "SuctionOpenBottomDrawer",
+            "DetachBottomDrawerHandle",
         ]);
         let compiled = |stop| {
-            compile_policy(&procedure, &o, Embodiment::Finger, stop)
+            compile_policy(&procedure, &o, Embodiment::Vacuum, stop)
                 .unwrap()
                 .code
         };
-        let turn = "angle=math.pi / 2 if along_y else 0.0";
-        assert!(compiled(true).contains(turn), "{}", compiled(true));
-        assert!(!compiled(false).contains(turn), "{}", compiled(false));
+        let on = compiled(true);
+        assert!(on.contains("for box in [\"hinge_body\"]:"), "{on}");
+        assert!(
+            on.contains("try:\n    move_gripper_to(\"bottom_drawer_handle\", pointing_to=pointing)\nexcept robot.CollisionError:\n    pointing = \"down\""),
+            "{on}"
+        );
+        let off = compiled(false);
+        assert!(!off.contains("for box in") && !off.contains("except"), "{off}");
+        assert!(
+            off.contains("move_gripper_to(\"bottom_drawer_handle\", pointing_to=pointing)"),
+            "{off}"
+        );
     }
 
     #[test]

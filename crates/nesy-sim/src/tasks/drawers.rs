@@ -40,10 +40,14 @@ const SIDE_TURNED: [f64; 2] = [0.16, -0.19];
 /// Largest shift (m) of a cabinet from its anchor.
 const CABINET_JITTER: f64 = 0.02;
 /// The band of the table the cubes are laid out in, relative to the offset: clear of both
-/// cabinets and of the drawers' travel in every setting, and far enough in front of the
-/// turned cabinet (15 cm from its centre) that the wrist reaching down for a cube keeps
-/// off it.
+/// cabinets and of the drawers' travel in every setting.
 const CUBE_BAND: ([f64; 2], [f64; 2]) = ([-0.07, -0.29], [0.13, -0.15]);
+/// Least distance (m) in y from the turned cabinet's centre to a cube's centre. Its drawer
+/// face stands 7.7 cm from its centre; with a cube closer than 18 cm, the arm coming down on
+/// the cube meets the cabinet whichever way the hand turns: lying along y, the 20 cm hand;
+/// lying along x, the wrist, which trails 9 cm off the hand's axis (measured with the
+/// protective stop: 17 cm stopped, 18 cm clear).
+const TURNED_CLEARANCE: f64 = 0.18;
 /// Least distance (m) between two cubes' centres on the table.
 const CUBE_SPACING: f64 = 0.065;
 
@@ -73,6 +77,9 @@ pub(crate) fn layout(config: &SubtaskConfig, [ox, oy]: [f64; 2]) -> SubtaskLayou
     rng.shuffle(&mut grid);
     let mut spots: Vec<[f64; 2]> = Vec::new();
     for spot in grid {
+        if turned && spot[1] > side[1] - TURNED_CLEARANCE {
+            continue;
+        }
         let apart = spots
             .iter()
             .all(|s| (s[0] - spot[0]).hypot(s[1] - spot[1]) >= CUBE_SPACING);

@@ -159,6 +159,22 @@ pub const DROP_CLEARANCE: f64 = 0.01;
 /// Height (m) above the hinge box's top at which a fruit is let go.
 pub const HINGE_DROP_CLEARANCE: f64 = 0.03;
 
+/// Reach (m) of the finger hand's wrist around the tool point when it grasps a drawer
+/// handle from above.
+pub const WRIST_CLEARANCE: f64 = 0.07;
+/// How far (m) the wrist and forearm trail behind the tool point when the hand grasps a
+/// handle pointing sideways.
+pub const FOREARM_REACH: f64 = 0.3;
+/// How far (m) below the tool point the wrist hangs when the hand points sideways: joint 6's
+/// housing (a 5 cm capsule 8.8 cm off the last joint's axis) swings below the forearm, and
+/// came down on the closed lid of a hinge box standing behind the cabinet.
+pub const FOREARM_BELOW: f64 = 0.1;
+/// How far (m) above the tool point the forearm rises when the hand points sideways.
+pub const FOREARM_ABOVE: f64 = 0.3;
+/// How far (m) to either side of the wrist's corridor the elbow swings the forearm on the
+/// way to a sideways grasp (it came down on a toy box 20–30 cm beside the bottom handle).
+pub const FOREARM_SWING: f64 = 0.3;
+
 /// Height (m) above the bottom drawer's rim at which a cylinder is let go: high enough that
 /// the hand clears the cylinders still standing on the cabinet.
 pub const DRAWER_DROP_CLEARANCE: f64 = 0.05;

@@ -3,6 +3,7 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
+use super::contact::FurnitureSnapshot;
 use super::floor::empty_floor_xy;
 use super::geometry::{Aabb, array_to_na, yaw_of};
 use super::objects::PartRole;
@@ -428,17 +429,8 @@ impl Sim {
         let yaw = match self.scene.embodiment {
             Embodiment::Vacuum => 0.0,
             Embodiment::Finger => {
-                let object_yaw = match p.role {
-                    PartRole::Loose => yaw_of(&self.part_pose(part).rotation),
-                    _ => p.base_yaw,
-                };
-                let step = match p.kind {
-                    ObjectKind::Cube | ObjectKind::Cylinder if p.role == PartRole::Loose => {
-                        std::f64::consts::FRAC_PI_2
-                    }
-                    _ => std::f64::consts::PI,
-                };
-                self.uncrowded_spin(part, pointing, object_yaw + p.grasp_yaw, step, target[2])
+                let (angle, step) = self.finger_grasp_spins(part);
+                self.uncrowded_spin(part, pointing, angle, step, target[2])
             }
         };
         // A hand coming down stops where its palm would meet a taller neighbour, as a real
@@ -535,21 +527,13 @@ impl Sim {
             let Some(furniture) = &furniture else {
                 return 0.0;
             };
-            let rotation = Sim::pointing(pointing, spin);
-            let travel = self.preshape_travel(part, &rotation);
-            let mut seed = self.q.clone();
-            let mut deepest = 0.0_f64;
-            for lift in DESCENT_CHECK_HEIGHTS.iter().rev() {
-                let goal = ToolGoal {
-                    position: Vector3::new(centre[0], centre[1], tool_z + lift),
-                    rotation,
-                };
-                if let Some(q) = self.ik(&goal, &seed, &IkOptions::default()) {
-                    deepest = deepest.max(furniture.arm_depth_at(&q, travel));
-                    seed = q;
-                }
-            }
-            deepest
+            self.descent_into_furniture(
+                furniture,
+                part,
+                [centre[0], centre[1]],
+                tool_z,
+                Sim::pointing(pointing, spin),
+            )
         };
         let scored: Vec<(f64, f64, f64)> = spins
             .iter()
@@ -567,6 +551,50 @@ impl Sim {
             .iter()
             .min_by(|a, b| a.1.total_cmp(&b.1).then(a.2.total_cmp(&b.2)))
             .map_or(nearest, |&(spin, _, _)| spin)
+    }
+
+    /// The finger hand's grasp spins of `part` as it lies now: `angle + k·step` for every
+    /// integer `k` (a box or cylinder from either pair of faces, anything else one way round).
+    pub(crate) fn finger_grasp_spins(&self, part: usize) -> (f64, f64) {
+        let p = &self.parts[part];
+        let object_yaw = match p.role {
+            PartRole::Loose => yaw_of(&self.part_pose(part).rotation),
+            _ => p.base_yaw,
+        };
+        let step = match p.kind {
+            ObjectKind::Cube | ObjectKind::Cylinder if p.role == PartRole::Loose => {
+                std::f64::consts::FRAC_PI_2
+            }
+            _ => std::f64::consts::PI,
+        };
+        (object_yaw + p.grasp_yaw, step)
+    }
+
+    /// How far (m) the arm, hand or open fingers would press into `furniture` on the way down
+    /// to take `part` with the tool at `xy` and height `tool_z` in orientation `rotation`,
+    /// checked at the heights of [`DESCENT_CHECK_HEIGHTS`] from the top down (0 when clear).
+    pub(crate) fn descent_into_furniture(
+        &self,
+        furniture: &FurnitureSnapshot<'_>,
+        part: usize,
+        xy: [f64; 2],
+        tool_z: f64,
+        rotation: UnitQuaternion<f64>,
+    ) -> f64 {
+        let travel = self.preshape_travel(part, &rotation);
+        let mut seed = self.q.clone();
+        let mut deepest = 0.0_f64;
+        for lift in DESCENT_CHECK_HEIGHTS.iter().rev() {
+            let goal = ToolGoal {
+                position: Vector3::new(xy[0], xy[1], tool_z + lift),
+                rotation,
+            };
+            if let Some(q) = self.ik(&goal, &seed, &IkOptions::default()) {
+                deepest = deepest.max(furniture.arm_depth_at(&q, travel));
+                seed = q;
+            }
+        }
+        deepest
     }
 
     /// The highest top of the loose objects (other than `part` and a held one) under the

@@ -3,6 +3,7 @@
 
 use nesy_core::Embodiment;
 
+use crate::api::{Direction, MAX_FINGER_DEPTH};
 use crate::robot::model::{HAND_HALF_LENGTH, HAND_HALF_WIDTH, PALM_ABOVE_TOOL};
 use crate::scene::TABLE_TOP;
 use crate::world::geometry::Aabb;
@@ -22,7 +23,9 @@ const REGION_Y: (f64, f64) = (-0.15, 0.16);
 /// With the protective stop on, the finger hand setting the object down must fit as well:
 /// a spot is free only if the hand, at the default angle above it with the object held at
 /// mid-height on the table, keeps its length off every piece of furniture standing higher
-/// than its palm (else the stop would end the set-down at an open lid or drawer).
+/// than its palm (else the stop would end the set-down at an open lid or drawer), and the
+/// arm must be able to take it again from there: for some grasp spin, nothing of the arm
+/// touches furniture on the way down to it.
 /// The current spot wins if it is free; otherwise the candidate nearest the object's
 /// current position.
 pub(crate) fn empty_floor_xy(sim: &Sim, part: usize) -> Option<[f64; 2]> {
@@ -70,22 +73,43 @@ pub(crate) fn empty_floor_xy(sim: &Sim, part: usize) -> Option<[f64; 2]> {
         obstacles.iter().all(|o| !foot.overlaps_xy(o, 0.0))
             && furniture.iter().all(|f| !hand.overlaps_xy(f, 0.0))
     };
+    // With the stop on, the arm must also be able to take the object again from there: for
+    // some grasp spin, the wrist and forearm above the hand clear the furniture on the way
+    // down (the hand's footprint alone let a cube be set down where the wrist then met a
+    // cabinet beside it). Checked last, by inverse kinematics, on the nearest free spots.
+    let snapshot = (!furniture.is_empty()).then(|| sim.furniture_snapshot());
+    let retakable = |x: f64, y: f64| {
+        let Some(snapshot) = &snapshot else {
+            return true;
+        };
+        let tool_z = TABLE_TOP + size[2] - (size[2] / 2.0).min(MAX_FINGER_DEPTH);
+        let (angle, step) = sim.finger_grasp_spins(part);
+        let spins = (std::f64::consts::TAU / step).round().max(1.0) as usize;
+        (0..spins).any(|k| {
+            let rotation = Sim::pointing(Direction::Down, angle + k as f64 * step);
+            sim.descent_into_furniture(snapshot, part, [x, y], tool_z, rotation) == 0.0
+        })
+    };
     let c = me.centre();
-    if (x_lo..=x_hi).contains(&c[0]) && (y_lo..=y_hi).contains(&c[1]) && free(c[0], c[1]) {
+    if (x_lo..=x_hi).contains(&c[0])
+        && (y_lo..=y_hi).contains(&c[1])
+        && free(c[0], c[1])
+        && retakable(c[0], c[1])
+    {
         return Some([c[0], c[1]]);
     }
     let step = 0.6 * size[0].max(size[1]).max(0.01);
     let nx = ((x_hi - x_lo) / step).floor() as usize;
     let ny = ((y_hi - y_lo) / step).floor() as usize;
-    let mut best: Option<(f64, [f64; 2])> = None;
-    for i in 0..=nx {
-        for j in 0..=ny {
-            let (x, y) = (x_lo + i as f64 * step, y_lo + j as f64 * step);
-            let d = (x - c[0]).powi(2) + (y - c[1]).powi(2);
-            if best.is_none_or(|(bd, _)| d < bd) && free(x, y) {
-                best = Some((d, [x, y]));
-            }
-        }
-    }
-    best.map(|(_, xy)| xy)
+    let mut candidates: Vec<(f64, [f64; 2])> = (0..=nx)
+        .flat_map(|i| (0..=ny).map(move |j| [x_lo + i as f64 * step, y_lo + j as f64 * step]))
+        .filter(|&[x, y]| free(x, y))
+        .map(|[x, y]| ((x - c[0]).powi(2) + (y - c[1]).powi(2), [x, y]))
+        .collect();
+    // Nearest first; among equals, grid order (the stable sort keeps it).
+    candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+    candidates
+        .into_iter()
+        .map(|(_, xy)| xy)
+        .find(|&[x, y]| retakable(x, y))
 }

@@ -6,24 +6,14 @@ use super::hand::{Bbox, Hand, centre, overlaps, overlaps_xy, size};
 use crate::api::{ApiError, DEFAULT_LIFT_CLEARANCE, Direction, RobotApi};
 use crate::domain::split_asset_part;
 use crate::scene::parts;
-use crate::tasks::layout::{DRAWER_DROP_CLEARANCE, DRAWER_PULL_FRACTION, DRAWER_RETREAT, DRAWER_SPOTS};
+use crate::tasks::layout::{
+    DRAWER_DROP_CLEARANCE, DRAWER_PULL_FRACTION, DRAWER_RETREAT, DRAWER_SPOTS, FOREARM_ABOVE, FOREARM_BELOW,
+    FOREARM_REACH, FOREARM_SWING, WRIST_CLEARANCE,
+};
 
-/// Reach (m) of the finger hand's wrist around the tool point when it grasps a drawer
-/// handle from above.
-const WRIST_CLEARANCE: f64 = 0.07;
-/// How far (m) the wrist and forearm trail behind the tool point when the hand grasps a
-/// handle pointing sideways.
-const FOREARM_REACH: f64 = 0.3;
-/// How far (m) below the tool point the wrist hangs when the hand points sideways: joint 6's
-/// housing (a 5 cm capsule 8.8 cm off the last joint's axis) swings below the forearm, and
-/// came down on the closed lid of a hinge box standing behind the cabinet.
-const FOREARM_BELOW: f64 = 0.1;
 /// How far (m) below the tool point the corridor reaches for a robot without the
 /// protective stop: the hand's own half height.
 const HAND_BELOW: f64 = 0.03;
-/// How far (m) to either side of the wrist's corridor the elbow swings the forearm on the
-/// way to a sideways grasp (it came down on a toy box 20–30 cm beside the bottom handle).
-const FOREARM_SWING: f64 = 0.3;
 
 /// Moves to the table the loose objects the arm would knock on its way to grasp `handle`
 /// pointing along `pointing`. From above, the wrist passes within [`WRIST_CLEARANCE`] of the
@@ -85,7 +75,11 @@ fn approach_corridor<R: RobotApi + ?Sized>(
             let back = -pointing.unit()[1] * FOREARM_REACH;
             [
                 [c[0] - WRIST_CLEARANCE, c[1].min(c[1] + back), c[2] - below],
-                [c[0] + WRIST_CLEARANCE, c[1].max(c[1] + back), c[2] + 0.3],
+                [
+                    c[0] + WRIST_CLEARANCE,
+                    c[1].max(c[1] + back),
+                    c[2] + FOREARM_ABOVE,
+                ],
             ]
         }
     })
