@@ -713,15 +713,20 @@ mod tests {
         verify_procedure(init, &patched, Some(goal))
     }
 
+    /// The hinge scene with the lid open, the apple on the floor and the hand empty.
+    fn lid_open_apple_on_floor() -> State {
+        parse_state_list(
+            "- (Open hinge_lid)\n- (GripperOpen)\n- (OnTopOf hinge_body floor)\n- (OnTopOf apple floor)",
+        )
+        .unwrap()
+    }
+
     /// A procedure that ends with every action applied but the goal `(Closed hinge_lid)`
     /// unmet (the lid was left open) gets a plan appended that closes it, and the check
     /// accepts it: the goal literals hold after the patched procedure.
     #[test]
     fn a_goal_violation_gets_an_appended_plan_that_reaches_the_goal() {
-        let init = parse_state_list(
-            "- (Open hinge_lid)\n- (GripperOpen)\n- (OnTopOf hinge_body floor)\n- (OnTopOf apple floor)",
-        )
-        .unwrap();
+        let init = lid_open_apple_on_floor();
         let config = PlannerConfig::default();
         let (procedure, end) = hinge_planning(&config)
             .plan(&init, &parse_formula("(InsideOf apple hinge_body)").unwrap())
@@ -739,10 +744,7 @@ mod tests {
     /// the plan is offered in its place. Where the window still moves the apple, it is not.
     #[test]
     fn a_placing_that_an_inserted_plan_already_did_is_absorbed_by_it() {
-        let init = parse_state_list(
-            "- (Open hinge_lid)\n- (GripperOpen)\n- (OnTopOf hinge_body floor)\n- (OnTopOf apple floor)",
-        )
-        .unwrap();
+        let init = lid_open_apple_on_floor();
         let config = PlannerConfig::default();
         let (placing, placed) = hinge_planning(&config)
             .plan(&init, &parse_formula("(InsideOf apple hinge_body)").unwrap())

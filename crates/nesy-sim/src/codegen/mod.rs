@@ -37,20 +37,13 @@ use Motion::*;
 // Where objects go and how the lid swings: the scripted experts' constants, shared so the
 // compiled policies place objects exactly where the experts do.
 use crate::tasks::layout::{
+    BOXES_BESIDE_CABINETS, FOREARM_ABOVE, FOREARM_BELOW, FOREARM_REACH, FOREARM_SWING, WRIST_CLEARANCE,
+};
+use crate::tasks::layout::{
     DRAWER_DROP_CLEARANCE, DRAWER_PULL_FRACTION, DRAWER_RETREAT, DRAWER_SPOTS, DROP_CLEARANCE,
     HINGE_DROP_CLEARANCE, HINGE_SPOTS, LID_CLOSING_ARC, LID_OPENING_ARC, LID_SWING_MAX_X, PUSH_DEPTH_DIVISOR,
     PUSH_OVERSHOOT, TOY_BOX_CELLS,
 };
-use crate::tasks::layout::{FOREARM_ABOVE, FOREARM_BELOW, FOREARM_REACH, FOREARM_SWING, WRIST_CLEARANCE};
-
-/// The boxes that may stand in the lane of an arm reaching a drawer handle sideways: the
-/// containers other than the drawers themselves (bare part names).
-const BOXES_BESIDE_CABINETS: [&str; 4] = [
-    parts::HINGE_BODY,
-    parts::TOY_BOX,
-    parts::LEFT_CHESS_BOX,
-    parts::RIGHT_CHESS_BOX,
-];
 
 /// How far inside the reachable table area ([`FLOOR_AABB`]) compiled targets are kept (m).
 const REACH_MARGIN: f64 = 0.005;

@@ -46,7 +46,8 @@ const CUBE_BAND: ([f64; 2], [f64; 2]) = ([-0.07, -0.29], [0.13, -0.15]);
 /// face stands 7.7 cm from its centre; with a cube closer than 18 cm, the arm coming down on
 /// the cube meets the cabinet whichever way the hand turns: lying along y, the 20 cm hand;
 /// lying along x, the wrist, which trails 9 cm off the hand's axis (measured with the
-/// protective stop: 17 cm stopped, 18 cm clear).
+/// protective stop: 13.6 to 15.6 cm stopped, and 16.6 cm stopped in one scene and not in
+/// another).
 const TURNED_CLEARANCE: f64 = 0.18;
 /// Least distance (m) between two cubes' centres on the table.
 const CUBE_SPACING: f64 = 0.065;

@@ -4,6 +4,7 @@
 //! that the expert moves a fruit's drop spot in the hinge box away from fruits that landed
 //! off theirs ([`hinge_drop_spot`]), while a compiled policy drops at [`HINGE_SPOTS`].
 
+use crate::scene::parts;
 use crate::world::FLOOR_AABB;
 
 /// Cells of the toy box the cubes are dropped into (offsets from its centre, m): three
@@ -159,6 +160,14 @@ pub const DROP_CLEARANCE: f64 = 0.01;
 /// Height (m) above the hinge box's top at which a fruit is let go.
 pub const HINGE_DROP_CLEARANCE: f64 = 0.03;
 
+/// The boxes that may stand in the lane of an arm reaching a drawer handle sideways: the
+/// containers other than the drawers themselves (bare part names).
+pub const BOXES_BESIDE_CABINETS: [&str; 4] = [
+    parts::HINGE_BODY,
+    parts::TOY_BOX,
+    parts::LEFT_CHESS_BOX,
+    parts::RIGHT_CHESS_BOX,
+];
 /// Reach (m) of the finger hand's wrist around the tool point when it grasps a drawer
 /// handle from above.
 pub const WRIST_CLEARANCE: f64 = 0.07;

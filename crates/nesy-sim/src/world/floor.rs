@@ -78,16 +78,21 @@ pub(crate) fn empty_floor_xy(sim: &Sim, part: usize) -> Option<[f64; 2]> {
     // down (the hand's footprint alone let a cube be set down where the wrist then met a
     // cabinet beside it). Checked last, by inverse kinematics, on the nearest free spots.
     let snapshot = (!furniture.is_empty()).then(|| sim.furniture_snapshot());
+    let grasp_z = TABLE_TOP + size[2] - (size[2] / 2.0).min(MAX_FINGER_DEPTH);
+    let spins = match snapshot {
+        Some(_) => {
+            let (angle, step) = sim.finger_grasp_spins(part);
+            sim.spins_by_nearness(Direction::Down, angle, step)
+        }
+        None => Vec::new(),
+    };
     let retakable = |x: f64, y: f64| {
         let Some(snapshot) = &snapshot else {
             return true;
         };
-        let tool_z = TABLE_TOP + size[2] - (size[2] / 2.0).min(MAX_FINGER_DEPTH);
-        let (angle, step) = sim.finger_grasp_spins(part);
-        let spins = (std::f64::consts::TAU / step).round().max(1.0) as usize;
-        (0..spins).any(|k| {
-            let rotation = Sim::pointing(Direction::Down, angle + k as f64 * step);
-            sim.descent_into_furniture(snapshot, part, [x, y], tool_z, rotation) == 0.0
+        spins.iter().any(|&spin| {
+            let rotation = Sim::pointing(Direction::Down, spin);
+            sim.descent_into_furniture(snapshot, part, [x, y], grasp_z, rotation) == 0.0
         })
     };
     let c = me.centre();

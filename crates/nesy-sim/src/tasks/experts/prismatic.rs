@@ -7,8 +7,8 @@ use crate::api::{ApiError, DEFAULT_LIFT_CLEARANCE, Direction, RobotApi};
 use crate::domain::split_asset_part;
 use crate::scene::parts;
 use crate::tasks::layout::{
-    DRAWER_DROP_CLEARANCE, DRAWER_PULL_FRACTION, DRAWER_RETREAT, DRAWER_SPOTS, FOREARM_ABOVE, FOREARM_BELOW,
-    FOREARM_REACH, FOREARM_SWING, WRIST_CLEARANCE,
+    BOXES_BESIDE_CABINETS, DRAWER_DROP_CLEARANCE, DRAWER_PULL_FRACTION, DRAWER_RETREAT, DRAWER_SPOTS,
+    FOREARM_ABOVE, FOREARM_BELOW, FOREARM_REACH, FOREARM_SWING, WRIST_CLEARANCE,
 };
 
 /// How far (m) below the tool point the corridor reaches for a robot without the
@@ -100,9 +100,7 @@ fn furniture_in_the_way<R: RobotApi + ?Sized>(
         corridor[1][0] += FOREARM_SWING;
     }
     for name in hand.robot.get_obj_names() {
-        let bare = bare_name(&name);
-        let drawer = bare == parts::TOP_DRAWER || bare == parts::BOTTOM_DRAWER;
-        if CONTAINERS.contains(&bare) && !drawer && overlaps(&hand.bbox(&name)?, &corridor) {
+        if BOXES_BESIDE_CABINETS.contains(&bare_name(&name)) && overlaps(&hand.bbox(&name)?, &corridor) {
             return Ok(true);
         }
     }
