@@ -118,10 +118,71 @@ pub struct RunSettings {
     pub observation: Observation,
     /// Whether the robot's protective stop is on in every scene the run builds (its
     /// demonstrations and its executions; `nesy_sim::scene::SceneSpec::protective_stop`).
-    /// Off by default, and then left out of the manifest, so runs made before the stop
+    /// Left out of the manifest when off, and off when absent, so runs made before the stop
     /// existed (which ran without it) keep their configuration hashes.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub protective_stop: bool,
+}
+
+impl RunSettings {
+    /// Which settings differ, each as `name here vs there`.
+    ///
+    /// ```
+    /// use nesy_bench::manifest::{Observation, RunSettings};
+    ///
+    /// let old = RunSettings {
+    ///     keep_gapped_demos: false,
+    ///     image_size: 256,
+    ///     policy_wall_ms: 300_000,
+    ///     max_calls_per_unit: None,
+    ///     observation: Observation::Images,
+    ///     protective_stop: false,
+    /// };
+    /// let new = RunSettings { protective_stop: true, ..old.clone() };
+    /// assert_eq!(old.difference(&new), "protective stop off vs on");
+    /// ```
+    pub fn difference(&self, other: &RunSettings) -> String {
+        let on_off = |on: bool| if on { "on" } else { "off" };
+        let calls = |cap: Option<u64>| cap.map_or("no cap".to_owned(), |n| n.to_string());
+        let pairs = [
+            (
+                "keep gapped demos",
+                on_off(self.keep_gapped_demos).to_owned(),
+                on_off(other.keep_gapped_demos).to_owned(),
+            ),
+            (
+                "image size",
+                self.image_size.to_string(),
+                other.image_size.to_string(),
+            ),
+            (
+                "policy wall ms",
+                self.policy_wall_ms.to_string(),
+                other.policy_wall_ms.to_string(),
+            ),
+            (
+                "max calls per unit",
+                calls(self.max_calls_per_unit),
+                calls(other.max_calls_per_unit),
+            ),
+            (
+                "observation",
+                self.observation.as_str().to_owned(),
+                other.observation.as_str().to_owned(),
+            ),
+            (
+                "protective stop",
+                on_off(self.protective_stop).to_owned(),
+                on_off(other.protective_stop).to_owned(),
+            ),
+        ];
+        pairs
+            .into_iter()
+            .filter(|(_, here, there)| here != there)
+            .map(|(name, here, there)| format!("{name} {here} vs {there}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
 }
 
 /// What every method is shown of the demonstration's keyframes and the target scene.
@@ -355,7 +416,10 @@ impl Manifest {
             ));
         }
         if self.settings != other.settings {
-            parts.push("the run settings".to_owned());
+            parts.push(format!(
+                "the run settings ({})",
+                self.settings.difference(&other.settings)
+            ));
         }
         if self.run_seed != other.run_seed || self.repeats != other.repeats {
             parts.push("the seed or the repeats".to_owned());

@@ -161,12 +161,13 @@ pub(crate) struct RunArgs {
     /// models; NeSyCR reads the ground-truth states).
     #[arg(long, value_enum, default_value_t = Observation::Images)]
     pub observation: Observation,
-    /// The robot's protective stop in every scene of the run: `off` (the kinematic arm,
-    /// which passes through furniture) or `on` (a motion that presses the arm or what it
-    /// carries into furniture ends there, and the experts' demonstrations keep off it); the
-    /// manifest records it.
-    #[arg(long, value_enum, default_value_t = OnOff::Off)]
-    pub protective_stop: OnOff,
+    /// The robot's protective stop in every scene of the run: `on` (a motion that presses
+    /// the arm or what it carries into furniture ends there, and the experts'
+    /// demonstrations keep off it) or `off` (the kinematic arm, which passes through
+    /// furniture). The manifest records it. Left out, a new run has it on and a resumed run
+    /// keeps the setting its manifest records.
+    #[arg(long, value_enum)]
+    pub protective_stop: Option<OnOff>,
     /// Record the offline responder's calls to per-unit cassettes too (live calls always are).
     #[arg(long)]
     pub record_cassettes: bool,
@@ -228,9 +229,9 @@ pub(crate) struct DemosArgs {
     /// Read the scenario suite from this folder instead of generating it.
     #[arg(long, value_name = "DIR")]
     pub suite: Option<PathBuf>,
-    /// The robot's protective stop in the demonstrations: `off` or `on`, as the run that
+    /// The robot's protective stop in the demonstrations: `on` or `off`, as the run that
     /// will use them sets it (`nesy bench run --protective-stop`).
-    #[arg(long, value_enum, default_value_t = OnOff::Off)]
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
     pub protective_stop: OnOff,
 }
 
@@ -384,6 +385,19 @@ fn responder(args: &RunArgs) -> anyhow::Result<ResponderSetup> {
     })
 }
 
+/// The protective stop a run uses: the one asked for; else, for a run that already has a
+/// manifest, the one it records (runs started while the stop was off by default resume
+/// unchanged); else on.
+fn protective_stop(asked: Option<OnOff>, run_dir: &Path) -> anyhow::Result<bool> {
+    Ok(match asked {
+        Some(setting) => setting.is_on(),
+        None if nesy_bench::manifest::manifest_path(run_dir).exists() => {
+            Manifest::read(run_dir)?.settings.protective_stop
+        }
+        None => true,
+    })
+}
+
 fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
     anyhow::ensure!(
         args.policy_timeout.is_finite() && args.policy_timeout > 0.0,
@@ -417,6 +431,7 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
         .run
         .clone()
         .unwrap_or_else(|| PathBuf::from("runs/bench").join(harness::default_run_id()));
+    let protective_stop = protective_stop(args.protective_stop, &run_dir)?;
     Ok(RunConfig {
         run_dir,
         variants: match study {
@@ -436,7 +451,7 @@ fn config(args: &RunArgs) -> anyhow::Result<RunConfig> {
             policy_wall_ms: (args.policy_timeout * 1000.0) as u64,
             max_calls_per_unit: args.max_calls_per_unit,
             observation: args.observation,
-            protective_stop: args.protective_stop.is_on(),
+            protective_stop,
         },
         shard: args.shard.parse()?,
         jobs: args.jobs.unwrap_or_else(cores).max(1),

@@ -103,10 +103,10 @@ pub(crate) enum ScenariosAction {
         /// displaced objects).
         #[arg(long, value_name = "REPORT")]
         rerun_failures: Option<PathBuf>,
-        /// The robot's protective stop: `off` (the kinematic arm, as the benchmark runs by
-        /// default) or `on` (a motion that presses the arm or what it carries into furniture
-        /// ends there, and the experts keep off it).
-        #[arg(long, value_enum, default_value_t = OnOff::Off)]
+        /// The robot's protective stop: `on` (a motion that presses the arm or what it
+        /// carries into furniture ends there, and the experts keep off it; as the benchmark
+        /// runs by default) or `off` (the kinematic arm, which passes through furniture).
+        #[arg(long, value_enum, default_value_t = OnOff::On)]
         protective_stop: OnOff,
     },
 }

@@ -565,9 +565,11 @@ fn the_drawers_study_fails_imitation_on_the_interference_and_adapts_around_it() 
     assert_eq!(of("replan")["status"], "succeeded", "{}", of("replan"));
     let imitation = of("imitation");
     assert_eq!(imitation["status"], "execution_failed", "{imitation}");
+    // With the protective stop on (the default) the hand reaching for the side drawer's
+    // handle meets the open front drawer; with it off the side drawer itself is stopped by it.
     let error = imitation["error"].as_str().unwrap();
     assert!(
-        error.contains("side_bottom_drawer ran into front_bottom_drawer"),
+        error.contains("ran into front_bottom_drawer"),
         "the failure names the interference: {error}"
     );
     let report = std::fs::read_to_string(run.join("report.md")).unwrap();
@@ -685,4 +687,51 @@ fn the_hook_study_gathers_the_screws_where_imitation_leaves_them() {
         report.contains("## A magnetic hook gathers scattered screws"),
         "{report}"
     );
+}
+
+/// A new run has the robot's protective stop on; a run started with it off resumes without the
+/// option as it was, and asking for the stop on in it is refused, naming the setting.
+#[test]
+fn a_new_run_has_the_protective_stop_on_and_a_resumed_run_keeps_its_own() {
+    let scratch = common::scratch();
+    let demos = scratch.path().join("demos");
+    let setting = |run: &Path| {
+        let manifest: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(run.join("manifest.json")).unwrap()).unwrap();
+        manifest["settings"]["protective_stop"].as_bool().unwrap_or(false)
+    };
+    let run = |dir: &Path, extra: &[&str]| {
+        common::nesy(&oracle_run_args(
+            dir,
+            &demos,
+            "imitation",
+            "obst_low_00_s0",
+            extra,
+        ))
+    };
+
+    let new = scratch.path().join("new");
+    let out = run(&new, &[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(setting(&new), "a new run has the stop on");
+
+    let old = scratch.path().join("old");
+    let out = run(&old, &["--protective-stop", "off"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(!setting(&old));
+    let resumed = run(&old, &[]);
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    assert!(
+        String::from_utf8_lossy(&resumed.stderr).contains("ran 0 unit(s) (1 already done)"),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    let refused = run(&old, &["--protective-stop", "on"]);
+    assert_eq!(refused.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(err.contains("protective stop off vs on"), "{err}");
 }
