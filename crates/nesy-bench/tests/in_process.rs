@@ -16,10 +16,16 @@ use nesy_bench::report::{ReportOptions, write};
 use nesy_bench::{Selection, UnitStatus};
 
 fn main() -> ExitCode {
-    nesy_testkit::run_tests_or_worker(&[(
-        "a_run_records_every_unit_resumes_with_nothing_left_and_reports",
-        run_resume_report,
-    )])
+    nesy_testkit::run_tests_or_worker(&[
+        (
+            "a_run_records_every_unit_resumes_with_nothing_left_and_reports",
+            run_resume_report,
+        ),
+        (
+            "an_unresolved_unit_keeps_its_symbolic_seconds",
+            unresolved_symbolic_seconds,
+        ),
+    ])
 }
 
 /// The scenario: a pick-and-place with one obstruction at low complexity, which NeSyCR
@@ -99,4 +105,21 @@ fn run_resume_report() {
     let report = std::fs::read_to_string(&files.report).unwrap();
     assert!(report.contains("NeSyCR"), "{report}");
     assert!(run_dir.join("tables/table1.csv").is_file());
+}
+
+/// NeSyCR with one refinement round on a scenario that needs two ends unresolved; its
+/// record still carries the symbolic time its world model and identification took.
+fn unresolved_symbolic_seconds() {
+    let dir = tempfile::tempdir().unwrap();
+    let (run_dir, demos) = (dir.path().join("run"), dir.path().join("demos"));
+    let mut unresolved = config(&run_dir, &demos);
+    unresolved.variants = parse_variants("nesycr+budget=1").unwrap();
+    run(unresolved);
+    let records = final_records(&run_dir).unwrap();
+    let record = records.values().next().expect("the unit's record");
+    assert_eq!(record.status, UnitStatus::Unresolved, "{record:?}");
+    let time = &record.effort.time;
+    assert!(time.symbolic_s > 0.0, "{time:?}");
+    assert!(time.symbolic_world_model_s > 0.0, "{time:?}");
+    assert!(time.symbolic_world_model_s <= time.symbolic_s, "{time:?}");
 }

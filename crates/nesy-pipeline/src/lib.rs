@@ -483,9 +483,10 @@ impl AdaptedEpisode {
     /// time to `timing`.
     fn add_times(&self, timing: &mut TimeBreakdown) {
         timing.vlm_s += self.vlm.as_secs_f64();
-        timing.symbolic_s = self.symbolic.as_secs_f64();
-        timing.symbolic_world_model_s = self.symbolic_world_model.as_secs_f64();
-        timing.symbolic_adaptation_s = (timing.symbolic_s - timing.symbolic_world_model_s).max(0.0);
+        timing.set_symbolic((
+            self.symbolic.as_secs_f64(),
+            self.symbolic_world_model.as_secs_f64(),
+        ));
         timing.adapt_wall_s = self.wall.as_secs_f64();
     }
 }

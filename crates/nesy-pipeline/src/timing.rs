@@ -44,6 +44,24 @@ pub struct TimeBreakdown {
     pub total_s: f64,
 }
 
+impl TimeBreakdown {
+    /// Sets the symbolic time from its total and its world-model part (in seconds); the
+    /// adaptation part is the rest.
+    ///
+    /// ```
+    /// use nesy_pipeline::TimeBreakdown;
+    ///
+    /// let mut t = TimeBreakdown::default();
+    /// t.set_symbolic((0.5, 0.25));
+    /// assert_eq!((t.symbolic_s, t.symbolic_world_model_s, t.symbolic_adaptation_s), (0.5, 0.25, 0.25));
+    /// ```
+    pub fn set_symbolic(&mut self, (total_s, world_model_s): (f64, f64)) {
+        self.symbolic_s = total_s;
+        self.symbolic_world_model_s = world_model_s;
+        self.symbolic_adaptation_s = (total_s - world_model_s).max(0.0);
+    }
+}
+
 /// A [`Reasoner`] that measures the time spent inside the wrapped reasoner and reports
 /// each call as progress.
 pub(crate) struct TimedReasoner<R> {

@@ -11,15 +11,15 @@ use crate::variant::hex;
 
 /// Phase A of an earlier run: its stored program, or its failure carried over.
 pub(super) fn reexecuted(source: &Path, unit: &Unit) -> Result<(String, PhaseA), PhaseAFailure> {
-    let records = final_records(source).map_err(|e| (UnitStatus::MethodError, e.to_string(), None))?;
+    let records =
+        final_records(source).map_err(|e| PhaseAFailure::new(UnitStatus::MethodError, e.to_string()))?;
     let old = records.get(&unit.key.name()).ok_or_else(|| {
-        (
+        PhaseAFailure::new(
             UnitStatus::MethodError,
             format!(
                 "{}: has no final record of this unit to re-execute",
                 source.display()
             ),
-            None,
         )
     })?;
     let policy = source.join(&old.artifacts).join(output::POLICY_FILE);
@@ -45,13 +45,15 @@ pub(super) fn reexecuted(source: &Path, unit: &Unit) -> Result<(String, PhaseA),
                 },
             ))
         }
-        _ => Err((
-            old.status,
-            old.error
+        _ => Err(PhaseAFailure {
+            status: old.status,
+            message: old
+                .error
                 .clone()
                 .unwrap_or_else(|| "no program in the re-executed run".into()),
-            old.spec.clone(),
-        )),
+            spec: old.spec.clone().map(Box::new),
+            symbolic_s: Some((old.effort.time.symbolic_s, old.effort.time.symbolic_world_model_s)),
+        }),
     }
 }
 

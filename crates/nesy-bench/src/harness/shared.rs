@@ -126,4 +126,25 @@ pub(super) struct PhaseA {
     pub(super) template_s: f64,
 }
 
-pub(super) type PhaseAFailure = (UnitStatus, String, Option<SpecSummary>);
+/// Why phase A ended without code, and what it measured before it did.
+pub(super) struct PhaseAFailure {
+    pub(super) status: UnitStatus,
+    pub(super) message: String,
+    /// Boxed, so that a failed phase stays a small `Err`.
+    pub(super) spec: Option<Box<SpecSummary>>,
+    /// Symbolic seconds (in all, on the world model) spent before the failure, when the
+    /// method got as far as its symbolic stages.
+    pub(super) symbolic_s: Option<(f64, f64)>,
+}
+
+impl PhaseAFailure {
+    /// A failure before anything was measured or specified.
+    pub(super) fn new(status: UnitStatus, message: String) -> PhaseAFailure {
+        PhaseAFailure {
+            status,
+            message,
+            spec: None,
+            symbolic_s: None,
+        }
+    }
+}

@@ -356,22 +356,23 @@ pub(super) async fn run_unit(shared: &Arc<Shared>, unit: &Unit) -> UnitRecord {
     account_calls(&mut effort, &counts, usage.as_ref());
     let (code, mut record_base) = match phase_a {
         Ok(a) => a,
-        Err((status, message, summary)) => {
+        Err(failure) => {
             let status = if counts.cap_reached {
                 UnitStatus::MethodError
             } else {
-                status
+                failure.status
             };
+            if let Some(symbolic_s) = failure.symbolic_s {
+                effort.time.set_symbolic(symbolic_s);
+            }
             effort.time.total_s = started.elapsed().as_secs_f64();
-            let mut r = failed_record(shared, unit, status, message, effort);
-            r.spec = summary;
+            let mut r = failed_record(shared, unit, status, failure.message, effort);
+            r.spec = failure.spec.map(|spec| *spec);
             return r;
         }
     };
     effort.time.vlm_s = record_base.vlm_s;
-    effort.time.symbolic_s = record_base.symbolic_s.0;
-    effort.time.symbolic_world_model_s = record_base.symbolic_s.1;
-    effort.time.symbolic_adaptation_s = (record_base.symbolic_s.0 - record_base.symbolic_s.1).max(0.0);
+    effort.time.set_symbolic(record_base.symbolic_s);
     effort.time.codegen_template_s = record_base.template_s;
 
     // Phase B: execution in the sandboxed simulator.
@@ -581,12 +582,11 @@ fn execution_verdict(report: &ExecutionReport) -> (UnitStatus, Option<String>) {
 /// A unit artifact that could not be written: the unit is recorded as interrupted, so that
 /// it runs again on resume rather than be scored without its evidence.
 fn unkept(summary: Option<SpecSummary>) -> impl FnOnce(PipelineError) -> PhaseAFailure {
-    move |e| {
-        (
-            UnitStatus::Interrupted,
-            format!("a unit artifact could not be written ({e}); the unit runs again on resume"),
-            summary,
-        )
+    move |e| PhaseAFailure {
+        status: UnitStatus::Interrupted,
+        message: format!("a unit artifact could not be written ({e}); the unit runs again on resume"),
+        spec: summary.map(Box::new),
+        symbolic_s: None,
     }
 }
 
@@ -600,8 +600,8 @@ pub(super) async fn specify_and_code(
     dir: &RunDir,
     unit: &Unit,
 ) -> Result<(String, PhaseA), PhaseAFailure> {
-    let method: Arc<dyn Method> =
-        methods::find(&unit.variant.method).map_err(|e| (UnitStatus::MethodError, e.to_string(), None))?;
+    let method: Arc<dyn Method> = methods::find(&unit.variant.method)
+        .map_err(|e| PhaseAFailure::new(UnitStatus::MethodError, e.to_string()))?;
     let specified = match method.specify(inputs, client).await {
         Ok(s) => s,
         Err(f) => {
@@ -616,7 +616,12 @@ pub(super) async fn specify_and_code(
                 iterations: Some(iterations),
                 budget: Some(budget),
             });
-            return Err((status_of(f.kind), f.message, summary));
+            return Err(PhaseAFailure {
+                status: status_of(f.kind),
+                message: f.message,
+                spec: summary.map(Box::new),
+                symbolic_s: f.symbolic_s,
+            });
         }
     };
     let summary = SpecSummary {
@@ -648,9 +653,15 @@ pub(super) async fn specify_and_code(
         dir.write_json(output::ADAPTATION_FILE, a)
             .map_err(unkept(Some(summary.clone())))?;
     }
-    let (code, vlm_code_s, template_s) = make_code(client, inputs, &specified)
-        .await
-        .map_err(|(s, m)| (s, m, Some(summary.clone())))?;
+    let (code, vlm_code_s, template_s) =
+        make_code(client, inputs, &specified)
+            .await
+            .map_err(|(status, message)| PhaseAFailure {
+                status,
+                message,
+                spec: Some(Box::new(summary.clone())),
+                symbolic_s: Some(specified.symbolic_s),
+            })?;
     Ok((
         code,
         PhaseA {

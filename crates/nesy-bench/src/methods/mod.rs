@@ -215,6 +215,9 @@ pub struct MethodFailure {
     pub adaptation: Option<Box<Adaptation>>,
     /// Refinement rounds used and the budget.
     pub iterations: Option<(usize, usize)>,
+    /// Symbolic seconds spent before the failure, in all and on the world model, when the
+    /// method got as far as its symbolic stages (an unresolved NeSyCR run).
+    pub symbolic_s: Option<(f64, f64)>,
 }
 
 impl MethodFailure {
@@ -225,6 +228,7 @@ impl MethodFailure {
             message: message.into(),
             adaptation: None,
             iterations: None,
+            symbolic_s: None,
         }
     }
 

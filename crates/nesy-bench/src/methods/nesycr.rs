@@ -284,6 +284,7 @@ impl Method for NeSyCr {
                             ),
                             adaptation: Some(Box::new(adaptation.clone())),
                             iterations: Some((*iterations, budget)),
+                            symbolic_s: Some(symbolic_s),
                         });
                     }
                     OnUnresolved::CompileLast => {
