@@ -38,11 +38,14 @@ def reason_line(correction):
     lines = [line for line in correction.splitlines() if line.strip()]
     if not lines:
         return "(empty)"
-    first = re.sub(r"\s*\(attempt \d+\)", "", lines[0]).rstrip(":")
-    # "The symbolic verifier rejected this answer:" heads the verifier's reasons; the reason
-    # itself is on the next line.
-    if first.lower().startswith("the symbolic verifier rejected") and len(lines) > 1:
-        return lines[1].rstrip(":")
+    first = re.sub(r"\s*\((attempt|proposal) \d+\)", "", lines[0]).rstrip(":")
+    # "The symbolic verifier rejected this answer:" and "This patch was rejected:" head the
+    # verifier's reasons; the reason itself is on the next line, without the step it names.
+    lowered = first.lower()
+    if (lowered.startswith("the symbolic verifier rejected") or lowered.startswith("this patch was rejected")) and len(
+        lines
+    ) > 1:
+        return re.sub(r"step \d+ \(\S+\)", "step N (action)", lines[1]).rstrip(":")
     return first
 
 
