@@ -302,8 +302,11 @@ fn resend(
     }
     files.retain(|f| f != out);
     anyhow::ensure!(!files.is_empty(), "no cassette (*.json) under {paths:?}");
-    let requests = tools::resend_selection(&files, plan)?;
+    let tools::ResendSelection { requests, duplicates } = tools::resend_selection(&files, plan)?;
     anyhow::ensure!(!requests.is_empty(), "no recorded request matches the selection");
+    if duplicates > 0 {
+        eprintln!("{duplicates} picked request(s) repeat an earlier one and are sent once");
+    }
     let config = nesy_vlm::VlmConfig::resolve(overrides, &nesy_vlm::ProcessEnv)
         .context("the live server's settings")?;
     let http = nesy_vlm::VlmClient::http_transport(&config)?;

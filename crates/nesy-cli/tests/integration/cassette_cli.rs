@@ -134,12 +134,14 @@ async fn resend_asks_the_same_prompts_again_without_their_constraint() {
         interaction("induce", 1, BLOCK, "stop", true),
         interaction("induce", 2, BLOCK, "stop", true),
         interaction("patch", 1, "no patch", "stop", true),
+        // The first prompt again (another run reached it): sent once.
         interaction("induce", 1, "Sure! The robot opened the lid.", "stop", true),
+        interaction("induce", 1, "The lid is closed.", "stop", true),
     ];
     std::fs::write(&source, cassette(recorded)).unwrap();
-    // Two different first tries: make the second distinct so that both are sent.
+    // Two different first tries: make the last distinct so that both are sent.
     let mut file: Value = serde_json::from_str(&std::fs::read_to_string(&source).unwrap()).unwrap();
-    file["interactions"][3]["request"]["body"]["messages"][1]["content"] = json!("another scene");
+    file["interactions"][4]["request"]["body"]["messages"][1]["content"] = json!("another scene");
     std::fs::write(&source, serde_json::to_string_pretty(&file).unwrap()).unwrap();
 
     let server = MockServer::start().await;
@@ -186,6 +188,12 @@ async fn resend_asks_the_same_prompts_again_without_their_constraint() {
         stdout.contains("2 request(s) answered, 0 failed (sent without their constraints)"),
         "{stdout}"
     );
+    assert!(
+        String::from_utf8_lossy(&output.stderr)
+            .contains("1 picked request(s) repeat an earlier one and are sent once"),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     let posted: Vec<Value> = server
         .received_requests()
         .await
@@ -197,7 +205,7 @@ async fn resend_asks_the_same_prompts_again_without_their_constraint() {
     assert_eq!(
         posted.len(),
         2,
-        "the two induction first tries, not the re-ask or the patch"
+        "the two distinct induction first tries, not the repeat, the re-ask or the patch"
     );
     assert!(
         posted

@@ -1,6 +1,6 @@
 //! Library side of `nesy cassette inspect | prune | verify | resend`.
 
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::fs;
 use std::path::{Path, PathBuf};
 
@@ -409,15 +409,31 @@ pub struct ResendPlan {
     pub strip_constraints: bool,
 }
 
+/// What [`resend_selection`] picked.
+#[derive(Debug, Clone)]
+pub struct ResendSelection {
+    /// The requests to send, each distinct.
+    pub requests: Vec<WireRequest>,
+    /// Picked requests left out because an earlier pick was the same request (same path and
+    /// body as it would be sent): two runs that reached the same prompt ask it once.
+    pub duplicates: usize,
+}
+
 /// The requests of `cassettes` (in the order given, each in recording order) that `plan`
 /// picks, ready to send: their recorded path, purpose and body, without the constraint when
 /// asked. A body holding an image reference is refused (its picture lives in the source's
 /// `blobs/`; resending covers text requests).
 ///
+/// Each distinct request is picked once, so that a share of replies read counts prompts,
+/// not how often runs happened to reach the same prompt; the limit per purpose counts
+/// distinct requests.
+///
 /// Sending each again, through a recording cassette, answers "what would the model have
 /// said to the same prompt without its grammar": a paired comparison on identical prompts.
-pub fn resend_selection(cassettes: &[PathBuf], plan: &ResendPlan) -> Result<Vec<WireRequest>, CassetteError> {
+pub fn resend_selection(cassettes: &[PathBuf], plan: &ResendPlan) -> Result<ResendSelection, CassetteError> {
     let mut picked: Vec<WireRequest> = Vec::new();
+    let mut seen: HashSet<String> = HashSet::new();
+    let mut duplicates = 0;
     let mut counts: HashMap<String, usize> = HashMap::new();
     for path in cassettes {
         let file = CassetteFile::load(path)?;
@@ -450,6 +466,10 @@ pub fn resend_selection(cassettes: &[PathBuf], plan: &ResendPlan) -> Result<Vec<
                     fields.remove(field);
                 }
             }
+            if !seen.insert(request_key(&interaction.request.path, &body)) {
+                duplicates += 1;
+                continue;
+            }
             *count += 1;
             picked.push(WireRequest {
                 path: interaction.request.path.clone(),
@@ -459,5 +479,8 @@ pub fn resend_selection(cassettes: &[PathBuf], plan: &ResendPlan) -> Result<Vec<
             });
         }
     }
-    Ok(picked)
+    Ok(ResendSelection {
+        requests: picked,
+        duplicates,
+    })
 }
