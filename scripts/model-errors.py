@@ -41,10 +41,7 @@ def reason_line(correction):
     first = re.sub(r"\s*\((attempt|proposal) \d+\)", "", lines[0]).rstrip(":")
     # "The symbolic verifier rejected this answer:" and "This patch was rejected:" head the
     # verifier's reasons; the reason itself is on the next line, without the step it names.
-    lowered = first.lower()
-    if (lowered.startswith("the symbolic verifier rejected") or lowered.startswith("this patch was rejected")) and len(
-        lines
-    ) > 1:
+    if first.lower().startswith(("the symbolic verifier rejected", "this patch was rejected")) and len(lines) > 1:
         return re.sub(r"step \d+ \(\S+\)", "step N (action)", lines[1]).rstrip(":")
     return first
 
