@@ -14,6 +14,15 @@ slice CI runs). When the run is finished (its tables/ exist) and every scenario 
 the tables that hold no timings (table1, status, stages, domain_gap) must be byte-identical
 too.
 
+A build later than the one the manifest names may compile a unit's procedure into another
+program (the code templates change; a model's code comes from the cassette and does not).
+A unit that ends differently AND whose program (`policy.py` in its artifacts folder) differs
+from the recorded one is listed as compiled anew, not as a difference: the replies and the
+procedure were the same, the program was not. A unit that ends differently from the same
+program, or without one, is a difference. When some unit was compiled anew, the tables are
+compared but a mismatch is reported as expected of that build; byte-identical tables are
+the check for the build the manifest names.
+
 Exit 0 when everything matches, 1 with the differences otherwise, 2 on bad input.
 """
 
@@ -63,6 +72,37 @@ def comparable(record):
     return kept
 
 
+def program_of(run, record):
+    """The program a unit ran (`policy.py` in its artifacts folder), or None."""
+    artifacts = record.get("artifacts")
+    if not artifacts:
+        return None
+    path = run / artifacts / "policy.py"
+    return path.read_bytes() if path.is_file() else None
+
+
+def program_changed(run, recorded, replay_run, replayed):
+    """True when both ran a program and the replay's is not the recorded one."""
+    want, got = program_of(run, recorded), program_of(replay_run, replayed)
+    return want is not None and got is not None and want != got
+
+
+def knows_option(nesy, option):
+    """Whether this build's `nesy bench run` has the option (older builds lack newer ones)."""
+    try:
+        shown = subprocess.run([nesy, "bench", "run", "--help"], capture_output=True, text=True)
+    except OSError as error:
+        fail_input(f"{nesy}: cannot run it ({error})")
+    return option in shown.stdout
+
+
+def build_of(manifest):
+    """The recording build's commit as the manifest names it."""
+    provenance = manifest.get("provenance") or {}
+    commit = provenance.get("git_commit") or provenance.get("commit") or "?"
+    return f"commit {commit[:12]}"
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("run", type=Path, help="the recorded run folder")
@@ -94,8 +134,12 @@ def main():
         "--methods", ",".join(variants),
         "--scenarios", ",".join(scenarios),
         "--observation", settings.get("observation", "images"),
-        # A manifest without the setting is a run made before the protective stop existed.
-        "--protective-stop", "on" if settings.get("protective_stop", False) else "off",
+    ]
+    # A manifest without the setting is a run made before the protective stop existed; a
+    # build from before then has no option for it (and no stop).
+    if knows_option(args.nesy, "--protective-stop"):
+        command += ["--protective-stop", "on" if settings.get("protective_stop", False) else "off"]
+    command += [
         "--repeats", str(manifest.get("repeats", 1)),
         "--seed", str(manifest.get("run_seed", 0)),
         "--vlm", f"replay:{(run / 'cassettes').resolve()}",
@@ -111,6 +155,7 @@ def main():
     replayed = read_records(out / "run")
 
     differences = []
+    compiled_anew = []
     compared = 0
     for key in sorted(k for k in recorded if k[0] in scenarios):
         if key not in replayed:
@@ -120,11 +165,15 @@ def main():
         want, got = comparable(recorded[key]), comparable(replayed[key])
         if want != got:
             fields = sorted(f for f in want if want[f] != got[f])
-            differences.append(
+            line = (
                 f"{'/'.join(map(str, key))}: {', '.join(fields)} differ\n"
                 f"    recorded: {json.dumps({f: want[f] for f in fields})[:600]}\n"
                 f"    replayed: {json.dumps({f: got[f] for f in fields})[:600]}"
             )
+            if program_changed(run, recorded[key], out / "run", replayed[key]):
+                compiled_anew.append(line)
+            else:
+                differences.append(line)
     tables_checked = []
     if every_scenario and (run / "tables").is_dir():
         report = [args.nesy, "bench", "report", str(out / "run")]
@@ -135,7 +184,8 @@ def main():
             if want.exists():
                 tables_checked.append(table)
                 if not got.exists() or want.read_bytes() != got.read_bytes():
-                    differences.append(f"tables/{table}: not byte-identical")
+                    mismatch = f"tables/{table}: not byte-identical"
+                    (compiled_anew if compiled_anew else differences).append(mismatch)
 
     print(
         f"rescore-run: {compared} unit(s) of {len(scenarios)} scenario(s) replayed"
@@ -143,12 +193,20 @@ def main():
     )
     if args.out is None:
         shutil.rmtree(out, ignore_errors=True)
+    if compiled_anew:
+        print(
+            f"rescore-run: {sum(1 for line in compiled_anew if not line.startswith('tables/'))} unit(s) "
+            f"compiled to another program by this build than the recording one ({build_of(manifest)}) "
+            "and end differently from it; re-score with that build to reproduce them:"
+        )
+        for line in compiled_anew:
+            print("  " + line)
     if differences:
         print("rescore-run: the replay differs from the recorded run:", file=sys.stderr)
         for line in differences:
             print("  " + line, file=sys.stderr)
         return 1
-    print("rescore-run: every unit ends as recorded")
+    print("rescore-run: every " + ("other " if compiled_anew else "") + "unit ends as recorded")
     return 0
 
 

@@ -9,7 +9,7 @@ use nesy_core::metrics::Tally;
 
 use super::csv::stage_use;
 use super::{Aggregate, Tables, is_method, pct};
-use crate::manifest::{Manifest, Observation};
+use crate::manifest::{Manifest, Observation, Responder};
 use crate::methods::{self, OfflineMeaning, Role};
 use crate::status::UnitStatus;
 use crate::unit_record::UnitRecord;
@@ -218,23 +218,33 @@ fn write_methods(md: &mut String, manifest: &Manifest) {
                 Role::Method => "method",
                 Role::Control => "CONTROL",
             };
-            let offline = match info.offline {
-                // Under injected noise the responder is no longer the best case: its rows
-                // measure the checks under the stated error model.
-                OfflineMeaning::UpperBound if v.variant.option("noise").is_some() => {
-                    "offline: synthetic, under the stated noise, not an upper bound"
-                }
-                OfflineMeaning::UpperBound => "offline: an upper bound",
-                OfflineMeaning::ModelFree => "uses no model",
-                OfflineMeaning::NotMeaningful => "needs a live model",
-            };
+            let noisy = v.variant.option("noise").is_some();
+            let answered = answered_by(info.offline, &manifest.responder, noisy);
             let _ = writeln!(
                 md,
-                "- **{}** ({role}; {offline}): {}",
+                "- **{}** ({role}; {answered}): {}",
                 title_of(&v.id),
                 info.summary
             );
         }
+    }
+}
+
+/// Who gave a method's answers in this run, in words. What an offline row means applies only
+/// when the offline responder answered: a live model's rows, and a replay of its calls, are
+/// that model's.
+fn answered_by(offline: OfflineMeaning, responder: &Responder, noisy: bool) -> &'static str {
+    match (offline, responder) {
+        (OfflineMeaning::ModelFree, _) => "uses no model",
+        (_, Responder::Live { .. }) => "answered by the model",
+        (_, Responder::Replay { .. }) => "the recorded run's answers, replayed",
+        // Under injected noise the responder is no longer the best case: its rows measure the
+        // checks under the stated error model.
+        (OfflineMeaning::UpperBound, Responder::Oracle) if noisy => {
+            "offline: synthetic, under the stated noise, not an upper bound"
+        }
+        (OfflineMeaning::UpperBound, Responder::Oracle) => "offline: an upper bound",
+        (OfflineMeaning::NotMeaningful, Responder::Oracle) => "needs a live model",
     }
 }
 
@@ -460,4 +470,44 @@ fn write_figures(md: &mut String) {
         md,
         "![SR and PD against task complexity](plots/complexity.png)\n\nAgainst task complexity, not Figure 4(b)'s complexity gap: in the 440 suite the source and the target always have the same subtasks.\n"
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A live model's NeSyCR rows are never called an upper bound, nor are their replays.
+    #[test]
+    fn only_the_offline_responder_gives_an_upper_bound() {
+        let live = Responder::Live {
+            backend: "llamacpp".to_owned(),
+            model: "gemma3-270m-q4_k_m".to_owned(),
+            base_url: "http://127.0.0.1:8080/v1".to_owned(),
+            constrain: Default::default(),
+        };
+        let replay = Responder::Replay {
+            cassettes: "run/cassettes".into(),
+        };
+        let upper = OfflineMeaning::UpperBound;
+        assert_eq!(
+            answered_by(upper, &Responder::Oracle, false),
+            "offline: an upper bound"
+        );
+        assert!(answered_by(upper, &Responder::Oracle, true).contains("not an upper bound"));
+        assert_eq!(answered_by(upper, &live, false), "answered by the model");
+        assert_eq!(
+            answered_by(OfflineMeaning::NotMeaningful, &live, false),
+            "answered by the model"
+        );
+        assert_eq!(
+            answered_by(upper, &replay, false),
+            "the recorded run's answers, replayed"
+        );
+        for responder in [&Responder::Oracle, &live, &replay] {
+            assert_eq!(
+                answered_by(OfflineMeaning::ModelFree, responder, false),
+                "uses no model"
+            );
+        }
+    }
 }

@@ -212,7 +212,8 @@ pub struct ReportFiles {
     pub partial: bool,
 }
 
-/// The banner of an offline run: what its numbers are and are not.
+/// The banner of a run: what its numbers are and are not (who answered; for a live model, the
+/// model, the observation setting and the sample its figures describe).
 pub fn banner(manifest: &Manifest) -> Option<String> {
     let noisy: Vec<String> = manifest
         .variants
@@ -234,7 +235,17 @@ pub fn banner(manifest: &Manifest) -> Option<String> {
 
 fn base_banner(manifest: &Manifest) -> Option<String> {
     match &manifest.responder {
-        Responder::Live { .. } => None,
+        Responder::Live {
+            backend,
+            model,
+            constrain,
+            ..
+        } => Some(format!(
+            // The first sentence is what a figure shows: short enough for the narrowest one.
+            "REAL MODEL — {model} ({backend}, constraints {constrain}), observation {}, {}. These numbers describe this model in this setting only; none is comparable with the paper's tables.",
+            manifest.settings.observation.as_str(),
+            sample_words(manifest)
+        )),
         Responder::Oracle => Some(
             "OFFLINE — no model answered. NeSyCR rows are the reference responder's upper bound (ground-truth answers, every one checked by the symbolic executor); control rows use no model. No number here is a method's performance, and none is comparable with the paper's tables.".into(),
         ),
@@ -242,6 +253,28 @@ fn base_banner(manifest: &Manifest) -> Option<String> {
             "REPLAYED — the model calls are replayed from {}; the numbers are those of the recorded run.",
             cassettes.display()
         )),
+    }
+}
+
+/// The run's scenarios in words: how many, and how they were drawn when sampled.
+fn sample_words(manifest: &Manifest) -> String {
+    let scenarios = manifest
+        .units
+        .iter()
+        .map(|u| u.scenario.as_str())
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    match manifest.selection.sample {
+        Some(_) => format!(
+            "{scenarios} scenarios ({}sample, seed {})",
+            if manifest.selection.stratify {
+                "stratified "
+            } else {
+                ""
+            },
+            manifest.selection.sample_seed
+        ),
+        None => format!("{scenarios} scenarios"),
     }
 }
 
@@ -559,6 +592,21 @@ mod tests {
             4,
             "every unit is accounted for"
         );
+    }
+
+    /// A live run's banner, on every figure and atop the report, names the model, the
+    /// observation setting and the sample (the published real-model run's manifest).
+    #[test]
+    fn a_live_run_is_labelled_with_its_model_setting_and_sample() {
+        let text = include_str!("../../../../bench/runs/2026-12-06-gemma3-270m/manifest.json");
+        let manifest = Manifest::parse(Path::new("manifest.json"), text).unwrap();
+        let banner = banner(&manifest).expect("a live run has a banner");
+        assert_eq!(
+            banner,
+            "REAL MODEL — gemma3-270m-q4_k_m (llamacpp, constraints auto), observation state-text, 12 scenarios (stratified sample, seed 0). These numbers describe this model in this setting only; none is comparable with the paper's tables."
+        );
+        // What the figures show fits the narrowest of them (1,100 pixels of 8-pixel glyphs).
+        assert!(figures::short_banner(&banner).chars().count() <= 1100 / 8);
     }
 
     #[test]

@@ -19,8 +19,9 @@ fn ascii(text: &str) -> String {
         .replace('Σ', "sum ")
 }
 
-/// Series colours (colour-blind friendly), in order.
-pub const PALETTE: [Rgb; 8] = [
+/// Series colours in order: the eight colour-blind-friendly ones, then four darker ones, so
+/// that a run of every method and control (eleven series) repeats no colour.
+pub const PALETTE: [Rgb; 12] = [
     [0, 114, 178],
     [230, 159, 0],
     [0, 158, 115],
@@ -29,6 +30,10 @@ pub const PALETTE: [Rgb; 8] = [
     [213, 94, 0],
     [240, 228, 66],
     [80, 80, 80],
+    [110, 60, 170],
+    [140, 85, 35],
+    [0, 80, 60],
+    [180, 25, 60],
 ];
 
 const WHITE: Rgb = [255, 255, 255];
