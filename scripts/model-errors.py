@@ -21,16 +21,7 @@ import re
 import sys
 from pathlib import Path
 
-
-def fail_input(message):
-    print(f"model-errors: {message}", file=sys.stderr)
-    sys.exit(2)
-
-
-def text_of(content):
-    if isinstance(content, str):
-        return content
-    return "\n".join(part.get("text", "") for part in content if isinstance(part, dict))
+from run_files import fail_input, interactions, is_verifier_rejection, reask
 
 
 def reason_line(correction):
@@ -41,7 +32,7 @@ def reason_line(correction):
     first = re.sub(r"\s*\((attempt|proposal) \d+\)", "", lines[0]).rstrip(":")
     # "The symbolic verifier rejected this answer:" and "This patch was rejected:" head the
     # verifier's reasons; the reason itself is on the next line, without the step it names.
-    if first.lower().startswith(("the symbolic verifier rejected", "this patch was rejected")) and len(lines) > 1:
+    if is_verifier_rejection(first) and len(lines) > 1:
         return re.sub(r"step \d+ \(\S+\)", "step N (action)", lines[1]).rstrip(":")
     return first
 
@@ -58,19 +49,15 @@ def main():
     reasks = collections.Counter()
     examples = collections.defaultdict(list)
     for path in cassettes:
-        try:
-            interactions = json.loads(path.read_text())["interactions"]
-        except (OSError, json.JSONDecodeError, KeyError, TypeError) as error:
-            fail_input(f"{path}: not a cassette ({error})")
-        for interaction in interactions:
-            request = interaction.get("request", {})
-            messages = request.get("body", request).get("messages", [])
-            if len(messages) < 3 or messages[-2].get("role") != "assistant":
+        for interaction in interactions(path):
+            pair = reask(interaction)
+            if pair is None:
                 continue
-            key = (interaction.get("purpose", "?"), reason_line(text_of(messages[-1]["content"])))
+            reply, correction = pair
+            key = (interaction.get("purpose", "?"), reason_line(correction))
             reasks[key] += 1
             if len(examples[key]) < args.examples:
-                examples[key].append(text_of(messages[-2]["content"]))
+                examples[key].append(reply)
 
     print("## Re-asks: what nesy sent back, by call purpose\n")
     print("| purpose | reason | re-asks |")

@@ -34,35 +34,13 @@ import sys
 import tempfile
 from pathlib import Path
 
+from run_files import fail_input, last_records
+
 # Fields of a unit's record that a replay must reproduce exactly.
 EFFORT_FIELDS = ("calls", "images", "calls_by_purpose", "tokens", "cost_usd")
 RECORD_FIELDS = ("status", "error", "scores", "method", "factor", "complexity", "seed")
 # The report's tables without timings.
 TIMELESS_TABLES = ("table1.csv", "status.csv", "stages.csv", "domain_gap.csv")
-
-
-def fail_input(message):
-    print(f"rescore-run: {message}", file=sys.stderr)
-    sys.exit(2)
-
-
-def read_records(run):
-    """The last record of every unit, keyed by (scenario, variant, repeat)."""
-    files = sorted((run / "results").glob("*.jsonl"))
-    if not files:
-        fail_input(f"{run / 'results'}: no results files (*.jsonl); is this a benchmark run folder?")
-    records = {}
-    for path in files:
-        for number, line in enumerate(path.read_text().splitlines(), start=1):
-            if not line.strip():
-                continue
-            try:
-                record = json.loads(line)
-                key = (record["scenario"], record["variant"], record["repeat"])
-            except (json.JSONDecodeError, KeyError, TypeError) as error:
-                fail_input(f"{path}:{number}: not a unit record ({error})")
-            records[key] = record
-    return records
 
 
 def comparable(record):
@@ -118,7 +96,7 @@ def main():
         fail_input(f"{run / 'manifest.json'}: {error}")
     if not (run / "cassettes").is_dir():
         fail_input(f"{run / 'cassettes'}: missing; the run was not recorded with --record-cassettes")
-    recorded = read_records(run)
+    recorded = last_records(run)
     scenarios = sorted({scenario for scenario, _, _ in recorded})
     every_scenario = args.scenarios is None or args.scenarios >= len(scenarios)
     if not every_scenario:
@@ -152,7 +130,7 @@ def main():
     if finished.returncode not in (0, 1):
         print(f"rescore-run: the replay exited with {finished.returncode}", file=sys.stderr)
         return 1
-    replayed = read_records(out / "run")
+    replayed = last_records(out / "run")
 
     differences = []
     compiled_anew = []
@@ -175,6 +153,7 @@ def main():
             else:
                 differences.append(line)
     tables_checked = []
+    table_mismatches = []
     if every_scenario and (run / "tables").is_dir():
         report = [args.nesy, "bench", "report", str(out / "run")]
         print("+ " + " ".join(report), flush=True)
@@ -184,8 +163,10 @@ def main():
             if want.exists():
                 tables_checked.append(table)
                 if not got.exists() or want.read_bytes() != got.read_bytes():
-                    mismatch = f"tables/{table}: not byte-identical"
-                    (compiled_anew if compiled_anew else differences).append(mismatch)
+                    table_mismatches.append(f"tables/{table}: not byte-identical")
+    # Tables follow their units: with a unit compiled anew they cannot be byte-identical.
+    if not compiled_anew:
+        differences += table_mismatches
 
     print(
         f"rescore-run: {compared} unit(s) of {len(scenarios)} scenario(s) replayed"
@@ -195,11 +176,11 @@ def main():
         shutil.rmtree(out, ignore_errors=True)
     if compiled_anew:
         print(
-            f"rescore-run: {sum(1 for line in compiled_anew if not line.startswith('tables/'))} unit(s) "
+            f"rescore-run: {len(compiled_anew)} unit(s) "
             f"compiled to another program by this build than the recording one ({build_of(manifest)}) "
             "and end differently from it; re-score with that build to reproduce them:"
         )
-        for line in compiled_anew:
+        for line in compiled_anew + table_mismatches:
             print("  " + line)
     if differences:
         print("rescore-run: the replay differs from the recorded run:", file=sys.stderr)

@@ -26,37 +26,11 @@ A last line sums the run. Standard library only. Exit 0, or 2 on bad input.
 
 import argparse
 import collections
-import json
 import math
 import sys
 from pathlib import Path
 
-# The first words of a correction that reports a verifier's rejection, not an unread reply.
-VERIFIER_HEADINGS = ("the symbolic verifier rejected", "this patch was rejected")
-
-
-def fail_input(message):
-    print(f"run-figures: {message}", file=sys.stderr)
-    sys.exit(2)
-
-
-def last_records(run):
-    """The last record of every unit, keyed by (scenario, variant, repeat)."""
-    files = sorted((run / "results").glob("*.jsonl"))
-    if not files:
-        fail_input(f"{run / 'results'}: no results files (*.jsonl); is this a benchmark run folder?")
-    records = {}
-    for path in files:
-        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
-            if not line.strip():
-                continue
-            try:
-                record = json.loads(line)
-                records[(record["scenario"], record["variant"], record["repeat"])] = record
-            except (json.JSONDecodeError, KeyError, TypeError) as error:
-                fail_input(f"{path}:{number}: not a unit record ({error})")
-    return records
-
+from run_files import interactions, is_verifier_rejection, last_records, reask
 
 def wilson(successes, n, z=1.96):
     """The 95 % Wilson score interval of a proportion, in percent."""
@@ -69,26 +43,14 @@ def wilson(successes, n, z=1.96):
     return (100 * max(0.0, centre - half), 100 * min(1.0, centre + half))
 
 
-def text_of(content):
-    if isinstance(content, str):
-        return content
-    return "\n".join(part.get("text", "") for part in content if isinstance(part, dict))
-
-
 def cassette_counts(path):
     """Calls, re-asks by kind, capped replies, tokens and server milliseconds of a cassette."""
-    try:
-        interactions = json.loads(path.read_text(encoding="utf-8"))["interactions"]
-    except (OSError, json.JSONDecodeError, KeyError, TypeError) as error:
-        fail_input(f"{path}: not a cassette ({error})")
     counts = collections.Counter()
-    for interaction in interactions:
+    for interaction in interactions(path):
         counts["calls"] += 1
-        request = interaction.get("request", {})
-        messages = request.get("body", request).get("messages", [])
-        if len(messages) >= 3 and messages[-2].get("role") == "assistant":
-            correction = text_of(messages[-1].get("content", "")).strip().lower()
-            counts["rejected" if correction.startswith(VERIFIER_HEADINGS) else "unread"] += 1
+        pair = reask(interaction)
+        if pair is not None:
+            counts["rejected" if is_verifier_rejection(pair[1]) else "unread"] += 1
         body = interaction.get("response", {}).get("body")
         if not isinstance(body, dict):
             continue
@@ -111,9 +73,12 @@ def main():
 
     records = last_records(args.run)
     replayed = last_records(args.replay) if args.replay else {}
+    # Only the cassettes of finished units count (a unit in flight has one too).
     counts = {}
-    for path in sorted((args.run / "cassettes").glob("*/*.json")):
-        counts[(path.parent.name, path.stem)] = cassette_counts(path)
+    for scenario, variant, _ in records:
+        path = args.run / "cassettes" / scenario / f"{variant}.json"
+        if (scenario, variant) not in counts and path.is_file():
+            counts[(scenario, variant)] = cassette_counts(path)
 
     by_variant = collections.defaultdict(list)
     for key, record in records.items():
