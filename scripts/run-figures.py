@@ -30,7 +30,7 @@ import math
 import sys
 from pathlib import Path
 
-from run_files import interactions, is_verifier_rejection, last_records, reask
+from run_files import cassette_of, interactions, is_verifier_rejection, last_records, reask
 
 def wilson(successes, n, z=1.96):
     """The 95 % Wilson score interval of a proportion, in percent."""
@@ -76,7 +76,7 @@ def main():
     # Only the cassettes of finished units count (a unit in flight has one too).
     counts = {}
     for scenario, variant, _ in records:
-        path = args.run / "cassettes" / scenario / f"{variant}.json"
+        path = cassette_of(args.run, scenario, variant)
         if (scenario, variant) not in counts and path.is_file():
             counts[(scenario, variant)] = cassette_counts(path)
 

@@ -50,6 +50,24 @@ def interactions(path):
         fail_input(f"{path}: not a cassette ({error})")
 
 
+def cassette_of(run, scenario, variant):
+    """A unit's cassette file in a run folder."""
+    return run / "cassettes" / scenario / f"{variant}.json"
+
+
+def has_unordered_twins(calls):
+    """Whether a cassette holds identical requests (same key) without their send order.
+    Concurrent identical requests complete in any order; a cassette that kept no send order
+    (recorded before it was stored) may replay their replies to each other's callers."""
+    seen = set()
+    for call in calls:
+        key = call.get("key")
+        if key in seen and call.get("send_order") is None:
+            return True
+        seen.add(key)
+    return False
+
+
 def text_of(content):
     """A message's text, whether it is a string or a list of parts."""
     if isinstance(content, str):

@@ -29,7 +29,8 @@ pub struct CassetteFile {
     pub schema_version: u32,
     /// Who recorded it, when, against what.
     pub meta: CassetteMeta,
-    /// Recorded calls, in recording order.
+    /// Recorded calls, in the order they completed (see [`Interaction::send_order`] for the
+    /// order they were sent in).
     pub interactions: Vec<Interaction>,
 }
 
@@ -71,10 +72,23 @@ pub struct Interaction {
     pub recorded_at: String,
     /// How long the live call took.
     pub latency_ms: f64,
+    /// Where this call stands in the order the cassette's calls were sent, counted across
+    /// every recording that appended to the file. Calls sent concurrently complete, and so
+    /// are appended, in whatever order the server finishes them; identical requests replay
+    /// by this order so that each caller gets the reply its own call got. Absent in files
+    /// recorded before it was kept: such an interaction counts as sent at its position.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub send_order: Option<u64>,
     /// The request.
     pub request: StoredRequest,
     /// The response.
     pub response: StoredResponse,
+}
+
+impl Interaction {
+    fn sent_at_or(&self, position: usize) -> u64 {
+        self.send_order.unwrap_or(position as u64)
+    }
 }
 
 /// A recorded request: images replaced by `blob:sha256:<hex>.<ext>` references.
@@ -232,6 +246,26 @@ impl CassetteFile {
             }
         }
         serde_json::from_str(text).map_err(parse_error)
+    }
+
+    /// The interactions' indices in the order their calls were sent: by
+    /// [`Interaction::send_order`], an interaction without one counting as sent at its
+    /// position, and ties kept in file order. Replay serves identical requests in this order.
+    pub fn send_sequence(&self) -> Vec<usize> {
+        let mut indices: Vec<usize> = (0..self.interactions.len()).collect();
+        indices.sort_by_key(|&index| (self.interactions[index].sent_at_or(index), index));
+        indices
+    }
+
+    /// The send-order number the next call recorded into this file gets: one past the
+    /// largest already used, so that a resumed recording sorts after everything before it.
+    pub fn next_send_order(&self) -> u64 {
+        self.interactions
+            .iter()
+            .enumerate()
+            .map(|(index, interaction)| interaction.sent_at_or(index) + 1)
+            .max()
+            .unwrap_or(0)
     }
 
     /// Pretty JSON, with every occurrence of a secret replaced.
@@ -393,6 +427,7 @@ mod tests {
                     purpose: None,
                     recorded_at: "t".into(),
                     latency_ms: 1.0,
+                    send_order: None,
                     request: StoredRequest {
                         method: "POST".into(),
                         path: "/p".into(),
@@ -420,5 +455,35 @@ mod tests {
         );
         let err = CassetteFile::parse(Path::new("x.json"), r#"{"interactions": []}"#).unwrap_err();
         assert!(err.to_string().contains("not a nesy cassette"), "{err}");
+    }
+
+    #[test]
+    fn send_order_sorts_replay_and_an_old_file_counts_by_position() {
+        let call = |send_order: Option<u64>| Interaction {
+            key: "k".into(),
+            purpose: None,
+            recorded_at: "t".into(),
+            latency_ms: 1.0,
+            send_order,
+            request: StoredRequest {
+                method: "POST".into(),
+                path: "/p".into(),
+                body: serde_json::Value::Null,
+            },
+            response: StoredResponse::from_wire(&WireResponse::new(200, b"{}".to_vec(), Origin::Live)),
+        };
+        let mut file = CassetteFile::new(None, None);
+        assert_eq!(file.next_send_order(), 0);
+        // Two calls recorded before the order was kept, then a resumed recording whose
+        // second call finished first.
+        file.interactions = vec![call(None), call(None), call(Some(3)), call(Some(2))];
+        assert_eq!(file.send_sequence(), [0, 1, 3, 2]);
+        assert_eq!(file.next_send_order(), 4);
+        let text = file.to_pretty_json(&[]);
+        assert_eq!(
+            text.matches("send_order").count(),
+            2,
+            "absent stays absent:\n{text}"
+        );
     }
 }

@@ -6,8 +6,9 @@
 //! `new_episodes` replays what matches and records the rest; `all` records every call
 //! afresh (the previous recording is discarded at the first write).
 //!
-//! A request matches by its key (see [`canonical`]); identical requests replay in recorded
-//! order. Recording appends each interaction as it completes, rewriting the file atomically
+//! A request matches by its key (see [`canonical`]); identical requests replay in the order
+//! they were sent, which concurrent calls need: they complete in whatever order the server
+//! finishes them. Recording appends each interaction as it completes, rewriting the file atomically
 //! under a lock file, so a crash loses at most the call in flight and `new_episodes` resumes
 //! where a broken recording stopped.
 
@@ -15,6 +16,7 @@ use std::collections::{HashMap, VecDeque};
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
@@ -152,7 +154,7 @@ pub enum CassetteError {
 pub struct InteractionRef {
     /// The request key.
     pub key: String,
-    /// Occurrence among interactions with that key, in file order.
+    /// Occurrence among interactions with that key, in the order they were sent.
     pub occurrence: usize,
 }
 
@@ -204,6 +206,12 @@ impl CassetteOptions {
     }
 }
 
+/// When a live call went out, and how long it took.
+struct Sent {
+    order: u64,
+    latency_ms: f64,
+}
+
 struct Recorded {
     key: String,
     occurrence: usize,
@@ -243,6 +251,8 @@ pub struct CassetteTransport {
     /// Serialises writes within the process (the lock file does so across processes) and
     /// remembers whether `all` mode has discarded the old recording yet.
     writer: Mutex<bool>,
+    /// The send-order number of the next live call (see [`Interaction::send_order`]).
+    next_send: AtomicU64,
 }
 
 impl fmt::Debug for CassetteTransport {
@@ -286,11 +296,13 @@ impl CassetteTransport {
         let mut state = ReplayState::default();
         let mut announced = Announced::default();
         let mut recorded_constrain = ConstrainMode::Auto;
+        let mut next_send = 0;
         if existed && replays {
             let file = CassetteFile::load(&path)?;
             announced.recorded = file.meta.server.clone();
             recorded_constrain = file.meta.constrain;
-            let mut occurrences: HashMap<String, usize> = HashMap::new();
+            next_send = file.next_send_order();
+            let sequence = file.send_sequence();
             for (index, interaction) in file.interactions.into_iter().enumerate() {
                 let key = request_key(&interaction.request.path, &interaction.request.body);
                 let response = interaction
@@ -300,17 +312,19 @@ impl CassetteTransport {
                         path: path.clone(),
                         message: format!("interaction #{index}: {message}"),
                     })?;
-                let occurrence = occurrences.entry(key.clone()).or_default();
-                state.queues.entry(key.clone()).or_default().push_back(index);
                 recorded.push(Recorded {
                     key,
-                    occurrence: *occurrence,
+                    occurrence: 0,
                     path: interaction.request.path,
                     body: interaction.request.body,
                     purpose: interaction.purpose,
                     response,
                 });
-                *occurrence += 1;
+            }
+            for index in sequence {
+                let queue = state.queues.entry(recorded[index].key.clone()).or_default();
+                recorded[index].occurrence = queue.len();
+                queue.push_back(index);
             }
             state.used = vec![false; recorded.len()];
         }
@@ -327,6 +341,7 @@ impl CassetteTransport {
             announced: Mutex::new(announced),
             recorded_constrain,
             writer: Mutex::new(false),
+            next_send: AtomicU64::new(next_send),
         })
     }
 
@@ -428,13 +443,19 @@ impl CassetteTransport {
         let Some(inner) = self.inner.as_ref().filter(|_| self.records) else {
             return Err(self.miss(request, &canonical, exhausted).into());
         };
+        // Numbered before the first await, so concurrent calls are numbered in the order
+        // they were issued, which is the order a replay issues them in.
+        let send_order = self.next_send.fetch_add(1, Ordering::Relaxed);
         let started = Instant::now();
         let response = inner.send(request).await?;
         self.append(
             request,
             canonical,
             &response,
-            started.elapsed().as_secs_f64() * 1e3,
+            Sent {
+                order: send_order,
+                latency_ms: started.elapsed().as_secs_f64() * 1e3,
+            },
         )?;
         Ok(response)
     }
@@ -444,7 +465,7 @@ impl CassetteTransport {
         request: &WireRequest,
         canonical: Canonical,
         response: &WireResponse,
-        latency_ms: f64,
+        sent: Sent,
     ) -> Result<(), CassetteError> {
         let blobs = blobs_dir(&self.path);
         for image in &canonical.images {
@@ -456,7 +477,8 @@ impl CassetteTransport {
             key: canonical.key,
             purpose: request.purpose.clone(),
             recorded_at: crate::timefmt::now_rfc3339(),
-            latency_ms: (latency_ms * 1000.0).round() / 1000.0,
+            latency_ms: (sent.latency_ms * 1000.0).round() / 1000.0,
+            send_order: Some(sent.order),
             request: StoredRequest {
                 method: "POST".into(),
                 path: request.path.clone(),

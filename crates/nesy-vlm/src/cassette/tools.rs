@@ -277,18 +277,27 @@ pub fn prune(
 ) -> Result<PruneOutcome, CassetteError> {
     let mut file = CassetteFile::load(path)?;
     let used: BTreeSet<&InteractionRef> = usage.used.iter().collect();
+    // Occurrences count in send order, as the replay that wrote the usage report did.
+    let mut references: Vec<Option<InteractionRef>> = vec![None; file.interactions.len()];
     let mut occurrences: HashMap<String, usize> = HashMap::new();
-    let mut dropped = Vec::new();
-    let mut kept = Vec::new();
-    for (index, interaction) in std::mem::take(&mut file.interactions).into_iter().enumerate() {
-        let key = request_key(&interaction.request.path, &interaction.request.body);
+    for index in file.send_sequence() {
+        let request = &file.interactions[index].request;
+        let key = request_key(&request.path, &request.body);
         let occurrence = occurrences.entry(key.clone()).or_default();
-        let reference = InteractionRef {
+        references[index] = Some(InteractionRef {
             key,
             occurrence: *occurrence,
-        };
+        });
         *occurrence += 1;
-        if used.contains(&reference) {
+    }
+    let mut dropped = Vec::new();
+    let mut kept = Vec::new();
+    for ((index, interaction), reference) in std::mem::take(&mut file.interactions)
+        .into_iter()
+        .enumerate()
+        .zip(references)
+    {
+        if reference.is_some_and(|reference| used.contains(&reference)) {
             kept.push(interaction)
         } else {
             dropped.push(index)

@@ -1,4 +1,5 @@
-//! Cassettes against an in-process mock server: record → replay byte for byte, FIFO order,
+//! Cassettes against an in-process mock server: record → replay byte for byte, FIFO order
+//! (by send order when concurrent calls complete out of order),
 //! helpful misses, blob de-duplication, secret hygiene, resuming, strict mode, and the
 //! inspect/prune/verify tools.
 
@@ -6,8 +7,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use nesy_vlm::{
-    BackendKind, CassetteError, CassetteMode, CassetteOptions, CassetteTransport, ChatRequest, Image,
-    Message, Origin, Part, SecretString, TaskContext, Transport, VlmClient, VlmConfig, VlmError,
+    BackendKind, BoxFuture, CassetteError, CassetteMode, CassetteOptions, CassetteTransport, ChatRequest,
+    Image, Message, Origin, Part, SecretString, TaskContext, Transport, TransportError, VlmClient, VlmConfig,
+    VlmError, WireRequest, WireResponse,
 };
 use nesy_vlm::{CassetteFile, cassette_tools as tools};
 use serde_json::json;
@@ -497,5 +499,66 @@ fn verify_refuses_paths_pipes_credentials_and_empty_successes() {
     assert!(
         problems.iter().all(|p| !p.contains("sk-stored-by-hand")),
         "{problems:?}"
+    );
+}
+
+/// Answers the n-th call it is sent with `answer n`; the first call takes longest, so it
+/// completes (and is appended to a cassette) after the others.
+#[derive(Debug, Default)]
+struct FirstCallFinishesLast {
+    sent: std::sync::atomic::AtomicUsize,
+}
+
+impl Transport for FirstCallFinishesLast {
+    fn send<'a>(&'a self, _request: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
+        let n = self.sent.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        Box::pin(async move {
+            if n == 0 {
+                tokio::time::sleep(std::time::Duration::from_millis(200)).await;
+            }
+            let body = serde_json::to_vec(&completion(&format!("answer {n}"))).unwrap();
+            Ok(WireResponse::new(200, body, Origin::Live))
+        })
+    }
+
+    fn label(&self) -> String {
+        "first call finishes last".into()
+    }
+}
+
+#[tokio::test]
+async fn identical_concurrent_requests_replay_in_the_order_they_were_sent() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("concurrent.json");
+    let builder =
+        VlmClient::from_config(&config(BackendKind::LlamaCpp, "gemma", "http://127.0.0.1:9")).unwrap();
+    let wire = builder.wire_request(&request("the same keyframe", &[]));
+    let send_both = |transport: Arc<CassetteTransport>| {
+        let wire = wire.clone();
+        async move {
+            let calls = [transport.send(&wire), transport.send(&wire)];
+            futures::future::join_all(calls)
+                .await
+                .into_iter()
+                .map(|response| String::from_utf8(response.unwrap().body.to_vec()).unwrap())
+                .collect::<Vec<_>>()
+        }
+    };
+
+    let live: Arc<dyn Transport> = Arc::new(FirstCallFinishesLast::default());
+    let recorder =
+        CassetteTransport::open(&path, CassetteMode::All, Some(live), CassetteOptions::default()).unwrap();
+    let recorded = send_both(Arc::new(recorder)).await;
+    assert!(recorded[0].contains("answer 0") && recorded[1].contains("answer 1"));
+    let file = CassetteFile::load(&path).unwrap();
+    let orders: Vec<Option<u64>> = file.interactions.iter().map(|i| i.send_order).collect();
+    assert_eq!(orders, [Some(1), Some(0)], "appended as they completed");
+
+    let replayer =
+        CassetteTransport::open(&path, CassetteMode::None, None, CassetteOptions::default()).unwrap();
+    assert_eq!(
+        send_both(Arc::new(replayer)).await,
+        recorded,
+        "each caller gets its own reply"
     );
 }
