@@ -1,7 +1,7 @@
 //! Per-call usage, latency and attempts, aggregated per run, with optional cost.
 
 use std::collections::BTreeMap;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
@@ -63,6 +63,8 @@ pub struct CallRecord {
     pub purpose: Option<String>,
     /// Usage, when known (failed calls that got a body may still have it).
     pub usage: Option<Usage>,
+    /// When the call began (before it waited for a concurrency slot).
+    pub started: Instant,
     /// Wall time, retries included.
     pub latency: Duration,
     /// Attempts made.
@@ -98,8 +100,15 @@ pub struct UsageTotals {
     pub cached_prompt_tokens: u64,
     /// Calls whose server reported no usage.
     pub calls_without_usage: u64,
-    /// Summed wall time in milliseconds.
+    /// Summed wall time in milliseconds: calls in flight together each count in full.
     pub latency_ms_total: f64,
+    /// Wall time in milliseconds during which at least one of these calls was in flight:
+    /// the time spent waiting for answers, which concurrent calls share rather than add up.
+    #[serde(default)]
+    pub waiting_ms_total: f64,
+    /// The calls' intervals behind `waiting_ms_total`, merged and in order.
+    #[serde(skip)]
+    in_flight: Vec<(Instant, Instant)>,
     /// Slowest call in milliseconds.
     pub latency_ms_max: f64,
     /// Cost in US dollars of the priced calls (replayed calls included: they cost this when
@@ -131,12 +140,31 @@ impl UsageTotals {
         }
         let ms = record.latency.as_secs_f64() * 1e3;
         self.latency_ms_total += ms;
+        self.add_in_flight(record.started, record.started + record.latency);
         self.latency_ms_max = self.latency_ms_max.max(ms);
         match cost {
             Some(cost) => self.cost_usd += cost,
             None if record.usage.is_some() => self.unpriced_calls += 1,
             None => {}
         }
+    }
+
+    /// Adds the interval `[start, end)` to the merged intervals and the waiting time.
+    fn add_in_flight(&mut self, start: Instant, end: Instant) {
+        // The merged intervals are disjoint and sorted, so those the new one touches are
+        // consecutive: the first ending at or after `start` up to the last starting by `end`.
+        let first = self.in_flight.partition_point(|&(_, e)| e < start);
+        let last = self.in_flight.partition_point(|&(s, _)| s <= end);
+        let (mut merged_start, mut merged_end) = (start, end);
+        let mut replaced = Duration::ZERO;
+        for &(s, e) in &self.in_flight[first..last] {
+            merged_start = merged_start.min(s);
+            merged_end = merged_end.max(e);
+            replaced += e - s;
+        }
+        self.in_flight.splice(first..last, [(merged_start, merged_end)]);
+        let added = (merged_end - merged_start).saturating_sub(replaced);
+        self.waiting_ms_total += added.as_secs_f64() * 1e3;
     }
 }
 
@@ -218,6 +246,7 @@ mod tests {
             model: "m".into(),
             purpose: Some(purpose.into()),
             usage: Some(usage),
+            started: Instant::now(),
             latency: Duration::from_millis(20),
             attempts,
             origin: Some(origin),
@@ -234,5 +263,24 @@ mod tests {
         assert_eq!(run.total.unpriced_calls, 3);
         assert_eq!(run.by_purpose["induce"].calls, 2);
         assert!((run.total.latency_ms_total - 60.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn calls_in_flight_together_share_their_waiting_time() {
+        let t0 = Instant::now();
+        let at = |ms: u64| t0 + Duration::from_millis(ms);
+        let mut totals = UsageTotals::default();
+        // Recorded as they complete: [0, 100) and [10, 30) overlap, [200, 250) stands
+        // alone, and [90, 210) bridges the gap between them.
+        for (start, end, waiting) in [
+            (10, 30, 20.0),
+            (0, 100, 100.0),
+            (200, 250, 150.0),
+            (90, 210, 250.0),
+        ] {
+            totals.add_in_flight(at(start), at(end));
+            assert!((totals.waiting_ms_total - waiting).abs() < 1e-6, "{totals:?}");
+        }
+        assert_eq!(totals.in_flight, [(at(0), at(250))]);
     }
 }

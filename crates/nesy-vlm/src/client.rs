@@ -392,6 +392,7 @@ impl VlmClient {
             model: self.inner.profile.model.clone(),
             purpose: request.purpose.clone(),
             usage,
+            started: started.into_std(),
             latency: started.elapsed(),
             attempts,
             origin,

@@ -450,10 +450,10 @@ fn account_calls(effort: &mut Effort, counts: &CallCounts, usage: Option<&RunUsa
     effort.images = counts.images;
     effort.calls_by_purpose = counts.by_purpose.clone();
     if let Some(u) = usage {
-        // The calls' summed wall time; a specification that completes replaces it with the
-        // reasoner's own measure, but a unit that fails keeps it, so its model seconds are
-        // not lost.
-        effort.time.vlm_s = u.total.latency_ms_total / 1e3;
+        // The wall time with a call in flight (concurrent calls share it); a specification
+        // that completes replaces it with the method's own measure, but a unit that fails
+        // keeps it, so its model seconds are not lost.
+        effort.time.vlm_s = u.total.waiting_ms_total / 1e3;
         effort.tokens = u.total.prompt_tokens + u.total.completion_tokens;
         effort.cost_usd = u.total.cost_usd;
         effort.cost_by_purpose = u
@@ -682,7 +682,8 @@ mod tests {
     fn a_unit_that_fails_keeps_its_model_seconds() {
         let mut usage = RunUsage::default();
         usage.total.calls = 3;
-        usage.total.latency_ms_total = 4_500.0;
+        usage.total.latency_ms_total = 9_000.0;
+        usage.total.waiting_ms_total = 4_500.0;
         usage.total.prompt_tokens = 100;
         usage.total.completion_tokens = 20;
         let mut effort = Effort::default();

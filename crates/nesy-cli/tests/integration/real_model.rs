@@ -118,6 +118,7 @@ fn strip_times(value: &mut Value) {
             map.retain(|key, _| {
                 !(key.ends_with("_s")
                     || key.ends_with("_ms")
+                    || key.ends_with("_ms_total")
                     || key.contains("latency")
                     || ORIGIN_COUNTS.contains(&key.as_str()))
             });

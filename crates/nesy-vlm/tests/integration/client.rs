@@ -572,7 +572,16 @@ async fn concurrency_cap_is_enforced() {
         let client = VlmClient::with_transport(&cfg, counter.clone());
         let started = std::time::Instant::now();
         let results = futures::future::join_all((0..calls).map(|_| client.chat(simple_request()))).await;
+        let wall_ms = started.elapsed().as_secs_f64() * 1e3;
         assert!(results.iter().all(Result::is_ok));
+        // Calls in flight together share their waiting time; their latencies add up.
+        let usage = client.usage().total;
+        assert!(usage.latency_ms_total >= calls as f64 * 150.0, "{usage:?}");
+        assert!(
+            (150.0..=wall_ms).contains(&usage.waiting_ms_total),
+            "waited {} ms of {wall_ms} ms",
+            usage.waiting_ms_total
+        );
         let max = counter.max.load(Ordering::SeqCst);
         if cap == 2 {
             assert_eq!(max, 2, "at most two calls in flight");
