@@ -2,6 +2,7 @@
 
 use std::fmt;
 use std::sync::Once;
+use std::time::Duration;
 
 use reqwest::header::{CONTENT_TYPE, HeaderMap, HeaderValue};
 
@@ -33,6 +34,8 @@ impl fmt::Debug for Auth {
     }
 }
 
+/// The waits between tries of reading what a server announces (three tries in all).
+const PROBE_RETRY_WAITS: [Duration; 2] = [Duration::from_millis(500), Duration::from_millis(1500)];
 /// Sends wire requests to an OpenAI-compatible server.
 pub struct HttpTransport {
     client: reqwest::Client,
@@ -133,20 +136,49 @@ impl HttpTransport {
         self
     }
 
+    /// GETs a JSON document, trying again after a short wait when the failure may pass (a
+    /// connection or timeout error, a 5xx or 429 such as a server still loading its model):
+    /// a missed announcement would send pictures to a text-only server for the whole run.
     async fn get_json(&self, url: &str) -> Result<serde_json::Value, String> {
+        let mut waits = PROBE_RETRY_WAITS.iter();
+        loop {
+            match self.get_json_once(url).await {
+                Err((error, true)) => match waits.next() {
+                    Some(wait) => {
+                        tracing::debug!("reading {url} failed ({error}); trying again in {wait:?}");
+                        tokio::time::sleep(*wait).await;
+                    }
+                    None => return Err(error),
+                },
+                other => return other.map_err(|(error, _)| error),
+            }
+        }
+    }
+
+    /// One GET; an error says whether it may pass on a second try.
+    async fn get_json_once(&self, url: &str) -> Result<serde_json::Value, (String, bool)> {
         let response = self
             .client
             .get(url)
             .headers(self.auth_headers.clone())
             .send()
             .await
-            .map_err(|e| classify(e).to_string())?;
+            .map_err(|e| {
+                let error = classify(e);
+                let transient = error.is_retryable();
+                (error.to_string(), transient)
+            })?;
         let status = response.status();
         if !status.is_success() {
-            return Err(format!("HTTP {}", status.as_u16()));
+            let transient = status.is_server_error() || status.as_u16() == 429;
+            return Err((format!("HTTP {}", status.as_u16()), transient));
         }
-        let bytes = response.bytes().await.map_err(|e| classify(e).to_string())?;
-        serde_json::from_slice(&bytes).map_err(|e| format!("not JSON: {e}"))
+        let bytes = response.bytes().await.map_err(|e| {
+            let error = classify(e);
+            let transient = error.is_retryable();
+            (error.to_string(), transient)
+        })?;
+        serde_json::from_slice(&bytes).map_err(|e| (format!("not JSON: {e}"), false))
     }
 
     async fn probe_capabilities(&self) -> ServerCapabilities {

@@ -418,3 +418,36 @@ async fn a_refusal_that_gives_no_count_is_not_sent_again() {
     assert!(matches!(error, VlmError::Http { status: 400, .. }), "{error}");
     assert_eq!(posted_bodies(&server).await.len(), 1);
 }
+
+#[tokio::test]
+async fn an_announcement_that_fails_once_is_read_on_a_second_try() {
+    let server = chat_server().await;
+    // A server still loading its model answers 503 at first.
+    Mock::given(method("GET"))
+        .and(path("/props"))
+        .respond_with(ResponseTemplate::new(503).set_body_string("Loading model"))
+        .up_to_n_times(1)
+        .with_priority(1)
+        .mount(&server)
+        .await;
+    Mock::given(method("GET"))
+        .and(path("/props"))
+        .respond_with(ResponseTemplate::new(200).set_body_json(json!({
+            "default_generation_settings": {"n_ctx": 2048},
+            "modalities": {"vision": false}
+        })))
+        .with_priority(2)
+        .mount(&server)
+        .await;
+    let cfg = config(BackendKind::LlamaCpp, "m", &format!("{}/v1", server.uri()));
+    let caps = VlmClient::from_config(&cfg).unwrap().capabilities().await;
+    assert_eq!((caps.images, caps.context_tokens), (Some(false), Some(2048)));
+
+    // A server without `/props` (404) is not asked again: it announces nothing.
+    let bare = chat_server().await;
+    let cfg = config(BackendKind::LlamaCpp, "m", &format!("{}/v1", bare.uri()));
+    let caps = VlmClient::from_config(&cfg).unwrap().capabilities().await;
+    assert_eq!(caps, nesy_vlm::ServerCapabilities::UNKNOWN);
+    let asked = bare.received_requests().await.unwrap();
+    assert_eq!(asked.iter().filter(|r| r.url.path() == "/props").count(), 1);
+}
