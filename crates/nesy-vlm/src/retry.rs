@@ -45,7 +45,13 @@ pub(crate) fn status_is_retryable(response: &WireResponse, provider: &ProviderEr
         Some(v) if v.eq_ignore_ascii_case("false") => return false,
         _ => {}
     }
-    matches!(response.status, 408 | 409 | 429) || response.status >= 500
+    status_may_pass(response.status)
+}
+
+/// Whether an HTTP status says the failure may pass on its own (a timeout, a conflict, rate
+/// limiting, a server error), whatever the body says.
+pub(crate) fn status_may_pass(status: u16) -> bool {
+    matches!(status, 408 | 409 | 429) || status >= 500
 }
 
 impl RetryPolicy {

@@ -2,7 +2,7 @@
 //! images as content references; responses stored whole (a JSON body is embedded verbatim,
 //! so replay is byte-identical); only allowlisted headers.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::fs;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -13,7 +13,8 @@ use bytes::Bytes;
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 
-use super::CassetteError;
+use super::canonical::request_key;
+use super::{CassetteError, InteractionRef};
 use crate::constraint::ConstrainMode;
 use crate::secret::SecretString;
 use crate::transport::{Origin, WireResponse, is_allowed_header};
@@ -255,6 +256,28 @@ impl CassetteFile {
         let mut indices: Vec<usize> = (0..self.interactions.len()).collect();
         indices.sort_by_key(|&index| (self.interactions[index].sent_at_or(index), index));
         indices
+    }
+
+    /// Each interaction's reference, in file order: its request key, and which recording of
+    /// that key it is, counted in `sequence` (the [`Self::send_sequence`]), the order a
+    /// replay serves identical requests in.
+    pub(crate) fn references(&self, sequence: &[usize]) -> Vec<InteractionRef> {
+        let keys: Vec<String> = self
+            .interactions
+            .iter()
+            .map(|interaction| request_key(&interaction.request.path, &interaction.request.body))
+            .collect();
+        let mut occurrences = vec![0; keys.len()];
+        let mut seen: HashMap<&str, usize> = HashMap::new();
+        for &index in sequence {
+            let count = seen.entry(keys[index].as_str()).or_default();
+            occurrences[index] = *count;
+            *count += 1;
+        }
+        keys.into_iter()
+            .zip(occurrences)
+            .map(|(key, occurrence)| InteractionRef { key, occurrence })
+            .collect()
     }
 
     /// The send-order number the next call recorded into this file gets: one past the

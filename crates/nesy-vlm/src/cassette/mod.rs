@@ -39,7 +39,7 @@ pub use format::{
     CassetteFile, CassetteMeta, Interaction, SCHEMA_VERSION, StoredRequest, StoredResponse, blobs_dir,
 };
 
-use canonical::{Canonical, canonicalize, request_key};
+use canonical::{Canonical, canonicalize};
 use format::{FileLock, write_atomically, write_blob};
 
 /// Record/replay mode (vcrpy's names).
@@ -303,8 +303,9 @@ impl CassetteTransport {
             recorded_constrain = file.meta.constrain;
             next_send = file.next_send_order();
             let sequence = file.send_sequence();
-            for (index, interaction) in file.interactions.into_iter().enumerate() {
-                let key = request_key(&interaction.request.path, &interaction.request.body);
+            let references = file.references(&sequence);
+            for ((index, interaction), reference) in file.interactions.into_iter().enumerate().zip(references)
+            {
                 let response = interaction
                     .response
                     .to_wire(Origin::Replayed)
@@ -313,8 +314,8 @@ impl CassetteTransport {
                         message: format!("interaction #{index}: {message}"),
                     })?;
                 recorded.push(Recorded {
-                    key,
-                    occurrence: 0,
+                    key: reference.key,
+                    occurrence: reference.occurrence,
                     path: interaction.request.path,
                     body: interaction.request.body,
                     purpose: interaction.purpose,
@@ -322,9 +323,8 @@ impl CassetteTransport {
                 });
             }
             for index in sequence {
-                let queue = state.queues.entry(recorded[index].key.clone()).or_default();
-                recorded[index].occurrence = queue.len();
-                queue.push_back(index);
+                let key = recorded[index].key.clone();
+                state.queues.entry(key).or_default().push_back(index);
             }
             state.used = vec![false; recorded.len()];
         }

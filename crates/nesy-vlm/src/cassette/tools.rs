@@ -278,18 +278,7 @@ pub fn prune(
     let mut file = CassetteFile::load(path)?;
     let used: BTreeSet<&InteractionRef> = usage.used.iter().collect();
     // Occurrences count in send order, as the replay that wrote the usage report did.
-    let mut references: Vec<Option<InteractionRef>> = vec![None; file.interactions.len()];
-    let mut occurrences: HashMap<String, usize> = HashMap::new();
-    for index in file.send_sequence() {
-        let request = &file.interactions[index].request;
-        let key = request_key(&request.path, &request.body);
-        let occurrence = occurrences.entry(key.clone()).or_default();
-        references[index] = Some(InteractionRef {
-            key,
-            occurrence: *occurrence,
-        });
-        *occurrence += 1;
-    }
+    let references = file.references(&file.send_sequence());
     let mut dropped = Vec::new();
     let mut kept = Vec::new();
     for ((index, interaction), reference) in std::mem::take(&mut file.interactions)
@@ -297,7 +286,7 @@ pub fn prune(
         .enumerate()
         .zip(references)
     {
-        if reference.is_some_and(|reference| used.contains(&reference)) {
+        if used.contains(&reference) {
             kept.push(interaction)
         } else {
             dropped.push(index)

@@ -11,6 +11,7 @@ use crate::capabilities::ServerCapabilities;
 use crate::config::Timeouts;
 use crate::error::{TimeoutPhase, TransportError};
 use crate::profile::BackendKind;
+use crate::retry::status_may_pass;
 use crate::secret::SecretString;
 
 /// How requests authenticate.
@@ -36,6 +37,7 @@ impl fmt::Debug for Auth {
 
 /// The waits between tries of reading what a server announces (three tries in all).
 const PROBE_RETRY_WAITS: [Duration; 2] = [Duration::from_millis(500), Duration::from_millis(1500)];
+
 /// Sends wire requests to an OpenAI-compatible server.
 pub struct HttpTransport {
     client: reqwest::Client,
@@ -137,7 +139,8 @@ impl HttpTransport {
     }
 
     /// GETs a JSON document, trying again after a short wait when the failure may pass (a
-    /// connection or timeout error, a 5xx or 429 such as a server still loading its model):
+    /// connection or timeout error, a status such as a 503 from a server still loading its
+    /// model):
     /// a missed announcement would send pictures to a text-only server for the whole run.
     async fn get_json(&self, url: &str) -> Result<serde_json::Value, String> {
         let mut waits = PROBE_RETRY_WAITS.iter();
@@ -163,21 +166,12 @@ impl HttpTransport {
             .headers(self.auth_headers.clone())
             .send()
             .await
-            .map_err(|e| {
-                let error = classify(e);
-                let transient = error.is_retryable();
-                (error.to_string(), transient)
-            })?;
-        let status = response.status();
-        if !status.is_success() {
-            let transient = status.is_server_error() || status.as_u16() == 429;
-            return Err((format!("HTTP {}", status.as_u16()), transient));
+            .map_err(described)?;
+        let status = response.status().as_u16();
+        if !response.status().is_success() {
+            return Err((format!("HTTP {status}"), status_may_pass(status)));
         }
-        let bytes = response.bytes().await.map_err(|e| {
-            let error = classify(e);
-            let transient = error.is_retryable();
-            (error.to_string(), transient)
-        })?;
+        let bytes = response.bytes().await.map_err(described)?;
         serde_json::from_slice(&bytes).map_err(|e| (format!("not JSON: {e}"), false))
     }
 
@@ -252,6 +246,13 @@ fn secret_header(value: &str) -> Result<HeaderValue, String> {
         .map_err(|_| "the API key contains characters not allowed in a header")?;
     header.set_sensitive(true);
     Ok(header)
+}
+
+/// A failed GET of an announcement as (what went wrong, whether it may pass).
+fn described(err: reqwest::Error) -> (String, bool) {
+    let error = classify(err);
+    let may_pass = error.is_retryable();
+    (error.to_string(), may_pass)
 }
 
 fn classify(err: reqwest::Error) -> TransportError {
