@@ -80,13 +80,14 @@ impl Readability {
             let Some(purpose) = interaction.purpose.as_deref() else {
                 continue;
             };
-            if !READ_PURPOSES.contains(&purpose) || interaction.response.status != 200 {
+            if !READ_PURPOSES.contains(&purpose) {
                 continue;
             }
             let Some(response) = interaction
                 .response
-                .body
                 .as_ref()
+                .filter(|response| response.status == 200)
+                .and_then(|response| response.body.as_ref())
                 .and_then(|raw| serde_json::from_str::<Value>(raw.get()).ok())
             else {
                 continue;

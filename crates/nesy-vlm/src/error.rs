@@ -407,7 +407,8 @@ pub(crate) fn truncate_chars(text: &str, max: usize) -> String {
 }
 
 /// Which timeout fired.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum TimeoutPhase {
     /// Establishing the connection.
     Connect,

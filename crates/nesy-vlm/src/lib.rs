@@ -64,7 +64,8 @@ pub use cassette::tools as cassette_tools;
 pub use cassette::{
     CassetteError, CassetteFile, CassetteMeta, CassetteMiss, CassetteMode, CassetteOptions,
     CassetteTransport, Interaction, InteractionRef, JsonDiff, MissReason, NearMatch,
-    SCHEMA_VERSION as CASSETTE_SCHEMA_VERSION, StoredRequest, StoredResponse, UsageReport, blobs_dir,
+    SCHEMA_VERSION as CASSETTE_SCHEMA_VERSION, StoredFailure, StoredRequest, StoredResponse, UsageReport,
+    blobs_dir,
 };
 pub use client::VlmClient;
 pub use config::{

@@ -239,7 +239,10 @@ fn inspect(cassette: &std::path::Path, json: bool) -> anyhow::Result<ExitCode> {
             call.messages,
             call.images,
             call.status,
-            call.finish_reason.as_deref().unwrap_or("-"),
+            call.finish_reason
+                .as_deref()
+                .or(call.failure.as_deref())
+                .unwrap_or("-"),
             call.prompt_tokens,
             call.completion_tokens,
             call.reasoning_tokens,

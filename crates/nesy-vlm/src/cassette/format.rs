@@ -16,6 +16,7 @@ use serde_json::value::RawValue;
 use super::canonical::request_key;
 use super::{CassetteError, InteractionRef};
 use crate::constraint::ConstrainMode;
+use crate::error::{TimeoutPhase, TransportError};
 use crate::secret::SecretString;
 use crate::transport::{Origin, WireResponse, is_allowed_header};
 
@@ -82,13 +83,102 @@ pub struct Interaction {
     pub send_order: Option<u64>,
     /// The request.
     pub request: StoredRequest,
-    /// The response.
-    pub response: StoredResponse,
+    /// The response; absent when the attempt got none, and then [`Interaction::failure`]
+    /// says why. A file holds exactly one of the two per interaction.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub response: Option<StoredResponse>,
+    /// Why a sent attempt got no response.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failure: Option<StoredFailure>,
 }
 
 impl Interaction {
     fn sent_at_or(&self, position: usize) -> u64 {
         self.send_order.unwrap_or(position as u64)
+    }
+
+    /// The recorded response, or the failure that took its place.
+    pub fn outcome(&self) -> Result<&StoredResponse, &StoredFailure> {
+        match (&self.response, &self.failure) {
+            (Some(response), _) => Ok(response),
+            (None, Some(failure)) => Err(failure),
+            // `CassetteFile::parse` refuses such an interaction; one built in code is
+            // read as a response with no body, which verification reports.
+            (None, None) => Ok(&EMPTY_RESPONSE),
+        }
+    }
+}
+
+static EMPTY_RESPONSE: StoredResponse = StoredResponse {
+    status: 0,
+    headers: BTreeMap::new(),
+    body: None,
+    body_text: None,
+    body_base64: None,
+};
+
+/// An attempt that was sent and got no HTTP response: a timeout, a refused or reset
+/// connection, a body cut short. Recorded so that a replay fails the same attempt the same
+/// way and the retry layer above the cassette retries (or gives up) as it did live; without
+/// it a replay would count fewer attempts than the run it reproduces. Failures that never
+/// reached the network (a call cap, a shutdown) are not recorded.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum StoredFailure {
+    /// A timeout fired.
+    Timeout {
+        /// Which timeout.
+        phase: TimeoutPhase,
+        /// The transport's message.
+        message: String,
+    },
+    /// The connection could not be established or was lost before a response.
+    Connect {
+        /// The transport's message.
+        message: String,
+    },
+    /// The response body could not be read to the end.
+    Body {
+        /// The transport's message.
+        message: String,
+    },
+}
+
+impl StoredFailure {
+    /// Its kind as the file names it: `timeout`, `connect` or `body`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Timeout { .. } => "timeout",
+            Self::Connect { .. } => "connect",
+            Self::Body { .. } => "body",
+        }
+    }
+
+    /// The failure as a cassette stores it, for the transport errors that mean a sent
+    /// attempt got no response; `None` for the others.
+    pub fn from_transport(error: &TransportError) -> Option<Self> {
+        match error {
+            TransportError::Timeout { phase, message } => Some(Self::Timeout {
+                phase: *phase,
+                message: message.clone(),
+            }),
+            TransportError::Connect(message) => Some(Self::Connect {
+                message: message.clone(),
+            }),
+            TransportError::Body(message) => Some(Self::Body {
+                message: message.clone(),
+            }),
+            TransportError::Cassette(_) | TransportError::Declined(_) | TransportError::Failed { .. } => None,
+        }
+    }
+
+    /// The transport error a replay returns for it.
+    pub fn to_transport(&self) -> TransportError {
+        match self.clone() {
+            Self::Timeout { phase, message } => TransportError::Timeout { phase, message },
+            Self::Connect { message } => TransportError::Connect(message),
+            Self::Body { message } => TransportError::Body(message),
+        }
     }
 }
 
@@ -246,7 +336,19 @@ impl CassetteFile {
                 });
             }
         }
-        serde_json::from_str(text).map_err(parse_error)
+        let file: Self = serde_json::from_str(text).map_err(parse_error)?;
+        for (index, interaction) in file.interactions.iter().enumerate() {
+            let problem = match (&interaction.response, &interaction.failure) {
+                (Some(_), None) | (None, Some(_)) => continue,
+                (None, None) => "has neither `response` nor `failure`",
+                (Some(_), Some(_)) => "has both `response` and `failure`; expected one of them",
+            };
+            return Err(CassetteError::Schema {
+                path: path.to_path_buf(),
+                message: format!("interaction #{index} {problem}"),
+            });
+        }
+        Ok(file)
     }
 
     /// The interactions' indices in the order their calls were sent: by
@@ -456,12 +558,17 @@ mod tests {
                         path: "/p".into(),
                         body: serde_json::Value::Null,
                     },
-                    response: stored,
+                    response: Some(stored),
+                    failure: None,
                 }],
             };
             let text = file.to_pretty_json(&[]);
             let back = CassetteFile::parse(Path::new("c.json"), &text).unwrap();
-            let replayed = back.interactions[0].response.to_wire(Origin::Replayed).unwrap();
+            let replayed = back.interactions[0]
+                .outcome()
+                .unwrap()
+                .to_wire(Origin::Replayed)
+                .unwrap();
             assert_eq!(&replayed.body[..], body, "{text}");
         }
     }
@@ -481,6 +588,74 @@ mod tests {
     }
 
     #[test]
+    fn an_interaction_holds_exactly_one_of_response_and_failure() {
+        let file = |outcome: &str| {
+            format!(
+                r#"{{"schema_version": 1,
+                "meta": {{"recorder": "r", "created_at": "t", "updated_at": "t"}},
+                "interactions": [{{"key": "k", "recorded_at": "t", "latency_ms": 1.0,
+                    "request": {{"method": "POST", "path": "/p", "body": null}}{outcome}}}]}}"#
+            )
+        };
+        let response = r#""response": {"status": 200, "body": {}}"#;
+        let failure =
+            r#""failure": {"kind": "timeout", "phase": "response", "message": "no reply in 1800 s"}"#;
+        let read = CassetteFile::parse(Path::new("c.json"), &file(&format!(", {failure}"))).unwrap();
+        assert_eq!(
+            read.interactions[0]
+                .outcome()
+                .unwrap_err()
+                .to_transport()
+                .to_string(),
+            "timed out (Response timeout): no reply in 1800 s"
+        );
+        for (outcome, expected) in [
+            (
+                String::new(),
+                "interaction #0 has neither `response` nor `failure`",
+            ),
+            (
+                format!(", {response}, {failure}"),
+                "interaction #0 has both `response` and `failure`",
+            ),
+        ] {
+            let err = CassetteFile::parse(Path::new("c.json"), &file(&outcome)).unwrap_err();
+            assert!(err.to_string().contains(expected), "{err}");
+        }
+    }
+
+    #[test]
+    fn only_failures_that_reached_the_network_are_stored() {
+        let timeout = TransportError::Timeout {
+            phase: TimeoutPhase::Connect,
+            message: "connect".into(),
+        };
+        let stored = StoredFailure::from_transport(&timeout).unwrap();
+        assert_eq!(
+            serde_json::to_value(&stored).unwrap(),
+            serde_json::json!({"kind": "timeout", "phase": "connect", "message": "connect"})
+        );
+        assert_eq!(stored.to_transport().to_string(), timeout.to_string());
+        for (error, kind) in [
+            (TransportError::Connect("refused".into()), "connect"),
+            (TransportError::Body("reset".into()), "body"),
+        ] {
+            let stored = StoredFailure::from_transport(&error).unwrap();
+            assert_eq!(serde_json::to_value(&stored).unwrap()["kind"], kind);
+            assert!(stored.to_transport().is_retryable());
+        }
+        let not_sent = TransportError::Failed {
+            message: "the unit's cap of 3 model call(s) is reached".into(),
+            retryable: false,
+        };
+        assert_eq!(StoredFailure::from_transport(&not_sent), None);
+        assert_eq!(
+            StoredFailure::from_transport(&TransportError::Declined("no".into())),
+            None
+        );
+    }
+
+    #[test]
     fn send_order_sorts_replay_and_an_old_file_counts_by_position() {
         let call = |send_order: Option<u64>| Interaction {
             key: "k".into(),
@@ -493,7 +668,12 @@ mod tests {
                 path: "/p".into(),
                 body: serde_json::Value::Null,
             },
-            response: StoredResponse::from_wire(&WireResponse::new(200, b"{}".to_vec(), Origin::Live)),
+            response: Some(StoredResponse::from_wire(&WireResponse::new(
+                200,
+                b"{}".to_vec(),
+                Origin::Live,
+            ))),
+            failure: None,
         };
         let mut file = CassetteFile::new(None, None);
         assert_eq!(file.next_send_order(), 0);

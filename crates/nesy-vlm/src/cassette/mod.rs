@@ -36,7 +36,8 @@ pub mod tools;
 pub(crate) use diff::json_diff;
 pub use diff::{CassetteMiss, JsonDiff, MissReason, NearMatch};
 pub use format::{
-    CassetteFile, CassetteMeta, Interaction, SCHEMA_VERSION, StoredRequest, StoredResponse, blobs_dir,
+    CassetteFile, CassetteMeta, Interaction, SCHEMA_VERSION, StoredFailure, StoredRequest, StoredResponse,
+    blobs_dir,
 };
 
 use canonical::{Canonical, canonicalize};
@@ -218,7 +219,8 @@ struct Recorded {
     path: String,
     body: serde_json::Value,
     purpose: Option<String>,
-    response: WireResponse,
+    /// The response, or the failure a replay returns in its place.
+    outcome: Result<WireResponse, StoredFailure>,
 }
 
 #[derive(Default)]
@@ -306,20 +308,23 @@ impl CassetteTransport {
             let references = file.references(&sequence);
             for ((index, interaction), reference) in file.interactions.into_iter().enumerate().zip(references)
             {
-                let response = interaction
-                    .response
-                    .to_wire(Origin::Replayed)
-                    .map_err(|message| CassetteError::Schema {
-                        path: path.clone(),
-                        message: format!("interaction #{index}: {message}"),
-                    })?;
+                let outcome =
+                    match interaction.outcome() {
+                        Ok(response) => Ok(response.to_wire(Origin::Replayed).map_err(|message| {
+                            CassetteError::Schema {
+                                path: path.clone(),
+                                message: format!("interaction #{index}: {message}"),
+                            }
+                        })?),
+                        Err(failure) => Err(failure.clone()),
+                    };
                 recorded.push(Recorded {
                     key: reference.key,
                     occurrence: reference.occurrence,
                     path: interaction.request.path,
                     body: interaction.request.body,
                     purpose: interaction.purpose,
-                    response,
+                    outcome,
                 });
             }
             for index in sequence {
@@ -372,7 +377,12 @@ impl CassetteTransport {
             .collect()
     }
 
-    fn try_replay(&self, canonical: &Canonical) -> Result<Option<WireResponse>, usize> {
+    /// What the cassette holds for this request: `Ok(None)` when it holds nothing, the
+    /// number of recordings when every one was used.
+    fn try_replay(
+        &self,
+        canonical: &Canonical,
+    ) -> Result<Option<Result<WireResponse, TransportError>>, usize> {
         let mut state = self
             .replay
             .lock()
@@ -381,18 +391,25 @@ impl CassetteTransport {
             Some(queue) => match queue.pop_front() {
                 Some(index) => {
                     state.used[index] = true;
-                    Ok(Some(self.recorded[index].response.clone()))
+                    Ok(Some(self.replayed(index)))
                 }
                 None => {
                     let last = self.recorded.iter().rposition(|r| r.key == canonical.key);
                     match last.filter(|_| self.options.allow_playback_repeats) {
-                        Some(index) => Ok(Some(self.recorded[index].response.clone())),
+                        Some(index) => Ok(Some(self.replayed(index))),
                         None => Err(self.recorded.iter().filter(|r| r.key == canonical.key).count()),
                     }
                 }
             },
             None => Ok(None),
         }
+    }
+
+    fn replayed(&self, index: usize) -> Result<WireResponse, TransportError> {
+        self.recorded[index]
+            .outcome
+            .clone()
+            .map_err(|failure| failure.to_transport())
     }
 
     fn miss(&self, request: &WireRequest, canonical: &Canonical, exhausted: Option<usize>) -> CassetteError {
@@ -435,7 +452,7 @@ impl CassetteTransport {
         let mut exhausted = None;
         if self.replays {
             match self.try_replay(&canonical) {
-                Ok(Some(response)) => return Ok(response),
+                Ok(Some(outcome)) => return outcome,
                 Ok(None) => {}
                 Err(recorded) => exhausted = Some(recorded),
             }
@@ -447,24 +464,29 @@ impl CassetteTransport {
         // they were issued, which is the order a replay issues them in.
         let send_order = self.next_send.fetch_add(1, Ordering::Relaxed);
         let started = Instant::now();
-        let response = inner.send(request).await?;
-        self.append(
-            request,
-            canonical,
-            &response,
-            Sent {
-                order: send_order,
-                latency_ms: started.elapsed().as_secs_f64() * 1e3,
-            },
-        )?;
-        Ok(response)
+        let result = inner.send(request).await;
+        let sent = Sent {
+            order: send_order,
+            latency_ms: started.elapsed().as_secs_f64() * 1e3,
+        };
+        match &result {
+            Ok(response) => self.append(request, canonical, Ok(response), sent)?,
+            Err(error) => {
+                // A sent attempt that got no response is kept too, so that a replay fails it
+                // the same way; an error that never reached the network is not.
+                if let Some(failure) = StoredFailure::from_transport(error) {
+                    self.append(request, canonical, Err(failure), sent)?;
+                }
+            }
+        }
+        result
     }
 
     fn append(
         &self,
         request: &WireRequest,
         canonical: Canonical,
-        response: &WireResponse,
+        outcome: Result<&WireResponse, StoredFailure>,
         sent: Sent,
     ) -> Result<(), CassetteError> {
         let blobs = blobs_dir(&self.path);
@@ -484,7 +506,11 @@ impl CassetteTransport {
                 path: request.path.clone(),
                 body: canonical.body,
             },
-            response: StoredResponse::from_wire(response),
+            response: outcome
+                .as_ref()
+                .ok()
+                .map(|response| StoredResponse::from_wire(response)),
+            failure: outcome.err(),
         };
         self.write_with(Some(interaction))
     }

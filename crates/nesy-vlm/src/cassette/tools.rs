@@ -33,8 +33,10 @@ pub struct InteractionSummary {
     pub messages: usize,
     /// Images in the request.
     pub images: usize,
-    /// Response status.
+    /// Response status; 0 when the attempt got no response.
     pub status: u16,
+    /// Why the attempt got no response (`timeout`, `connect`, `body`), if it got none.
+    pub failure: Option<String>,
     /// `choices[0].finish_reason`, if the body has one.
     pub finish_reason: Option<String>,
     /// Usage from the response body.
@@ -87,8 +89,8 @@ pub fn inspect(path: &Path) -> Result<Inspection, CassetteError> {
         blobs.extend(refs.iter().cloned());
         let response: Option<Value> = interaction
             .response
-            .body
             .as_ref()
+            .and_then(|response| response.body.as_ref())
             .and_then(|raw| serde_json::from_str(raw.get()).ok());
         let usage = |pointer: &str| {
             response
@@ -106,7 +108,14 @@ pub fn inspect(path: &Path) -> Result<Inspection, CassetteError> {
             model,
             messages: body.get("messages").and_then(Value::as_array).map_or(0, Vec::len),
             images: refs.len(),
-            status: interaction.response.status,
+            status: interaction
+                .response
+                .as_ref()
+                .map_or(0, |response| response.status),
+            failure: interaction
+                .failure
+                .as_ref()
+                .map(|failure| failure.kind().to_string()),
             finish_reason: response
                 .as_ref()
                 .and_then(|r| r.pointer("/choices/0/finish_reason"))
@@ -173,26 +182,29 @@ pub fn verify(path: &Path) -> Result<Vec<Problem>, CassetteError> {
                 ),
             });
         }
-        match interaction.response.to_wire(crate::transport::Origin::Replayed) {
-            Err(message) => problems.push(Problem {
-                interaction: at,
-                message: format!("response: {message}"),
-            }),
-            // A replayed success must be a completion; an empty one fails every replay.
-            Ok(wire) if wire.is_success() && wire.body.is_empty() => problems.push(Problem {
-                interaction: at,
-                message: format!("response: status {} with no body", wire.status),
-            }),
-            Ok(_) => {}
-        }
-        for name in interaction.response.headers.keys() {
-            if !crate::transport::is_allowed_header(name) {
-                problems.push(Problem {
+        // A recorded failure has no response to decode; `CassetteFile::parse` checked its shape.
+        if let Some(response) = &interaction.response {
+            match response.to_wire(crate::transport::Origin::Replayed) {
+                Err(message) => problems.push(Problem {
                     interaction: at,
-                    message: format!(
-                        "response header `{name}` is not on the allowlist (a recorder never stores it; it may hold a credential)"
-                    ),
-                });
+                    message: format!("response: {message}"),
+                }),
+                // A replayed success must be a completion; an empty one fails every replay.
+                Ok(wire) if wire.is_success() && wire.body.is_empty() => problems.push(Problem {
+                    interaction: at,
+                    message: format!("response: status {} with no body", wire.status),
+                }),
+                Ok(_) => {}
+            }
+            for name in response.headers.keys() {
+                if !crate::transport::is_allowed_header(name) {
+                    problems.push(Problem {
+                        interaction: at,
+                        message: format!(
+                            "response header `{name}` is not on the allowlist (a recorder never stores it; it may hold a credential)"
+                        ),
+                    });
+                }
             }
         }
         let mut refs = Vec::new();

@@ -115,7 +115,8 @@ async fn record_then_replay_is_byte_identical_and_offline() {
     assert!(file.meta.recorder.starts_with("nesy-vlm "));
     assert_eq!(file.interactions[1].purpose.as_deref(), Some("induce"));
     let headers: Vec<&str> = file.interactions[0]
-        .response
+        .outcome()
+        .unwrap()
         .headers
         .keys()
         .map(String::as_str)
@@ -560,5 +561,66 @@ async fn identical_concurrent_requests_replay_in_the_order_they_were_sent() {
         send_both(Arc::new(replayer)).await,
         recorded,
         "each caller gets its own reply"
+    );
+}
+
+/// Gets no response to its first attempt (the read timeout fires), then answers.
+#[derive(Debug, Default)]
+struct TimesOutOnce {
+    sent: std::sync::atomic::AtomicUsize,
+}
+
+impl Transport for TimesOutOnce {
+    fn send<'a>(&'a self, _request: &'a WireRequest) -> BoxFuture<'a, Result<WireResponse, TransportError>> {
+        let n = self.sent.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        Box::pin(async move {
+            if n == 0 {
+                return Err(TransportError::Timeout {
+                    phase: nesy_vlm::TimeoutPhase::Response,
+                    message: "operation timed out".into(),
+                });
+            }
+            let body = serde_json::to_vec(&completion("(On a b)")).unwrap();
+            Ok(WireResponse::new(200, body, Origin::Live))
+        })
+    }
+
+    fn label(&self) -> String {
+        "times out once".into()
+    }
+}
+
+#[tokio::test]
+async fn an_attempt_that_got_no_response_replays_as_the_same_failure() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("timeout.json");
+    let base = config(BackendKind::LlamaCpp, "gemma", "http://127.0.0.1:9");
+
+    let live: Arc<dyn Transport> = Arc::new(TimesOutOnce::default());
+    let recorder =
+        VlmClient::from_config_over(&with_cassette(base.clone(), &path, CassetteMode::All), live).unwrap();
+    let recorded = recorder.chat(request("a slow keyframe", &[])).await.unwrap();
+    let recorded_usage = recorder.finish().unwrap();
+    assert_eq!(recorded_usage.total.attempts, 2, "the retry layer tried twice");
+
+    let file = CassetteFile::load(&path).unwrap();
+    let kinds: Vec<&str> = file
+        .interactions
+        .iter()
+        .map(|i| i.outcome().map_or_else(|failure| failure.kind(), |_| "response"))
+        .collect();
+    assert_eq!(kinds, ["timeout", "response"]);
+    assert!(tools::verify(&path).unwrap().is_empty());
+    let listed = tools::inspect(&path).unwrap();
+    assert_eq!(listed.interactions[0].status, 0);
+    assert_eq!(listed.interactions[0].failure.as_deref(), Some("timeout"));
+
+    let replayer = VlmClient::from_config(&with_cassette(base, &path, CassetteMode::None)).unwrap();
+    let replayed = replayer.chat(request("a slow keyframe", &[])).await.unwrap();
+    assert_eq!(replayed.text, recorded.text);
+    let replayed_usage = replayer.finish().unwrap();
+    assert_eq!(
+        replayed_usage.total.attempts, recorded_usage.total.attempts,
+        "the replay fails the first attempt as the live run did"
     );
 }
