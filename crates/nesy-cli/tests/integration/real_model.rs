@@ -129,8 +129,10 @@ fn strip_times(value: &mut Value) {
     }
 }
 
-/// The calls a run made, from its summary or its failure record.
-fn calls_made(run: &Path) -> u64 {
+/// The attempts a run's calls made (retries included), from its summary or its failure
+/// record: each one reached the server and is in the cassette, with its response or, when
+/// it got none, its failure.
+fn attempts_made(run: &Path) -> u64 {
     let file = ["summary.json", "failure.json"]
         .iter()
         .map(|name| run.join(name))
@@ -138,11 +140,11 @@ fn calls_made(run: &Path) -> u64 {
         .unwrap_or_else(|| panic!("{} holds neither summary.json nor failure.json", run.display()));
     let value: Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
     let total = value
-        .pointer("/usage/total/calls")
-        .or_else(|| value.pointer("/calls/total/calls"));
+        .pointer("/usage/total/attempts")
+        .or_else(|| value.pointer("/calls/total/attempts"));
     total
         .and_then(Value::as_u64)
-        .unwrap_or_else(|| panic!("{}: no call count", file.display()))
+        .unwrap_or_else(|| panic!("{}: no attempt count", file.display()))
 }
 
 fn adapt_args(codegen: &str, out: &Path, vlm: Option<String>, record: Option<&Path>) -> Vec<String> {
@@ -210,8 +212,8 @@ fn live_then_replayed(codegen: &str) {
     let recorded = nesy_vlm::CassetteFile::load(&cassette).expect("the run recorded a cassette");
     assert_eq!(
         recorded.interactions.len() as u64,
-        calls_made(&live),
-        "every call the run made is in its cassette"
+        attempts_made(&live),
+        "every attempt the run made is in its cassette"
     );
 
     let replay = format!("replay:{}", cassette.display());
