@@ -97,25 +97,18 @@ impl Interaction {
         self.send_order.unwrap_or(position as u64)
     }
 
-    /// The recorded response, or the failure that took its place.
-    pub fn outcome(&self) -> Result<&StoredResponse, &StoredFailure> {
+    /// What the attempt got: its response, or the failure that took its place. The outer
+    /// `Err` says what is wrong when the interaction holds neither or both, which
+    /// [`CassetteFile::parse`] refuses in a file.
+    pub fn outcome(&self) -> Result<Result<&StoredResponse, &StoredFailure>, &'static str> {
         match (&self.response, &self.failure) {
-            (Some(response), _) => Ok(response),
-            (None, Some(failure)) => Err(failure),
-            // `CassetteFile::parse` refuses such an interaction; one built in code is
-            // read as a response with no body, which verification reports.
-            (None, None) => Ok(&EMPTY_RESPONSE),
+            (Some(response), None) => Ok(Ok(response)),
+            (None, Some(failure)) => Ok(Err(failure)),
+            (None, None) => Err("has neither `response` nor `failure`"),
+            (Some(_), Some(_)) => Err("has both `response` and `failure`; expected one of them"),
         }
     }
 }
-
-static EMPTY_RESPONSE: StoredResponse = StoredResponse {
-    status: 0,
-    headers: BTreeMap::new(),
-    body: None,
-    body_text: None,
-    body_base64: None,
-};
 
 /// An attempt that was sent and got no HTTP response: a timeout, a refused or reset
 /// connection, a body cut short. Recorded so that a replay fails the same attempt the same
@@ -338,15 +331,12 @@ impl CassetteFile {
         }
         let file: Self = serde_json::from_str(text).map_err(parse_error)?;
         for (index, interaction) in file.interactions.iter().enumerate() {
-            let problem = match (&interaction.response, &interaction.failure) {
-                (Some(_), None) | (None, Some(_)) => continue,
-                (None, None) => "has neither `response` nor `failure`",
-                (Some(_), Some(_)) => "has both `response` and `failure`; expected one of them",
-            };
-            return Err(CassetteError::Schema {
-                path: path.to_path_buf(),
-                message: format!("interaction #{index} {problem}"),
-            });
+            if let Err(problem) = interaction.outcome() {
+                return Err(CassetteError::Schema {
+                    path: path.to_path_buf(),
+                    message: format!("interaction #{index} {problem}"),
+                });
+            }
         }
         Ok(file)
     }
@@ -567,6 +557,7 @@ mod tests {
             let replayed = back.interactions[0]
                 .outcome()
                 .unwrap()
+                .unwrap()
                 .to_wire(Origin::Replayed)
                 .unwrap();
             assert_eq!(&replayed.body[..], body, "{text}");
@@ -604,6 +595,7 @@ mod tests {
         assert_eq!(
             read.interactions[0]
                 .outcome()
+                .unwrap()
                 .unwrap_err()
                 .to_transport()
                 .to_string(),

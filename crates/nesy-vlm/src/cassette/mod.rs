@@ -308,16 +308,14 @@ impl CassetteTransport {
             let references = file.references(&sequence);
             for ((index, interaction), reference) in file.interactions.into_iter().enumerate().zip(references)
             {
-                let outcome =
-                    match interaction.outcome() {
-                        Ok(response) => Ok(response.to_wire(Origin::Replayed).map_err(|message| {
-                            CassetteError::Schema {
-                                path: path.clone(),
-                                message: format!("interaction #{index}: {message}"),
-                            }
-                        })?),
-                        Err(failure) => Err(failure.clone()),
-                    };
+                let schema = |message: String| CassetteError::Schema {
+                    path: path.clone(),
+                    message: format!("interaction #{index}: {message}"),
+                };
+                let outcome = match interaction.outcome().map_err(|problem| schema(problem.into()))? {
+                    Ok(response) => Ok(response.to_wire(Origin::Replayed).map_err(schema)?),
+                    Err(failure) => Err(failure.clone()),
+                };
                 recorded.push(Recorded {
                     key: reference.key,
                     occurrence: reference.occurrence,

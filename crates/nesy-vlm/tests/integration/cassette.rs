@@ -117,6 +117,7 @@ async fn record_then_replay_is_byte_identical_and_offline() {
     let headers: Vec<&str> = file.interactions[0]
         .outcome()
         .unwrap()
+        .unwrap()
         .headers
         .keys()
         .map(String::as_str)
@@ -607,7 +608,11 @@ async fn an_attempt_that_got_no_response_replays_as_the_same_failure() {
     let kinds: Vec<&str> = file
         .interactions
         .iter()
-        .map(|i| i.outcome().map_or_else(|failure| failure.kind(), |_| "response"))
+        .map(|i| {
+            i.outcome()
+                .unwrap()
+                .map_or_else(|failure| failure.kind(), |_| "response")
+        })
         .collect();
     assert_eq!(kinds, ["timeout", "response"]);
     assert!(tools::verify(&path).unwrap().is_empty());
