@@ -116,7 +116,10 @@ def main():
     every_scenario = args.scenarios is None or args.scenarios >= len(scenarios)
     if not every_scenario:
         scenarios = scenarios[: args.scenarios]
-    variants = sorted({variant for scenario, variant, _ in recorded if scenario in scenarios})
+    # In the manifest's order: the tables list methods in the order the run was given them.
+    present = {variant for scenario, variant, _ in recorded if scenario in scenarios}
+    declared = [entry.get("id") for entry in manifest.get("variants", [])]
+    variants = [v for v in declared if v in present] + sorted(present - set(declared))
     settings = manifest.get("settings", {})
 
     out = args.out or Path(tempfile.mkdtemp(prefix="nesy-rescore-"))
