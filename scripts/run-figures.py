@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Per-method figures of a recorded benchmark run, from its records and cassettes.
 
-    scripts/run-figures.py RUN [--replay REPLAY_RUN]
+    scripts/run-figures.py RUN [--replay REPLAY_RUN] [--scenarios ID,ID,...]
 
 RUN is a folder `nesy bench run --record-cassettes` wrote (manifest.json, results/*.jsonl,
 cassettes/<scenario>/<method>.json). Prints one Markdown table row per method:
@@ -19,7 +19,9 @@ cassettes/<scenario>/<method>.json). Prints one Markdown table row per method:
   its own time, so the sum exceeds the wall clock; it never counts a call's time queued;
 - with `--replay`, nesy's own seconds per unit: the `total_s` of the same unit in a run folder
   that an offline replay of the cassettes wrote (`scripts/rescore-run.py RUN --out DIR`
-  writes DIR/run), so that no model time is in it.
+  writes DIR/run), so that no model time is in it;
+- with `--scenarios`, only those scenarios' units, so that two runs can be set side by side
+  over the scenarios they share.
 
 A last line sums the run. Standard library only. Exit 0, or 2 on bad input.
 """
@@ -30,7 +32,7 @@ import math
 import sys
 from pathlib import Path
 
-from run_files import cassette_of, interactions, is_verifier_rejection, last_records, reask
+from run_files import cassette_of, fail_input, interactions, is_verifier_rejection, last_records, reask
 
 def wilson(successes, n, z=1.96):
     """The 95 % Wilson score interval of a proportion, in percent."""
@@ -69,9 +71,16 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("run", type=Path)
     parser.add_argument("--replay", type=Path, help="the run folder an offline replay wrote")
+    parser.add_argument("--scenarios", help="count only these scenarios (comma-separated ids)")
     args = parser.parse_args()
 
     records = last_records(args.run)
+    if args.scenarios:
+        wanted = {name.strip() for name in args.scenarios.split(",") if name.strip()}
+        unknown = sorted(wanted - {scenario for scenario, _, _ in records})
+        if unknown:
+            fail_input(f"--scenarios: {', '.join(unknown)}: no finished unit of the run {args.run}")
+        records = {key: record for key, record in records.items() if key[0] in wanted}
     replayed = last_records(args.replay) if args.replay else {}
     # Only the cassettes of finished units count (a unit in flight has one too).
     counts = {}
